@@ -1,0 +1,52 @@
+# Helper functions shared by every module: one target per module, explicit PUBLIC/PRIVATE links.
+
+set(RECONAR_WARNING_FLAGS -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wno-missing-field-initializers)
+if(RECONAR_WERROR)
+  list(APPEND RECONAR_WARNING_FLAGS -Werror)
+endif()
+
+if(RECONAR_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+
+# Architecture flags for SIMD kernels: each instruction set lives in its own translation unit.
+if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
+  set(RECONAR_ARCH_X86 ON)
+  set(RECONAR_AVX2_FLAGS -mavx2 -mfma)
+elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^(aarch64|arm64|ARM64)$")
+  set(RECONAR_ARCH_ARM64 ON)
+endif()
+
+# reconar_add_library(NAME SOURCES ... [PUBLIC_LINKS ...] [PRIVATE_LINKS ...])
+# Creates target reconar_<NAME> with the repository root as include root ("core/base/status.h").
+function(reconar_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_LINKS;PRIVATE_LINKS" ${ARGN})
+  add_library(reconar_${name} STATIC ${ARG_SOURCES})
+  target_include_directories(reconar_${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
+  target_compile_options(reconar_${name} PRIVATE ${RECONAR_WARNING_FLAGS})
+  target_link_libraries(reconar_${name} PUBLIC ${ARG_PUBLIC_LINKS} PRIVATE ${ARG_PRIVATE_LINKS})
+endfunction()
+
+# reconar_add_test(NAME SOURCES ... [LINKS ...] [LABELS ...] [TIMEOUT seconds])
+# A GoogleTest executable; each TEST becomes a CTest case (discovered through the cross emulator too).
+# Label "unit" for fast self-contained tests, "e2e" for tests on ../shared/data.
+function(reconar_add_test name)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LINKS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_compile_options(${name} PRIVATE ${RECONAR_WARNING_FLAGS})
+  target_compile_definitions(${name} PRIVATE
+      RECONAR_SHARED_DATA_DIR="${RECONAR_SHARED_DATA_DIR}"
+      RECONAR_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  target_link_libraries(${name} PRIVATE ${ARG_LINKS} GTest::gtest GTest::gtest_main)
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/tests")
+  if(NOT ARG_LABELS)
+    set(ARG_LABELS unit)
+  endif()
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 600)
+  endif()
+  gtest_discover_tests(${name}
+      PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+      DISCOVERY_TIMEOUT 120)
+endfunction()

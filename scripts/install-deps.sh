@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Installs what reconar needs on Debian 12. Idempotent: re-running installs nothing new.
+#   scripts/install-deps.sh            build + test dependencies (x86-64 host)
+#   scripts/install-deps.sh --cross    also the aarch64 cross toolchain, arm64 libraries and qemu-user
+#   scripts/install-deps.sh --bench    also the peers measured side by side in bench/ (OpenCV)
+set -euo pipefail
+
+want_cross=0
+want_bench=0
+for arg in "$@"; do
+  case "$arg" in
+    --cross) want_cross=1 ;;
+    --bench) want_bench=1 ;;
+    -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
+    *) echo "install-deps.sh: unknown option '$arg'" >&2; exit 2 ;;
+  esac
+done
+
+sudo_cmd=""
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+
+host_packages=(build-essential cmake pkg-config
+  libjpeg62-turbo-dev libpng-dev libeigen3-dev
+  libgtest-dev libbenchmark-dev)
+cross_packages=(g++-aarch64-linux-gnu qemu-user
+  libjpeg62-turbo-dev:arm64 libpng-dev:arm64 libgtest-dev:arm64)
+bench_packages=(libopencv-dev)
+
+missing() {
+  local out=()
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || out+=("$p")
+  done
+  echo "${out[@]:-}"
+}
+
+todo=( $(missing "${host_packages[@]}") )
+if [ "$want_cross" = 1 ]; then
+  if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+    $sudo_cmd dpkg --add-architecture arm64
+  fi
+  todo+=( $(missing "${cross_packages[@]}") )
+fi
+if [ "$want_bench" = 1 ]; then todo+=( $(missing "${bench_packages[@]}") ); fi
+
+if [ "${#todo[@]}" -eq 0 ]; then
+  echo "install-deps: all packages present"
+  exit 0
+fi
+echo "install-deps: installing ${todo[*]}"
+$sudo_cmd apt-get update -qq
+$sudo_cmd apt-get install -y -qq --no-install-recommends "${todo[@]}"
