@@ -1,0 +1,52 @@
+#include "core/geometry/fundamental_eight_point.h"
+
+#include <Eigen/SVD>
+
+#include "core/geometry/normalization.h"
+#include "core/geometry/null_space.h"
+#include "core/geometry/residuals.h"
+
+namespace reconar {
+
+int FundamentalEightPoint::Estimate(const Sample* samples, int count, std::array<Model, kMaxModels>* models) {
+  if (count < kMinSamples) return 0;
+  Eigen::Matrix3d T1, T2;
+  if (!HartleyNormalisation(samples, count, &T1, &T2)) return 0;
+
+  Eigen::Matrix<double, 9, 1> f;
+  if (count == kMinSamples) {
+    Eigen::Matrix<double, kMinSamples, 9> A;
+    for (int i = 0; i < kMinSamples; ++i) {
+      A.row(i) = EpipolarRow(ApplySimilarity(T1, samples[i].x1), ApplySimilarity(T2, samples[i].x2));
+    }
+    f = NullSpaceOfWideMatrix<kMinSamples>(A);
+  } else {
+    Eigen::Matrix<double, 9, 9> AtA = Eigen::Matrix<double, 9, 9>::Zero();
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Matrix<double, 1, 9> row =
+          EpipolarRow(ApplySimilarity(T1, samples[i].x1), ApplySimilarity(T2, samples[i].x2));
+      AtA.selfadjointView<Eigen::Lower>().rankUpdate(row.transpose());
+    }
+    AtA.triangularView<Eigen::StrictlyUpper>() = AtA.transpose();
+    f = SmallestEigenvectors<1>(AtA);
+  }
+
+  // Closest rank-2 matrix in the Frobenius norm (Eckart-Young), in normalised coordinates.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(Matrix3FromVector(f), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Vector3d singular = svd.singularValues();
+  singular(2) = 0.0;
+  const Eigen::Matrix3d F_normalised = svd.matrixU() * singular.asDiagonal() * svd.matrixV().transpose();
+
+  Eigen::Matrix3d F = T2.transpose() * F_normalised * T1;
+  const double norm = F.norm();
+  if (!(norm > 0.0) || !F.allFinite()) return 0;
+  (*models)[0] = F / norm;
+  return 1;
+}
+
+void FundamentalEightPoint::Residuals(const Sample* samples, int count, const Model& F,
+                                      double* squared_residuals) {
+  for (int i = 0; i < count; ++i) squared_residuals[i] = SquaredSampsonError(F, samples[i].x1, samples[i].x2);
+}
+
+}  // namespace reconar

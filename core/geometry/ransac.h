@@ -1,0 +1,238 @@
+#pragma once
+// Ransac<Estimator, LocalEstimator>: one robust-estimation loop for every estimator in this
+// module (DESIGN.md: "One RANSAC template serves them all"). An Estimator is a type with
+//   using Sample, Model; static constexpr int kMinSamples, kMaxModels;
+//   static int Estimate(const Sample*, int count, std::array<Model, kMaxModels>*);
+//   static void Residuals(const Sample*, int count, const Model&, double* squared_residuals);
+// The loop is RANSAC (Fischler & Bolles 1981) with
+//  - MSAC scoring (Torr & Zisserman 2000): cost = sum_i min(r_i^2, t^2); lower is better;
+//  - the adaptive iteration count N = log(1 - confidence) / log(1 - w^kMinSamples) from the
+//    inlier ratio w of the best model so far;
+//  - LO-RANSAC (Chum, Matas & Kittler 2003): every new best model is re-estimated by iterated
+//    least squares (LocalEstimator with more than kMinSamples samples) on its inliers under a
+//    threshold shrinking to t;
+//  - early exit from scoring a hypothesis once its partial cost exceeds the best cost;
+//  - a SplitMix64 sampler seeded from the options: runs are deterministic.
+// The minimal solver is called on a std::array copy of the sample; the per-run buffers
+// (residuals, LO inliers) are allocated once per Run.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/geometry/prng.h"
+#include "core/geometry/ransac_options.h"
+
+namespace reconar {
+
+namespace ransac_internal {
+
+// Iterations after which an all-inlier minimal sample of `sample_size` has been drawn with
+// probability `confidence` when a fraction `inlier_ratio` of the samples are inliers:
+// log(1 - confidence) / log(1 - inlier_ratio^sample_size), clamped to [0, max_iterations].
+inline int RequiredIterationsForRatio(double inlier_ratio, int sample_size, double confidence, int max_iterations) {
+  if (!(inlier_ratio > 0.0)) return max_iterations;
+  if (inlier_ratio >= 1.0) return 0;
+  const double p_all_inliers = std::pow(inlier_ratio, sample_size);
+  const double log_miss = std::log1p(-p_all_inliers);  // log(1 - w^s), accurate for tiny w^s
+  if (!(log_miss < 0.0)) return max_iterations;
+  const double n = std::log(1.0 - confidence) / log_miss;
+  if (!(n < max_iterations)) return max_iterations;
+  return static_cast<int>(std::ceil(n));
+}
+
+// The same for num_inliers of num_samples.
+inline int RequiredIterations(int num_inliers, int num_samples, int sample_size, double confidence,
+                              int max_iterations) {
+  if (num_samples <= 0) return max_iterations;
+  return RequiredIterationsForRatio(static_cast<double>(num_inliers) / num_samples, sample_size, confidence,
+                                    max_iterations);
+}
+
+}  // namespace ransac_internal
+
+template <typename Estimator, typename LocalEstimator = Estimator>
+class Ransac {
+ public:
+  using Sample = typename Estimator::Sample;
+  using Model = typename Estimator::Model;
+  using Report = RansacReport<Model>;
+  static_assert(std::is_same_v<Sample, typename LocalEstimator::Sample>, "estimators must share Sample");
+  static_assert(std::is_same_v<Model, typename LocalEstimator::Model>, "estimators must share Model");
+  static_assert(Estimator::kMinSamples > 0 && Estimator::kMaxModels > 0, "bad estimator constants");
+
+  // InvalidArgument for options failing Check() or a negative count. Otherwise a report whose
+  // status says whether a model was found.
+  static Result<Report> Run(const Sample* samples, int count, const RansacOptions& options) {
+    RECONAR_RETURN_IF_ERROR(options.Check());
+    if (count < 0 || (count > 0 && samples == nullptr)) {
+      return InvalidArgument("Ransac::Run: invalid sample array (count " + std::to_string(count) + ")");
+    }
+    Report report;
+    if (count < Estimator::kMinSamples) {
+      report.status = RansacStatus::kTooFewSamples;
+      return report;
+    }
+
+    const double t2 = options.max_residual * options.max_residual;
+    std::vector<double> residuals(static_cast<size_t>(count));
+    std::vector<Sample> local_samples;
+    if (options.local_optimisation) local_samples.reserve(static_cast<size_t>(count));
+
+    SplitMix64 rng(options.seed);
+    std::array<int, Estimator::kMinSamples> indices;
+    std::array<Sample, Estimator::kMinSamples> minimal;
+    std::array<Model, Estimator::kMaxModels> models;
+    Candidate best;
+    int required = options.max_iterations;
+    int iterations = 0;
+    while (iterations < options.max_iterations &&
+           (iterations < options.min_iterations || iterations < required)) {
+      ++iterations;
+      DrawSample(&rng, count, &indices);
+      for (int i = 0; i < Estimator::kMinSamples; ++i) minimal[i] = samples[indices[i]];
+      const int num_models = Estimator::Estimate(minimal.data(), Estimator::kMinSamples, &models);
+      bool improved = false;
+      for (int m = 0; m < num_models; ++m) {
+        Candidate candidate;
+        if (!Score(samples, count, models[m], t2, best.cost, residuals.data(), &candidate)) continue;
+        if (candidate.cost < best.cost) {
+          best = candidate;
+          improved = true;
+        }
+      }
+      if (!improved) continue;
+      if (options.local_optimisation && options.local_iterations > 0) {
+        LocalOptimise(samples, count, options, t2, residuals.data(), &local_samples, &best);
+        ++report.local_optimisations;
+      }
+      required = ransac_internal::RequiredIterations(best.num_inliers, count, Estimator::kMinSamples,
+                                                     options.confidence, options.max_iterations);
+    }
+
+    report.iterations = iterations;
+    if (best.num_inliers < Estimator::kMinSamples) {
+      report.status = RansacStatus::kNoModel;
+      return report;
+    }
+    report.status = RansacStatus::kSuccess;
+    report.model = best.model;
+    report.cost = best.cost;
+    report.num_inliers = best.num_inliers;
+    Estimator::Residuals(samples, count, best.model, residuals.data());
+    report.inlier_mask.resize(static_cast<size_t>(count));
+    for (int i = 0; i < count; ++i) report.inlier_mask[i] = residuals[i] < t2 ? 1 : 0;
+    return report;
+  }
+
+  static Result<Report> Run(const std::vector<Sample>& samples, const RansacOptions& options) {
+    return Run(samples.data(), static_cast<int>(samples.size()), options);
+  }
+
+ private:
+  struct Candidate {
+    Model model = Model::Zero();
+    double cost = std::numeric_limits<double>::infinity();
+    int num_inliers = 0;
+  };
+
+  static constexpr int kScoreBlock = 256;  // residuals computed between early-exit checks
+
+  // kMinSamples distinct indices in [0, count), count >= kMinSamples, by rejection.
+  static void DrawSample(SplitMix64* rng, int count, std::array<int, Estimator::kMinSamples>* indices) {
+    for (int i = 0; i < Estimator::kMinSamples; ++i) {
+      bool fresh;
+      do {
+        (*indices)[i] = static_cast<int>(rng->UniformInt(static_cast<uint32_t>(count)));
+        fresh = std::find(indices->begin(), indices->begin() + i, (*indices)[i]) == indices->begin() + i;
+      } while (!fresh);
+    }
+  }
+
+  // MSAC cost and inlier count of `model`. Returns false (result unset) as soon as the partial
+  // cost exceeds `bound`, which cannot beat the best model any more.
+  static bool Score(const Sample* samples, int count, const Model& model, double t2, double bound,
+                    double* residuals, Candidate* result) {
+    double cost = 0.0;
+    int num_inliers = 0;
+    for (int begin = 0; begin < count; begin += kScoreBlock) {
+      const int length = std::min(kScoreBlock, count - begin);
+      Estimator::Residuals(samples + begin, length, model, residuals + begin);
+      for (int i = begin; i < begin + length; ++i) {
+        if (residuals[i] < t2) {
+          cost += residuals[i];
+          ++num_inliers;
+        } else {
+          cost += t2;
+        }
+      }
+      if (cost > bound) return false;
+    }
+    result->model = model;
+    result->cost = cost;
+    result->num_inliers = num_inliers;
+    return true;
+  }
+
+  // Least-squares fit (LocalEstimator on all samples with squared residual under `threshold2`
+  // for `model`), scored at t2. False when too few samples qualify or no model results.
+  static bool LeastSquaresStep(const Sample* samples, int count, const Model& model, double threshold2, double t2,
+                               double* residuals, std::vector<Sample>* inliers, Candidate* result) {
+    Estimator::Residuals(samples, count, model, residuals);
+    inliers->clear();
+    for (int i = 0; i < count; ++i) {
+      if (residuals[i] < threshold2) inliers->push_back(samples[i]);
+    }
+    if (static_cast<int>(inliers->size()) < LocalEstimator::kMinSamples) return false;
+    std::array<Model, LocalEstimator::kMaxModels> models;
+    const int num_models = LocalEstimator::Estimate(inliers->data(), static_cast<int>(inliers->size()), &models);
+    Candidate step_best;
+    for (int m = 0; m < num_models; ++m) {
+      Candidate candidate;
+      if (Score(samples, count, models[m], t2, step_best.cost, residuals, &candidate) &&
+          candidate.cost < step_best.cost) {
+        step_best = candidate;
+      }
+    }
+    if (step_best.num_inliers == 0) return false;
+    *result = step_best;
+    return true;
+  }
+
+  // LO step of Chum et al.: iterated least squares from `best` with the inlier threshold
+  // shrinking from local_threshold_multiplier * t to t over local_iterations steps, then the
+  // best model so far is polished by least squares on its own inliers (threshold t) while that
+  // lowers the cost. The wide early thresholds let the fit escape a poor minimal model; the
+  // polish removes the pull of the near-threshold outliers they admit. `best` is replaced by
+  // any lower-cost model.
+  static void LocalOptimise(const Sample* samples, int count, const RansacOptions& options, double t2,
+                            double* residuals, std::vector<Sample>* inliers, Candidate* best) {
+    const int steps = options.local_iterations;
+    const double m = options.local_threshold_multiplier;
+    Model current = best->model;
+    Candidate candidate;
+    for (int step = 0; step < steps; ++step) {
+      const double fraction = steps > 1 ? static_cast<double>(step) / (steps - 1) : 1.0;
+      const double multiplier = m - (m - 1.0) * fraction;
+      if (!LeastSquaresStep(samples, count, current, t2 * multiplier * multiplier, t2, residuals, inliers,
+                            &candidate)) {
+        break;
+      }
+      current = candidate.model;
+      if (candidate.cost < best->cost) *best = candidate;
+    }
+    for (int polish = 0; polish < steps; ++polish) {
+      if (!LeastSquaresStep(samples, count, best->model, t2, t2, residuals, inliers, &candidate) ||
+          !(candidate.cost < best->cost)) {
+        break;
+      }
+      *best = candidate;
+    }
+  }
+};
+
+}  // namespace reconar

@@ -1,0 +1,25 @@
+#pragma once
+// An initial focal length in pixels for self-calibration, from EXIF when possible.
+#include <string>
+
+#include "core/io/exif.h"
+
+namespace reconar {
+
+struct FocalPrior {
+  enum class Source {
+    kExif35mm,         // FocalLengthIn35mmFilm: f_px = f35 / 36 * max(w, h)
+    kExifSensorTable,  // FocalLength + sensor width from the built-in camera table
+    kDefault,          // no usable EXIF: 1.2 * max(w, h)
+  };
+  double focal_px = 0;
+  Source source = Source::kDefault;
+  std::string explanation;  // one line for logs and reports, with the numbers used
+};
+
+// `width`/`height` are the image size after orientation (max(w, h) is what matters).
+FocalPrior EstimateFocalPrior(const ExifInfo& exif, int width, int height);
+
+const char* FocalPriorSourceName(FocalPrior::Source source);
+
+}  // namespace reconar

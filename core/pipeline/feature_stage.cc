@@ -1,0 +1,133 @@
+#include "core/pipeline/feature_stage.h"
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "core/base/atomic_file.h"
+#include "core/base/log.h"
+#include "core/base/progress.h"
+#include "core/base/thread_pool.h"
+#include "core/features/sift/sift_io.h"
+#include "core/io/focal_prior.h"
+#include "core/io/image_io.h"
+
+namespace reconar {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Per-worker extractors: the configured one, and a first-octave-0 one used when a large photo's
+// doubled first octave would not fit the arena (said in the image's warnings).
+struct WorkerExtractors {
+  std::unique_ptr<SiftExtractor> configured;
+  std::unique_ptr<SiftExtractor> fallback;
+};
+
+std::string KeyPathFor(const FeatureStageOptions& options, const std::string& image_path, size_t num_images) {
+  if (options.key_output.empty()) return "";
+  std::error_code ec;
+  if (num_images == 1 && !fs::is_directory(options.key_output, ec)) return options.key_output;
+  return (fs::path(options.key_output) / fs::path(image_path).stem()).string() + ".key";
+}
+
+}  // namespace
+
+Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image_paths, const Project* project,
+                                           const FeatureStageOptions& options,
+                                           std::vector<SiftFeatures>* features_out) {
+  RECONAR_RETURN_IF_ERROR(options.sift.Check());
+  const auto start = Clock::now();
+  if (project != nullptr) RECONAR_RETURN_IF_ERROR(CreateDirectories(project->FeaturesDir()));
+  if (!options.key_output.empty() && image_paths.size() > 1) {
+    RECONAR_RETURN_IF_ERROR(CreateDirectories(options.key_output));
+  }
+  const size_t n = image_paths.size();
+  const int threads = std::min<int>(ThreadPool::ResolveThreadCount(options.num_threads), static_cast<int>(n));
+  ThreadPool pool(threads);
+  std::vector<WorkerExtractors> extractors(pool.num_threads());
+  std::vector<std::optional<ImageFeatureSummary>> summaries(n);
+  std::vector<SiftFeatures> features(n);
+  std::vector<std::string> skipped(n);
+  std::vector<Status> output_errors(n);
+  std::optional<Progress> progress;
+  if (options.show_progress) progress.emplace("features", n);
+
+  pool.ParallelFor(0, n, [&](size_t i, int worker) {
+    const std::string& path = image_paths[i];
+    const auto image_start = Clock::now();
+    auto decoded = ReadImage(path);
+    if (!decoded.ok()) {
+      skipped[i] = decoded.status().message();
+      if (progress) progress->Advance();
+      return;
+    }
+    ImageFeatureSummary summary;
+    summary.warnings = decoded->warnings;
+    const Image<float> gray = ToGrayFloat(decoded->rgb);
+    const FocalPrior prior = EstimateFocalPrior(decoded->exif, gray.width(), gray.height());
+    summary.image.name = fs::path(path).filename().string();
+    summary.image.path = path;
+    summary.image.width = gray.width();
+    summary.image.height = gray.height();
+    summary.image.focal_px = prior.focal_px;
+    summary.image.focal_source = FocalPriorSourceName(prior.source);
+    summary.focal_explanation = prior.explanation;
+
+    WorkerExtractors& mine = extractors[worker];
+    if (!mine.configured) mine.configured = std::make_unique<SiftExtractor>(options.sift);
+    auto result = mine.configured->Extract(gray.view());
+    if (!result.ok() && result.status().code() == StatusCode::kResourceExhausted && options.sift.first_octave < 0) {
+      if (!mine.fallback) {
+        SiftOptions fallback = options.sift;
+        fallback.first_octave = 0;
+        mine.fallback = std::make_unique<SiftExtractor>(fallback);
+      }
+      summary.warnings.push_back("first octave 0 used: " + result.status().message());
+      result = mine.fallback->Extract(gray.view());
+    }
+    if (!result.ok()) {
+      skipped[i] = path + ": " + result.status().message();
+      if (progress) progress->Advance();
+      return;
+    }
+    summary.num_features = static_cast<int>(result->keypoints.size());
+    if (project != nullptr) {
+      FeatureFile file{gray.width(), gray.height(), *result};
+      output_errors[i] = WriteFeatureFile(project->FeaturePath(summary.image.name), file);
+    }
+    const std::string key_path = KeyPathFor(options, path, n);
+    if (output_errors[i].ok() && !key_path.empty()) output_errors[i] = WriteLoweKeyFile(key_path, *result);
+    features[i] = std::move(result).value();
+    summary.seconds = std::chrono::duration<double>(Clock::now() - image_start).count();
+    summaries[i] = std::move(summary);
+    if (progress) progress->Advance();
+  });
+  if (progress) progress->Finish();
+
+  for (const Status& status : output_errors) RECONAR_RETURN_IF_ERROR(status);
+  FeatureStageReport report;
+  std::vector<ProjectImage> listed;
+  for (size_t i = 0; i < n; ++i) {
+    if (!skipped[i].empty()) {
+      report.skipped.push_back(skipped[i]);
+      continue;
+    }
+    listed.push_back(summaries[i]->image);
+    report.extracted.push_back(std::move(*summaries[i]));
+    if (features_out != nullptr) features_out->push_back(std::move(features[i]));
+  }
+  if (report.extracted.empty()) {
+    std::string reasons;
+    for (const std::string& s : report.skipped) reasons += "\n  " + s;
+    return InvalidArgument("no image could be processed:" + reasons);
+  }
+  if (project != nullptr) RECONAR_RETURN_IF_ERROR(project->WriteImageList(listed));
+  report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return report;
+}
+
+}  // namespace reconar

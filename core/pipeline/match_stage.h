@@ -1,0 +1,60 @@
+#pragma once
+// Match stage: kd-forest matching with Lowe's ratio test between every pair of a project's
+// images (exhaustive), then two-view verification (F by LO-RANSAC, H screening). Pairs with at
+// least TwoViewOptions::min_inliers F-inliers go to <project>/matches/matches.txt:
+//   # reconar matches v1
+//   pair NAME_A NAME_B CONFIG NUM_INLIERS f11 f12 ... f33     (x_b^T F x_a = 0, pixels)
+//   INDEX_A INDEX_B                                           (NUM_INLIERS lines, feature indices)
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/base/status.h"
+#include "core/features/matcher.h"
+#include "core/features/sift/sift.h"
+#include "core/geometry/two_view.h"
+#include "core/pipeline/project.h"
+
+namespace reconar {
+
+struct MatchStageOptions {
+  MatchOptions match;
+  TwoViewOptions two_view;
+  int num_threads = 0;  // pairs in parallel; <= 0: one per core
+  bool show_progress = true;
+};
+
+struct VerifiedPair {
+  int image_a = -1;
+  int image_b = -1;
+  int num_putative = 0;
+  TwoViewGeometry geometry;
+  std::vector<FeatureMatch> inlier_matches;
+};
+
+struct MatchStageReport {
+  int num_images = 0;
+  int num_pairs = 0;
+  int num_verified = 0;   // kVerified
+  int num_planar = 0;     // kPlanarOrRotation (kept: good matches, low parallax)
+  int num_rejected = 0;   // kTooFewInliers
+  double seconds = 0;
+  std::vector<VerifiedPair> pairs;  // kept pairs only, without per-pair rejects
+};
+
+// Verifies putative matches between two feature sets of images of the given sizes.
+Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int height_a, const SiftFeatures& b,
+                                   int width_b, int height_b, const std::vector<FeatureMatch>& putative,
+                                   const TwoViewOptions& options);
+
+Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageOptions& options);
+
+struct MatchesFilePair {
+  std::string name_a, name_b, config;
+  Eigen::Matrix3d F;
+  std::vector<FeatureMatch> matches;
+};
+Result<std::vector<MatchesFilePair>> ReadMatchesFile(const std::string& path);
+
+}  // namespace reconar

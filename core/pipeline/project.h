@@ -1,0 +1,43 @@
+#pragma once
+// A project folder: features/ (one .rfeat per image plus images.txt), matches/ (matches.txt).
+// images.txt lists, one image per line, "name width height focal_px focal_source path"; names are
+// unique within a project and key every other file.
+#include <string>
+#include <vector>
+
+#include "core/base/status.h"
+
+namespace reconar {
+
+struct ProjectImage {
+  std::string name;   // file name, e.g. "0004.jpg"
+  std::string path;   // as given on the command line
+  int width = 0;      // after EXIF orientation
+  int height = 0;
+  double focal_px = 0;
+  std::string focal_source;  // "exif-35mm", "exif-sensor-table" or "default"
+};
+
+class Project {
+ public:
+  explicit Project(std::string root) : root_(std::move(root)) {}
+  const std::string& root() const { return root_; }
+  std::string FeaturesDir() const { return root_ + "/features"; }
+  std::string MatchesDir() const { return root_ + "/matches"; }
+  std::string ImageListPath() const { return FeaturesDir() + "/images.txt"; }
+  std::string FeaturePath(const std::string& image_name) const { return FeaturesDir() + "/" + image_name + ".rfeat"; }
+  std::string MatchesPath() const { return MatchesDir() + "/matches.txt"; }
+
+  Status WriteImageList(const std::vector<ProjectImage>& images) const;
+  Result<std::vector<ProjectImage>> ReadImageList() const;
+
+ private:
+  std::string root_;
+};
+
+// Expands arguments into image files: a directory contributes its .jpg/.jpeg/.png files (any case,
+// sorted by name), a file is taken as is. NotFound for a missing argument; InvalidArgument when two
+// images share a file name or nothing is left.
+Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string>& arguments);
+
+}  // namespace reconar

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Cross-builds for aarch64 (toolchains/aarch64-linux-gnu.cmake) and runs the unit tests under
+# qemu-user through CMAKE_CROSSCOMPILING_EMULATOR. End-to-end tests (label e2e) run natively only.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/install-deps.sh --cross
+build=${RECONAR_CROSS_BUILD_DIR:-build-aarch64}
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON \
+  -DCMAKE_TOOLCHAIN_FILE=toolchains/aarch64-linux-gnu.cmake > "$build.configure.log" 2>&1 \
+  || { cat "$build.configure.log"; exit 1; }
+cmake --build "$build" -j"$(nproc)"
+file "$build/bin/reconar" 2>/dev/null | grep -q aarch64 || { echo "not an aarch64 binary" >&2; exit 1; }
+ctest --test-dir "$build" --output-on-failure -j"$(nproc)" -L unit --timeout 900

@@ -1,0 +1,90 @@
+#include "tools/args.h"
+
+#include <cstdio>
+#include <cstdlib>
+
+namespace reconar::tools {
+
+Args::Args(std::set<std::string> valued, std::set<std::string> flags)
+    : valued_(std::move(valued)), flags_(std::move(flags)) {
+  flags_.insert("help");
+}
+
+Status Args::Parse(int argc, char** argv, int first) {
+  for (int i = first; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "-h") arg = "--help";
+    if (arg.rfind("--", 0) != 0 || arg.size() == 2) {
+      positionals_.push_back(arg);
+      continue;
+    }
+    std::string name = arg.substr(2);
+    std::string value;
+    const size_t eq = name.find('=');
+    const bool inline_value = eq != std::string::npos;
+    if (inline_value) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    }
+    if (flags_.count(name) != 0) {
+      if (inline_value) return InvalidArgument("option --" + name + " takes no value");
+      values_[name] = "1";
+    } else if (valued_.count(name) != 0) {
+      if (!inline_value) {
+        if (i + 1 >= argc) return InvalidArgument("option --" + name + " needs a value");
+        value = argv[++i];
+      }
+      values_[name] = value;
+    } else {
+      return InvalidArgument("unknown option --" + name + " (see --help)");
+    }
+  }
+  return Status::Ok();
+}
+
+std::string Args::Get(const std::string& name, const std::string& fallback) const {
+  auto it = values_.find(name);
+  return it == values_.end() ? fallback : it->second;
+}
+
+Result<int> Args::GetInt(const std::string& name, int fallback, int min, int max) const {
+  if (!Has(name)) return fallback;
+  const std::string text = Get(name);
+  char* end = nullptr;
+  const long value = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || value < min || value > max) {
+    return InvalidArgument("--" + name + " expects an integer in [" + std::to_string(min) + ", " +
+                           std::to_string(max) + "], got '" + text + "'");
+  }
+  return static_cast<int>(value);
+}
+
+Result<double> Args::GetDouble(const std::string& name, double fallback, double min, double max) const {
+  if (!Has(name)) return fallback;
+  const std::string text = Get(name);
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !(value >= min && value <= max)) {
+    return InvalidArgument("--" + name + " expects a number in [" + std::to_string(min) + ", " +
+                           std::to_string(max) + "], got '" + text + "'");
+  }
+  return value;
+}
+
+int ExitCodeFor(const Status& status) {
+  switch (status.code()) {
+    case StatusCode::kOk: return 0;
+    case StatusCode::kInvalidArgument:
+    case StatusCode::kNotFound:
+    case StatusCode::kCorruptData:
+    case StatusCode::kUnsupported: return 2;
+    default: return 1;
+  }
+}
+
+int Fail(const Status& status) {
+  std::fprintf(stderr, "reconar: error: %s\n", status.ToString().c_str());
+  return ExitCodeFor(status);
+}
+
+}  // namespace reconar::tools

@@ -1,0 +1,89 @@
+#include <cstdio>
+#include <optional>
+
+#include "core/pipeline/feature_stage.h"
+#include "core/pipeline/project.h"
+#include "tools/commands.h"
+
+namespace reconar::tools {
+
+namespace {
+
+constexpr char kHelp[] =
+    "usage: reconar features IMAGE|DIR... [--project DIR] [--key OUT] [--first-octave -1|0]\n"
+    "                        [--max-features N] [--sift-memory-mib M] [--threads N]\n"
+    "\n"
+    "Finds SIFT keypoints and descriptors (Lowe 2004) in each photo (JPEG or PNG; a directory\n"
+    "contributes all of its .jpg/.jpeg/.png files). Unreadable photos are skipped with a warning.\n"
+    "  --project DIR       write DIR/features/<name>.rfeat and DIR/features/images.txt\n"
+    "  --key OUT           also write Lowe's ASCII .key format (a file for one image, else a directory)\n"
+    "  --first-octave N    -1 (default) doubles the image first for more small-scale features; 0 does not\n"
+    "  --max-features N    keep the N strongest per image (default 16384, 0 = all)\n"
+    "  --sift-memory-mib M working-memory bound per thread (default 512); larger photos fall back to\n"
+    "                      first octave 0 with a warning\n"
+    "  --threads N         photos processed in parallel (default: one per core)\n";
+
+}  // namespace
+
+Result<SiftOptions> SiftOptionsFromArgs(const Args& args) {
+  SiftOptions options;
+  RECONAR_ASSIGN_OR_RETURN(options.first_octave, args.GetInt("first-octave", options.first_octave, -1, 0));
+  RECONAR_ASSIGN_OR_RETURN(options.max_features, args.GetInt("max-features", options.max_features, 0, 1 << 24));
+  RECONAR_ASSIGN_OR_RETURN(const int mib,
+                           args.GetInt("sift-memory-mib", static_cast<int>(options.arena_bytes >> 20), 16, 1 << 16));
+  options.arena_bytes = static_cast<size_t>(mib) << 20;
+  return options;
+}
+
+int RunFeatures(int argc, char** argv, int first) {
+  std::set<std::string> valued = kSiftValuedOptions;
+  valued.insert({"project", "key", "threads"});
+  Args args(valued, {});
+  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
+  if (args.Has("help")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  if (args.positionals().empty()) {
+    std::fputs(kHelp, stderr);
+    return 2;
+  }
+  if (!args.Has("project") && !args.Has("key")) {
+    return Fail(InvalidArgument("nothing to write: give --project DIR and/or --key OUT"));
+  }
+  FeatureStageOptions options;
+  auto sift = SiftOptionsFromArgs(args);
+  if (!sift.ok()) return Fail(sift.status());
+  options.sift = *sift;
+  auto threads = args.GetInt("threads", 0, 0, 1024);
+  if (!threads.ok()) return Fail(threads.status());
+  options.num_threads = *threads;
+  options.key_output = args.Get("key");
+
+  auto paths = CollectImagePaths(args.positionals());
+  if (!paths.ok()) return Fail(paths.status());
+  std::optional<Project> project;
+  if (args.Has("project")) project.emplace(args.Get("project"));
+  auto report = RunFeatureStage(*paths, project ? &*project : nullptr, options);
+  if (!report.ok()) return Fail(report.status());
+
+  for (const std::string& skipped : report->skipped) std::fprintf(stderr, "warning: skipped %s\n", skipped.c_str());
+  size_t total = 0;
+  bool default_focal_said = false;
+  for (const ImageFeatureSummary& s : report->extracted) {
+    std::printf("%-24s %5dx%-5d %6d features  %.2fs  focal %.1f px (%s)\n", s.image.name.c_str(), s.image.width,
+                s.image.height, s.num_features, s.seconds, s.image.focal_px, s.image.focal_source.c_str());
+    for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s: %s\n", s.image.path.c_str(), w.c_str());
+    if (s.image.focal_source == "default" && !default_focal_said) {
+      std::fprintf(stderr, "note: %s\n", s.focal_explanation.c_str());
+      default_focal_said = true;
+    }
+    total += static_cast<size_t>(s.num_features);
+  }
+  std::printf("features: %zu images, %zu skipped, %zu features, %.1fs%s%s\n", report->extracted.size(),
+              report->skipped.size(), total, report->seconds, project ? ", written to " : "",
+              project ? project->FeaturesDir().c_str() : "");
+  return 0;
+}
+
+}  // namespace reconar::tools

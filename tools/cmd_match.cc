@@ -1,0 +1,118 @@
+#include <cstdio>
+
+#include "core/base/atomic_file.h"
+#include "core/pipeline/feature_stage.h"
+#include "core/pipeline/match_stage.h"
+#include "tools/commands.h"
+
+namespace reconar::tools {
+
+namespace {
+
+constexpr char kHelp[] =
+    "usage: reconar match IMAGE_A IMAGE_B [--pairs OUT.txt] [options]\n"
+    "       reconar match --project DIR [options]\n"
+    "\n"
+    "Matches SIFT descriptors with a randomized kd-forest and Lowe's ratio test, then keeps the\n"
+    "matches consistent with a fundamental matrix (normalised 8-point in LO-RANSAC, threshold\n"
+    "0.6 % of the larger image side) and screens for planar/rotation-only pairs with a homography.\n"
+    "  --pairs OUT.txt   write the verified matches, one 'xa ya xb yb' per line (pixels)\n"
+    "  --project DIR     match all pairs of a project made by `reconar features --project DIR`;\n"
+    "                    writes DIR/matches/matches.txt\n"
+    "  --ratio R         Lowe ratio (default 0.6)   --checks N  leaf checks per query (default 200)\n"
+    "  --min-inliers N   inliers a pair needs (default 100)\n"
+    "  --threads N       worker threads (default: one per core)\n"
+    "  plus the SIFT options of `reconar features` for the two-image form\n";
+
+Result<MatchStageOptions> OptionsFromArgs(const Args& args) {
+  MatchStageOptions options;
+  RECONAR_ASSIGN_OR_RETURN(options.match.max_ratio, args.GetDouble("ratio", options.match.max_ratio, 0.01, 1.0));
+  RECONAR_ASSIGN_OR_RETURN(options.match.max_leaf_checks,
+                           args.GetInt("checks", options.match.max_leaf_checks, 1, 1 << 20));
+  RECONAR_ASSIGN_OR_RETURN(options.two_view.min_inliers,
+                           args.GetInt("min-inliers", options.two_view.min_inliers, 8, 1 << 20));
+  RECONAR_ASSIGN_OR_RETURN(options.num_threads, args.GetInt("threads", 0, 0, 1024));
+  options.match.num_threads = options.num_threads;
+  return options;
+}
+
+int MatchProject(const Args& args, const MatchStageOptions& options) {
+  const Project project(args.Get("project"));
+  auto report = RunMatchStage(project, options);
+  if (!report.ok()) return Fail(report.status());
+  std::printf("matching: %d images, %d pairs: %d verified, %d planar or rotation-only, %d rejected; %.1fs\n",
+              report->num_images, report->num_pairs, report->num_verified, report->num_planar, report->num_rejected,
+              report->seconds);
+  std::printf("written to %s\n", project.MatchesPath().c_str());
+  return 0;
+}
+
+int MatchTwo(const Args& args, const MatchStageOptions& options) {
+  FeatureStageOptions feature_options;
+  auto sift = SiftOptionsFromArgs(args);
+  if (!sift.ok()) return Fail(sift.status());
+  feature_options.sift = *sift;
+  feature_options.num_threads = options.num_threads;
+  feature_options.show_progress = false;
+  const std::vector<std::string> paths = args.positionals();
+  std::vector<SiftFeatures> features;
+  auto extracted = RunFeatureStage(paths, nullptr, feature_options, &features);
+  if (!extracted.ok()) return Fail(extracted.status());
+  if (!extracted->skipped.empty()) return Fail(InvalidArgument(extracted->skipped.front()));
+  const ProjectImage& a = extracted->extracted[0].image;
+  const ProjectImage& b = extracted->extracted[1].image;
+  MatchOptions match = options.match;
+  auto putative = MatchDescriptors(features[0].descriptors.data(), static_cast<int>(features[0].keypoints.size()),
+                                   features[1].descriptors.data(), static_cast<int>(features[1].keypoints.size()),
+                                   match);
+  if (!putative.ok()) return Fail(putative.status());
+  auto verified = VerifyMatches(features[0], a.width, a.height, features[1], b.width, b.height, *putative,
+                                options.two_view);
+  if (!verified.ok()) return Fail(verified.status());
+  const TwoViewGeometry& g = verified->geometry;
+  std::printf("%s: %zu features, %s: %zu features\n", a.name.c_str(), features[0].keypoints.size(), b.name.c_str(),
+              features[1].keypoints.size());
+  std::printf("putative matches (ratio %.2f): %d\n", match.max_ratio, verified->num_putative);
+  std::printf("F-inliers (threshold %.2f px): %d, H-inliers among them (%.2f px): %d, ratio %.2f\n",
+              g.f_threshold_px, g.num_f_inliers, g.h_threshold_px, g.num_h_inliers, g.h_to_f_inlier_ratio);
+  std::printf("result: %s%s%s\n", TwoViewConfigName(g.config), g.reason.empty() ? "" : " - ", g.reason.c_str());
+  if (args.Has("pairs")) {
+    std::string text;
+    char line[128];
+    for (const FeatureMatch& m : verified->inlier_matches) {
+      const SiftKeypoint& ka = features[0].keypoints[m.index_a];
+      const SiftKeypoint& kb = features[1].keypoints[m.index_b];
+      std::snprintf(line, sizeof(line), "%.3f %.3f %.3f %.3f\n", ka.x, ka.y, kb.x, kb.y);
+      text += line;
+    }
+    if (Status s = WriteFileAtomically(args.Get("pairs"), text); !s.ok()) return Fail(s);
+    std::printf("wrote %zu matches to %s\n", verified->inlier_matches.size(), args.Get("pairs").c_str());
+  }
+  return g.config == TwoViewGeometry::Config::kTooFewInliers ? 1 : 0;
+}
+
+}  // namespace
+
+int RunMatch(int argc, char** argv, int first) {
+  std::set<std::string> valued = kSiftValuedOptions;
+  valued.insert({"project", "pairs", "ratio", "checks", "min-inliers", "threads"});
+  Args args(valued, {});
+  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
+  if (args.Has("help")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  auto options = OptionsFromArgs(args);
+  if (!options.ok()) return Fail(options.status());
+  if (args.Has("project")) {
+    if (!args.positionals().empty()) return Fail(InvalidArgument("give either --project DIR or two images, not both"));
+    return MatchProject(args, *options);
+  }
+  if (args.positionals().size() != 2) {
+    std::fputs(kHelp, stderr);
+    return 2;
+  }
+  return MatchTwo(args, *options);
+}
+
+}  // namespace reconar::tools

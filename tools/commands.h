@@ -1,0 +1,21 @@
+#pragma once
+// One function per `reconar` subcommand; argv[first] is the first argument after the name.
+
+namespace reconar::tools {
+
+int RunFeatures(int argc, char** argv, int first);
+int RunMatch(int argc, char** argv, int first);
+
+}  // namespace reconar::tools
+
+#include "core/base/status.h"
+#include "core/features/sift/sift.h"
+#include "tools/args.h"
+
+namespace reconar::tools {
+
+// --first-octave, --max-features and --memory-budget (MiB) shared by features and match.
+Result<SiftOptions> SiftOptionsFromArgs(const Args& args);
+inline const std::set<std::string> kSiftValuedOptions = {"first-octave", "max-features", "sift-memory-mib"};
+
+}  // namespace reconar::tools

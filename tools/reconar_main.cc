@@ -1,0 +1,32 @@
+// reconar: photos to a metric 3D model, shown in AR. Thin subcommands over the libraries.
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "tools/commands.h"
+
+namespace {
+
+constexpr char kUsage[] =
+    "usage: reconar COMMAND [ARGS] [--help]\n"
+    "\n"
+    "commands:\n"
+    "  features IMAGE|DIR... [--project DIR] [--key OUT]   SIFT keypoints and descriptors\n"
+    "  match IMAGE_A IMAGE_B [--pairs OUT.txt]             verified matches between two photos\n"
+    "  match --project DIR                                 verified matches between all pairs of a project\n"
+    "\n"
+    "exit codes: 0 ok, 1 failed run, 2 bad usage or input\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
+    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string command = argv[1];
+  if (command == "features") return reconar::tools::RunFeatures(argc, argv, 2);
+  if (command == "match") return reconar::tools::RunMatch(argc, argv, 2);
+  std::fprintf(stderr, "reconar: unknown command '%s'\n\n%s", command.c_str(), kUsage);
+  return 2;
+}
