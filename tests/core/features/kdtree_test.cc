@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <random>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "core/base/arena.h"
@@ -17,13 +18,14 @@ namespace {
 
 uint8_t Clamp8(double v) { return static_cast<uint8_t>(std::clamp(std::lround(v), 0l, 255l)); }
 
-// SIFT-like synthetic data: cluster centres with skewed (mostly small, few large) components,
-// points scattered around them. Many points share a cluster, as repeated texture does.
-std::vector<uint8_t> ClusteredDescriptors(int count, uint32_t seed) {
+// SIFT-like synthetic data: cluster centres with skewed components (mostly small, a few large,
+// like SIFT's), ~500 points per cluster with a spread comparable to the gaps between them, so
+// nearest neighbours are ambiguous (mean NN/2nd-NN distance ratio ~0.74 for the queries below).
+std::vector<uint8_t> ClusteredDescriptors(int count, uint32_t seed, double spread = 30.0) {
   std::mt19937 rng(seed);
   std::exponential_distribution<double> component(1.0 / 25.0);
-  std::normal_distribution<double> noise(0.0, 12.0);
-  const int num_clusters = std::max(1, count / 20);
+  std::normal_distribution<double> noise(0.0, spread);
+  const int num_clusters = std::max(1, count / 500);
   std::vector<double> centers(static_cast<size_t>(num_clusters) * kDescriptorSize);
   for (auto& c : centers) c = std::min(160.0, component(rng));
   std::uniform_int_distribution<int> pick(0, num_clusters - 1);
@@ -35,7 +37,7 @@ std::vector<uint8_t> ClusteredDescriptors(int count, uint32_t seed) {
   return data;
 }
 
-// Noisy copies of random database points: each has a true (but not trivially exact) neighbour.
+// Noisy copies of random database points: each has a true (but not necessarily nearest) neighbour.
 std::vector<uint8_t> NoisyQueries(const std::vector<uint8_t>& database, int count, double sigma, uint32_t seed) {
   std::mt19937 rng(seed);
   const int n = static_cast<int>(database.size() / kDescriptorSize);
@@ -78,14 +80,14 @@ class KdForestRecallTest : public ::testing::TestWithParam<int> {};
 TEST_P(KdForestRecallTest, RecallAgainstBruteForceWith200Checks) {
   const int n = GetParam();
   const std::vector<uint8_t> database = ClusteredDescriptors(n, 1000 + n);
-  const std::vector<uint8_t> queries = NoisyQueries(database, 1000, 6.0, 2000 + n);
+  const std::vector<uint8_t> queries = NoisyQueries(database, 1000, 30.0, 2000 + n);
   Result<KdForest> forest = KdForest::Build(database.data(), n, KdForestOptions{});
   ASSERT_TRUE(forest.ok()) << forest.status().ToString();
   const RecallResult r = MeasureRecall(*forest, database, queries, 200);
   std::printf("n=%d trees=%d nodes=%d depth=%d: recall@1 %.4f, mean checks %.1f\n", n, forest->num_trees(),
               forest->num_nodes(), forest->max_depth(), r.recall_at_1, r.mean_checks);
   RecordProperty("recall_at_1_x10000", static_cast<int>(r.recall_at_1 * 10000));
-  EXPECT_GE(r.recall_at_1, n <= 5000 ? 0.95 : 0.90);
+  EXPECT_GE(r.recall_at_1, n <= 100 ? 0.99 : n <= 5000 ? 0.95 : 0.90);
   EXPECT_LE(r.mean_checks, 200.0);
 }
 
@@ -94,7 +96,7 @@ INSTANTIATE_TEST_SUITE_P(Sizes, KdForestRecallTest, ::testing::Values(100, 5000,
 TEST(KdForestTest, RecallGrowsWithChecks) {
   const int n = 5000;
   const std::vector<uint8_t> database = ClusteredDescriptors(n, 11);
-  const std::vector<uint8_t> queries = NoisyQueries(database, 500, 10.0, 12);
+  const std::vector<uint8_t> queries = NoisyQueries(database, 500, 30.0, 12);
   Result<KdForest> forest = KdForest::Build(database.data(), n, KdForestOptions{});
   ASSERT_TRUE(forest.ok());
   const double low = MeasureRecall(*forest, database, queries, 16).recall_at_1;
@@ -103,7 +105,24 @@ TEST(KdForestTest, RecallGrowsWithChecks) {
   std::printf("recall@1 with 16 / 200 / 5000 checks: %.3f / %.3f / %.3f\n", low, mid, high);
   EXPECT_LE(low, mid);
   EXPECT_LE(mid, high);
-  EXPECT_GE(high, 0.99);
+  EXPECT_GE(high, 0.995);
+}
+
+TEST(KdForestTest, OtherLeafSizesAndTreeCounts) {
+  const int n = 5000;
+  const std::vector<uint8_t> database = ClusteredDescriptors(n, 71);
+  const std::vector<uint8_t> queries = NoisyQueries(database, 300, 30.0, 72);
+  for (const auto& [leaf_size, trees] : std::vector<std::pair<int, int>>{{1, 1}, {4, 4}, {8, 4}, {16, 8}}) {
+    KdForestOptions options;
+    options.leaf_size = leaf_size;
+    options.num_trees = trees;
+    Result<KdForest> forest = KdForest::Build(database.data(), n, options);
+    ASSERT_TRUE(forest.ok());
+    EXPECT_EQ(forest->num_trees(), trees);
+    const RecallResult r = MeasureRecall(*forest, database, queries, 200);
+    std::printf("leaf_size %d, %d trees: recall@1 %.3f\n", leaf_size, trees, r.recall_at_1);
+    EXPECT_GE(r.recall_at_1, 0.8) << leaf_size << " " << trees;
+  }
 }
 
 TEST(KdForestTest, ResultsSortedDistinctAndExactDistances) {

@@ -79,10 +79,49 @@ TEST(MatcherTest, FindsTrueCorrespondences) {
   for (size_t i = 1; i < matches->size(); ++i) EXPECT_LT((*matches)[i - 1].index_a, (*matches)[i].index_a);
 }
 
+// A harder pair: B in SIFT-like clusters of ~500 with ambiguous neighbours, A = noisy copies of
+// some of B plus unrelated descriptors from the same clusters.
+SyntheticPair MakeClusteredPair(int count_b, int num_true, int num_distractors, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::exponential_distribution<double> component(1.0 / 25.0);
+  std::normal_distribution<double> spread(0.0, 30.0);
+  std::normal_distribution<double> noise(0.0, 20.0);
+  const int num_clusters = std::max(1, count_b / 500);
+  std::vector<double> centers(static_cast<size_t>(num_clusters) * kDescriptorSize);
+  for (auto& c : centers) c = std::min(160.0, component(rng));
+  std::uniform_int_distribution<int> pick(0, num_clusters - 1);
+  auto sample = [&](uint8_t* dst) {
+    const double* center = &centers[static_cast<size_t>(pick(rng)) * kDescriptorSize];
+    for (int d = 0; d < kDescriptorSize; ++d) dst[d] = Clamp8(center[d] + spread(rng));
+  };
+  SyntheticPair p;
+  p.count_b = count_b;
+  p.count_a = num_true + num_distractors;
+  p.b.resize(static_cast<size_t>(count_b) * kDescriptorSize);
+  for (int i = 0; i < count_b; ++i) sample(&p.b[static_cast<size_t>(i) * kDescriptorSize]);
+  p.a.resize(static_cast<size_t>(p.count_a) * kDescriptorSize);
+  p.true_b_for_a.assign(static_cast<size_t>(p.count_a), -1);
+  std::uniform_int_distribution<int> pick_b(0, count_b - 1);
+  for (int i = 0; i < p.count_a; ++i) {
+    uint8_t* dst = &p.a[static_cast<size_t>(i) * kDescriptorSize];
+    if (i < num_true) {
+      const int b = pick_b(rng);
+      p.true_b_for_a[static_cast<size_t>(i)] = b;
+      for (int d = 0; d < kDescriptorSize; ++d) dst[d] = Clamp8(p.b[static_cast<size_t>(b) * kDescriptorSize + d] + noise(rng));
+    } else {
+      sample(dst);
+    }
+  }
+  return p;
+}
+
 TEST(MatcherTest, AgreesWithBruteForceMatching) {
   for (const int n : {100, 5000, 20000}) {
-    const SyntheticPair p = MakePair(n, n / 2, n / 4, 10.0, 100 + n);
+    const int queries = std::min(n, 1500);
+    const SyntheticPair p = MakeClusteredPair(n, queries * 2 / 3, queries / 3, 100 + n);
     MatchOptions options;
+    options.max_ratio = 0.8;
+    options.num_threads = 2;
     Result<std::vector<FeatureMatch>> approx = MatchDescriptors(p.a.data(), p.count_a, p.b.data(), p.count_b, options);
     Result<std::vector<FeatureMatch>> exact = BruteForceMatch(p.a.data(), p.count_a, p.b.data(), p.count_b, options);
     ASSERT_TRUE(approx.ok() && exact.ok());
@@ -92,10 +131,10 @@ TEST(MatcherTest, AgreesWithBruteForceMatching) {
     for (const FeatureMatch& m : *approx) common += exact_set.count({m.index_a, m.index_b}) != 0;
     const double recall = static_cast<double>(common) / std::max<size_t>(1, exact->size());
     const double precision = static_cast<double>(common) / std::max<size_t>(1, approx->size());
-    std::printf("n=%d: brute force %zu matches, kd-forest %zu, recall %.4f precision %.4f\n", n, exact->size(),
-                approx->size(), recall, precision);
+    std::printf("n=%d, %d queries: brute force %zu matches, kd-forest %zu, recall %.4f precision %.4f\n", n,
+                p.count_a, exact->size(), approx->size(), recall, precision);
     EXPECT_GE(recall, 0.95) << n;
-    EXPECT_GE(precision, 0.99) << n;
+    EXPECT_GE(precision, 0.95) << n;
   }
 }
 
@@ -208,7 +247,7 @@ TEST(MatcherTest, RejectsBadInput) {
 }
 
 TEST(MatcherTest, DeterministicAcrossRunsAndThreadCounts) {
-  const SyntheticPair p = MakePair(5000, 2500, 2500, 10.0, 3);
+  const SyntheticPair p = MakeClusteredPair(5000, 1500, 1000, 3);
   MatchOptions options;
   options.cross_check = true;
   Result<std::vector<FeatureMatch>> first = MatchDescriptors(p.a.data(), p.count_a, p.b.data(), p.count_b, options);

@@ -1,0 +1,114 @@
+// The `reconar` executable as a user meets it: exit codes, messages naming the file and the
+// reason, bad photos skipped while the rest proceed, nothing half-written.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "core/base/atomic_file.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandRun {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+CommandRun RunReconar(const std::string& arguments) {
+  const std::string command = std::string(RECONAR_BINARY) + " " + arguments + " 2>&1";
+  CommandRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  char buffer[4096];
+  size_t n;
+  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) run.output.append(buffer, n);
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("reconar_cli_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+const std::string kTemple = std::string(RECONAR_SOURCE_DIR) + "/data/templeSparseRing";
+
+TEST(Cli, HelpAndUsageErrors) {
+  EXPECT_EQ(RunReconar("--help").exit_code, 0);
+  EXPECT_EQ(RunReconar("features --help").exit_code, 0);
+  EXPECT_EQ(RunReconar("match --help").exit_code, 0);
+  const CommandRun unknown = RunReconar("frobnicate");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.output.find("unknown command"), std::string::npos);
+  const CommandRun bad_option = RunReconar("features x.jpg --project /tmp/x --first-octave 3");
+  EXPECT_EQ(bad_option.exit_code, 2);
+  EXPECT_NE(bad_option.output.find("--first-octave"), std::string::npos) << bad_option.output;
+}
+
+TEST(Cli, MissingFileIsNamed) {
+  const CommandRun run = RunReconar("features /nonexistent/photo.jpg --project " + TempDir("missing").string());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find("/nonexistent/photo.jpg"), std::string::npos) << run.output;
+}
+
+TEST(Cli, BadPhotosInAFolderAreSkippedAndTheRestProceed) {
+  const fs::path photos = TempDir("photos");
+  fs::copy_file(kTemple + "/templeSR0001.png", photos / "a.png");
+  fs::copy_file(kTemple + "/templeSR0002.png", photos / "b.png");
+  std::ofstream(photos / "empty.jpg").close();
+  std::ofstream(photos / "text.png") << "this is not an image";
+  {
+    auto bytes = reconar::ReadFileToString(kTemple + "/templeSR0003.png");
+    ASSERT_TRUE(bytes.ok());
+    std::ofstream(photos / "truncated.png", std::ios::binary) << bytes->substr(0, bytes->size() / 3);
+  }
+  const fs::path project = TempDir("project");
+  const CommandRun run = RunReconar("features " + photos.string() + " --project " + project.string() + " --threads 2");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  for (const char* bad : {"empty.jpg", "text.png", "truncated.png"}) {
+    EXPECT_NE(run.output.find(std::string("skipped ") + (photos / bad).string()), std::string::npos)
+        << bad << "\n" << run.output;
+  }
+  EXPECT_TRUE(fs::exists(project / "features" / "a.png.rfeat"));
+  EXPECT_TRUE(fs::exists(project / "features" / "b.png.rfeat"));
+  EXPECT_FALSE(fs::exists(project / "features" / "text.png.rfeat"));
+  EXPECT_NE(run.output.find("no EXIF"), std::string::npos) << "the default focal prior is announced\n" << run.output;
+  for (const auto& entry : fs::directory_iterator(project / "features")) {
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << "temporary left: " << entry.path();
+  }
+}
+
+TEST(Cli, ProjectFeaturesThenMatchesOnTheBundledTemple) {
+  const fs::path project = TempDir("temple");
+  const fs::path keys = TempDir("keys");
+  CommandRun run = RunReconar("features " + kTemple + " --project " + project.string() + " --key " + keys.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("features: 16 images, 0 skipped"), std::string::npos) << run.output;
+  EXPECT_TRUE(fs::exists(keys / "templeSR0001.key"));
+  run = RunReconar("match --project " + project.string() + " --threads 2");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("16 images, 120 pairs"), std::string::npos) << run.output;
+  EXPECT_TRUE(fs::exists(project / "matches" / "matches.txt"));
+  // Matching a project that has no features is a clear usage error.
+  run = RunReconar("match --project " + TempDir("empty_project").string());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find("reconar features"), std::string::npos) << run.output;
+}
+
+TEST(Cli, TwoUnrelatedPhotosAreReportedNotCrashed) {
+  const std::string a = kTemple + "/templeSR0001.png";
+  const std::string b = std::string(RECONAR_SHARED_DATA_DIR) + "/middlebury_dinoSparseRing/dinoSR0001.png";
+  const fs::path out = TempDir("unrelated") / "pairs.txt";
+  const CommandRun run = RunReconar("match " + a + " " + b + " --pairs " + out.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("too few inliers"), std::string::npos) << run.output;
+}
+
+}  // namespace
