@@ -51,8 +51,9 @@ Status KdForestOptions::Check() const {
   if (num_top_dims < 1 || num_top_dims > kDescriptorSize) {
     return InvalidArgument("KdForestOptions: num_top_dims must be in [1, 128], got " + std::to_string(num_top_dims));
   }
-  if (variance_samples < 1) {
-    return InvalidArgument("KdForestOptions: variance_samples must be >= 1, got " + std::to_string(variance_samples));
+  if (variance_samples < 1 || variance_samples > kMaxVarianceSamples) {
+    return InvalidArgument("KdForestOptions: variance_samples must be in [1, " + std::to_string(kMaxVarianceSamples) +
+                           "], got " + std::to_string(variance_samples));
   }
   return Status::Ok();
 }
@@ -63,14 +64,14 @@ Status KdForestOptions::Check() const {
 KdSearchScratch::Sizes KdSearchScratch::SizesFor(const KdForest& forest) {
   Sizes sizes;
   sizes.points = forest.size();
-  sizes.heap = 2 * forest.num_inner_nodes();
+  sizes.queue = 2 * forest.num_inner_nodes();
   sizes.leaf_points = forest.max_leaf_points();
   return sizes;
 }
 
 size_t KdSearchScratch::BytesFor(const Sizes& sizes) {
   return AlignUp(sizeof(uint32_t) * static_cast<size_t>(sizes.points)) +
-         AlignUp(sizeof(uint64_t) * static_cast<size_t>(sizes.heap)) +
+         3 * AlignUp(sizeof(int32_t) * static_cast<size_t>(sizes.queue)) +
          2 * AlignUp(sizeof(int32_t) * static_cast<size_t>(sizes.leaf_points)) + kScratchAlignment;
 }
 
@@ -86,10 +87,13 @@ Status KdSearchScratch::InitFromArena(const KdForest& forest, Arena* arena) {
   const Sizes sizes = SizesFor(forest);
   const size_t mark = arena->Mark();
   auto* stamps = arena->AllocateArray<uint32_t>(static_cast<size_t>(sizes.points));
-  auto* heap = arena->AllocateArray<uint64_t>(static_cast<size_t>(sizes.heap));
+  auto* queue_keys = arena->AllocateArray<uint32_t>(static_cast<size_t>(sizes.queue));
+  auto* queue_refs = arena->AllocateArray<int32_t>(static_cast<size_t>(sizes.queue));
+  auto* queue_links = arena->AllocateArray<int32_t>(static_cast<size_t>(sizes.queue));
   auto* candidates = arena->AllocateArray<int32_t>(static_cast<size_t>(sizes.leaf_points));
   auto* candidate_distances = arena->AllocateArray<int32_t>(static_cast<size_t>(sizes.leaf_points));
-  if (stamps == nullptr || heap == nullptr || candidates == nullptr || candidate_distances == nullptr) {
+  if (stamps == nullptr || queue_keys == nullptr || queue_refs == nullptr || queue_links == nullptr ||
+      candidates == nullptr || candidate_distances == nullptr) {
     arena->ResetTo(mark);
     return ResourceExhausted("kd-forest search scratch needs " + std::to_string(BytesFor(sizes)) +
                              " bytes, arena has " + std::to_string(arena->capacity() - mark) + " free");
@@ -98,7 +102,9 @@ Status KdSearchScratch::InitFromArena(const KdForest& forest, Arena* arena) {
   sizes_ = sizes;
   stamps_ = stamps;
   stamp_ = 0;
-  heap_ = heap;
+  queue_keys_ = queue_keys;
+  queue_refs_ = queue_refs;
+  queue_links_ = queue_links;
   candidates_ = candidates;
   candidate_distances_ = candidate_distances;
   return Status::Ok();
@@ -106,7 +112,7 @@ Status KdSearchScratch::InitFromArena(const KdForest& forest, Arena* arena) {
 
 bool KdSearchScratch::Fits(const KdForest& forest) const {
   const Sizes need = SizesFor(forest);
-  return stamps_ != nullptr && need.points <= sizes_.points && need.heap <= sizes_.heap &&
+  return stamps_ != nullptr && need.points <= sizes_.points && need.queue <= sizes_.queue &&
          need.leaf_points <= sizes_.leaf_points;
 }
 
@@ -221,14 +227,16 @@ void KdForest::BuildTree(int tree, uint64_t* rng_state, std::vector<BuildTask>* 
 bool KdForest::ChooseSplit(int begin, int end, uint64_t* rng_state, int* dim, int* threshold) const {
   const int size = end - begin;
   const int samples = std::min(size, options_.variance_samples);
-  int64_t sum[kDescriptorSize] = {};
-  int64_t sum_sq[kDescriptorSize] = {};
+  // 32-bit sums vectorise; they cannot overflow as variance_samples <= kMaxVarianceSamples.
+  int32_t sum[kDescriptorSize] = {};
+  int32_t sum_sq[kDescriptorSize] = {};
   for (int s = 0; s < samples; ++s) {
     const int64_t pos = begin + static_cast<int64_t>(s) * size / samples;
     const uint8_t* row = descriptors_ + static_cast<int64_t>(point_ids_[pos]) * kDescriptorSize;
     for (int d = 0; d < kDescriptorSize; ++d) {
-      sum[d] += row[d];
-      sum_sq[d] += row[d] * row[d];
+      const int32_t v = row[d];
+      sum[d] += v;
+      sum_sq[d] += v * v;
     }
   }
   // Top dimensions by samples^2 * variance, descending; ties keep the lower dimension.
@@ -236,7 +244,7 @@ bool KdForest::ChooseSplit(int begin, int end, uint64_t* rng_state, int* dim, in
   int64_t top_var[kDescriptorSize];
   int num_top = 0;
   for (int d = 0; d < kDescriptorSize; ++d) {
-    const int64_t var = samples * sum_sq[d] - sum[d] * sum[d];
+    const int64_t var = static_cast<int64_t>(samples) * sum_sq[d] - static_cast<int64_t>(sum[d]) * sum[d];
     if (var <= 0) continue;
     if (num_top == options_.num_top_dims && var <= top_var[num_top - 1]) continue;
     int pos = num_top < options_.num_top_dims ? num_top++ : num_top - 1;
@@ -300,10 +308,10 @@ size_t KdForest::memory_bytes() const {
 // ---------------------------------------------------------------------------------------------
 // Search
 
-// Best-bin-first over all trees with one min-heap of (bound, child reference). The bound of a
-// branch is its parent's plus the squared gap from the query to the data on the branch's side of
-// the split (the stored extents, tighter than the split value where the data leaves a band
-// around it). Like FLANN's, it adds one term per split crossed, so it is a true lower bound
+// Best-bin-first over all trees with one priority queue of (bound, child reference). The bound
+// of a branch is its parent's plus the squared gap from the query to the data on the branch's
+// side of the split (the stored extents, tighter than the split value where the data leaves a
+// band around it). Like FLANN's, it adds one term per split crossed, so it is a true lower bound
 // unless a dimension is crossed twice on the path (about 0.1 % of splits on SIFT data); exact
 // per-dimension tracking measured no better recall and ~10 % more time.
 class KdForest::SearchState {
@@ -319,17 +327,20 @@ class KdForest::SearchState {
         indices_(indices),
         distances_(distances),
         scratch_(scratch),
-        heap_(scratch->heap_),
-        stamp_(scratch->NextStamp()) {}
+        keys_(scratch->queue_keys_),
+        refs_(scratch->queue_refs_),
+        links_(scratch->queue_links_),
+        stamp_(scratch->NextStamp()) {
+    for (int32_t& h : heads_) h = -1;
+  }
 
   void Run() {
     for (const int32_t root : forest_.roots_) Descend(root, 0);
-    while (heap_size_ > 0) {
-      if (found_ == k_ && checks_ >= max_checks_) break;
-      const uint64_t top = Pop();
-      const int bound = static_cast<int>(top >> 32);
+    int bound;
+    int32_t ref;
+    while (!(found_ == k_ && checks_ >= max_checks_) && Pop(&bound, &ref)) {
       if (bound >= Worst()) break;  // every queued branch is at least this far
-      Descend(static_cast<int32_t>(static_cast<uint32_t>(top)), bound);
+      Descend(ref, bound);
     }
   }
 
@@ -339,36 +350,52 @@ class KdForest::SearchState {
  private:
   int Worst() const { return found_ < k_ ? INT32_MAX : distances_[k_ - 1]; }
 
+  // Monotone priority queue (radix heap): every key pushed is >= the last key popped, since a
+  // branch's bound never falls below its parent's. Bucket b > 0 holds keys whose highest bit
+  // differing from last_ is bit b-1, bucket 0 keys equal to last_. A pop takes from bucket 0, or
+  // first finds the smallest key of the lowest non-empty bucket and spreads that bucket over the
+  // lower ones: each entry moves at most 32 times, a push is O(1). About 20 % faster than a
+  // binary heap here: most queued branches are never popped.
   void Push(int bound, int32_t ref) {
-    const uint64_t item = (static_cast<uint64_t>(bound) << 32) | static_cast<uint32_t>(ref);
-    int i = heap_size_++;
-    while (i > 0) {
-      const int parent = (i - 1) >> 1;
-      if (heap_[parent] <= item) break;
-      heap_[i] = heap_[parent];
-      i = parent;
-    }
-    heap_[i] = item;
+    const uint32_t key = static_cast<uint32_t>(bound);
+    RECONAR_CHECK(key >= last_) << "non-monotone kd-forest queue";
+    const int32_t e = num_entries_++;
+    keys_[e] = key;
+    refs_[e] = ref;
+    const int b = Bucket(key);
+    links_[e] = heads_[b];
+    heads_[b] = e;
+    nonempty_ |= 1ull << b;
     ++pushes_;
   }
 
-  uint64_t Pop() {
-    const uint64_t top = heap_[0];
-    const uint64_t last = heap_[--heap_size_];
-    int i = 0;
-    while (true) {
-      int child = 2 * i + 1;
-      if (child >= heap_size_) break;
-      const uint64_t left = heap_[child];
-      const uint64_t right = child + 1 < heap_size_ ? heap_[child + 1] : UINT64_MAX;
-      const uint64_t smaller = right < left ? right : left;
-      child += right < left;
-      if (last <= smaller) break;
-      heap_[i] = smaller;
-      i = child;
+  int Bucket(uint32_t key) const { return key == last_ ? 0 : 32 - __builtin_clz(key ^ last_); }
+
+  bool Pop(int* bound, int32_t* ref) {
+    if (nonempty_ == 0) return false;
+    if (heads_[0] < 0) {
+      const int b = __builtin_ctzll(nonempty_);
+      uint32_t min_key = UINT32_MAX;
+      for (int32_t e = heads_[b]; e >= 0; e = links_[e]) min_key = std::min(min_key, keys_[e]);
+      last_ = min_key;
+      int32_t e = heads_[b];
+      heads_[b] = -1;
+      nonempty_ &= ~(1ull << b);
+      while (e >= 0) {
+        const int32_t next = links_[e];
+        const int nb = Bucket(keys_[e]);
+        links_[e] = heads_[nb];
+        heads_[nb] = e;
+        nonempty_ |= 1ull << nb;
+        e = next;
+      }
     }
-    if (heap_size_ > 0) heap_[i] = last;
-    return top;
+    const int32_t e = heads_[0];
+    heads_[0] = links_[e];
+    if (heads_[0] < 0) nonempty_ &= ~1ull;
+    *bound = static_cast<int>(keys_[e]);
+    *ref = refs_[e];
+    return true;
   }
 
   // Follows the nearer side down to a leaf, queueing the other side of every split.
@@ -444,10 +471,15 @@ class KdForest::SearchState {
   int* indices_;
   int* distances_;
   KdSearchScratch* scratch_;
-  uint64_t* heap_;
+  uint32_t* keys_;
+  int32_t* refs_;
+  int32_t* links_;
   const uint32_t stamp_;
+  int32_t heads_[33];
+  uint64_t nonempty_ = 0;
+  uint32_t last_ = 0;
+  int32_t num_entries_ = 0;
   int found_ = 0;
-  int heap_size_ = 0;
   int checks_ = 0;
   int leaves_ = 0;
   int pushes_ = 0;

@@ -24,8 +24,8 @@ struct KdForestOptions {
   int num_trees = 4;
   // A node with at most this many points becomes a leaf (searched whole, batched SIMD distances).
   // Recall per check is best with single-point leaves (as FLANN); larger leaves trade recall at a
-  // fixed budget for speed (on fountain-P11 SIFT, 200 checks: leaf 1 recall@1 0.968, leaf 2
-  // 0.959, leaf 4 0.948, leaf 8 0.932; time 1 : 0.8 : 0.4 : 0.25).
+  // fixed budget for speed (two fountain-P11 SIFT pairs, 200 checks, 4 seeds: recall@1 0.968 /
+  // 0.959 / 0.948 / 0.930 for leaves of 1 / 2 / 4 / 8, time about 1 : 0.55 : 0.4 : 0.25).
   int leaf_size = 1;
   // Default search budget: distinct descriptors whose distance is computed (FLANN's "checks";
   // Lowe's paper checks ~200 candidates). Once k neighbours are known and this many have been
@@ -36,6 +36,7 @@ struct KdForestOptions {
   // halfway between the mean and the middle of the node's range on that dimension.
   int num_top_dims = 5;
   int variance_samples = 100;
+  static constexpr int kMaxVarianceSamples = 10000;
   uint64_t seed = 0x5eed'f00d'cafe'beefull;
 
   Status Check() const;
@@ -45,14 +46,14 @@ struct KdForestOptions {
 struct KdSearchStats {
   int checks = 0;       // distance computations
   int leaves = 0;       // leaves entered
-  int heap_pushes = 0;  // branches queued
+  int queued = 0;       // branches queued
 };
 
 class KdForest;
 
 // Working memory of one search at a time (so one per thread): a visited stamp per point, which
-// deduplicates points met in several trees, and the branch heap. Sized for a forest; it also
-// serves any forest with no more points, nodes and leaf points.
+// deduplicates points met in several trees, and the branch queue. Sized for a forest; it also
+// serves any forest with no more points, inner nodes and leaf points.
 class KdSearchScratch {
  public:
   KdSearchScratch() = default;
@@ -73,7 +74,7 @@ class KdSearchScratch {
   friend class KdForest;
   struct Sizes {
     int points = 0;
-    int heap = 0;  // every child of every inner node can be queued once per search
+    int queue = 0;  // every child of every inner node can be queued once per search
     int leaf_points = 0;
   };
   static Sizes SizesFor(const KdForest& forest);
@@ -83,7 +84,11 @@ class KdSearchScratch {
   Sizes sizes_;
   uint32_t* stamps_ = nullptr;     // sizes_.points
   uint32_t stamp_ = 0;
-  uint64_t* heap_ = nullptr;       // sizes_.heap entries: (bound << 32) | child reference
+  // The branch queue (a radix heap): entry i has key queue_keys_[i] (the bound), value
+  // queue_refs_[i] (a child reference) and the next entry of its bucket queue_links_[i].
+  uint32_t* queue_keys_ = nullptr;  // sizes_.queue
+  int32_t* queue_refs_ = nullptr;   // sizes_.queue
+  int32_t* queue_links_ = nullptr;  // sizes_.queue
   int32_t* candidates_ = nullptr;  // sizes_.leaf_points
   int32_t* candidate_distances_ = nullptr;
   std::unique_ptr<Arena> owned_;

@@ -29,13 +29,23 @@ void RefineFundamental(const std::vector<Correspondence>& matches, double t2, in
   std::vector<Correspondence> subset;
   std::vector<double> residuals(matches.size());
   std::array<Eigen::Matrix3d, FundamentalEightPoint::kMaxModels> models;
+  // MSAC score (Torr & Zisserman 2000): sum of squared residuals truncated at the threshold. A refit
+  // that drops a borderline inlier but fits the rest better still wins; a raw count would refuse it.
+  const auto msac_cost = [&](const Eigen::Matrix3d& model) {
+    FundamentalEightPoint::Residuals(matches.data(), static_cast<int>(matches.size()), model, residuals.data());
+    double cost = 0;
+    for (double r2 : residuals) cost += std::min(r2, t2);
+    return cost;
+  };
+  double current_cost = msac_cost(*F);
   for (int iteration = 0; iteration < iterations; ++iteration) {
     subset.clear();
     for (int i : *inliers) subset.push_back(matches[i]);
     if (FundamentalEightPoint::Estimate(subset.data(), static_cast<int>(subset.size()), &models) == 0) return;
-    FundamentalEightPoint::Residuals(matches.data(), static_cast<int>(matches.size()), models[0], residuals.data());
+    const double refined_cost = msac_cost(models[0]);
+    if (refined_cost > current_cost) return;
+    current_cost = refined_cost;
     std::vector<int> refined = InlierIndices(residuals, t2);
-    if (refined.size() < inliers->size()) return;
     const bool converged = refined == *inliers;
     *F = models[0];
     *inliers = std::move(refined);
