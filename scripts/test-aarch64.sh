@@ -10,9 +10,4 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON \
   || { cat "$build.configure.log"; exit 1; }
 cmake --build "$build" -j"$(nproc)"
 file "$build/bin/reconar" 2>/dev/null | grep -q aarch64 || { echo "not an aarch64 binary" >&2; exit 1; }
-# KNOWN FAILURE, excluded until fixed: on aarch64 VerifyTwoView.GeneralSceneIsVerified (seed 4)
-# returns an F whose RMS Sampson error on the noise-free points is 0.305 px against the test's
-# 0.2 px bound (x86-64 passes). The estimator takes a different RANSAC path on ARM; see the
-# closing note of issue 2. Every other unit test runs.
-ctest --test-dir "$build" --output-on-failure -j"$(nproc)" -L unit --timeout 900 \
-  -E '^VerifyTwoView\.GeneralSceneIsVerified$'
+ctest --test-dir "$build" --output-on-failure -j"$(nproc)" -L unit --timeout 900

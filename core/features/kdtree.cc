@@ -43,8 +43,12 @@ inline void InsertResult(int id, int distance, int k, int* found, int* indices, 
 }  // namespace
 
 Status KdForestOptions::Check() const {
-  if (num_trees < 1 || num_trees > 64) return InvalidArgument("KdForestOptions: num_trees must be in [1, 64], got " + std::to_string(num_trees));
-  if (leaf_size < 1) return InvalidArgument("KdForestOptions: leaf_size must be >= 1, got " + std::to_string(leaf_size));
+  if (num_trees < 1 || num_trees > 64) {
+    return InvalidArgument("KdForestOptions: num_trees must be in [1, 64], got " + std::to_string(num_trees));
+  }
+  if (leaf_size < 1) {
+    return InvalidArgument("KdForestOptions: leaf_size must be >= 1, got " + std::to_string(leaf_size));
+  }
   if (max_leaf_checks < 1) {
     return InvalidArgument("KdForestOptions: max_leaf_checks must be >= 1, got " + std::to_string(max_leaf_checks));
   }
@@ -169,10 +173,11 @@ void KdForest::BuildTree(int tree, uint64_t* rng_state, std::vector<BuildTask>* 
     max_depth_ = std::max(max_depth_, static_cast<int>(task.depth));
     int dim = 0;
     int threshold = 0;
-    if (task.end - task.begin <= options_.leaf_size || !ChooseSplit(task.begin, task.end, rng_state, &dim, &threshold)) {
-      const int32_t size = task.end - task.begin;
+    const int32_t size = task.end - task.begin;
+    if (size <= options_.leaf_size || !ChooseSplit(task.begin, task.end, rng_state, &dim, &threshold)) {
       if (size <= 2) {  // ids inline: no indirection through point_ids_ when searching
-        nodes_[task.node] = Node{point_ids_[task.begin], size == 2 ? point_ids_[task.begin + 1] : -1, kInlineLeaf, 0, 0};
+        const int32_t second = size == 2 ? point_ids_[task.begin + 1] : -1;
+        nodes_[task.node] = Node{point_ids_[task.begin], second, kInlineLeaf, 0, 0};
       } else {
         nodes_[task.node] = Node{task.begin, task.end, kRangeLeaf, 0, 0};
       }

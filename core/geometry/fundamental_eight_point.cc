@@ -8,6 +8,39 @@
 
 namespace reconar {
 
+namespace {
+
+// Closest rank-2 matrix in the Frobenius norm (Eckart-Young), taken back to pixel coordinates.
+int FinishModel(const Eigen::Matrix<double, 9, 1>& f, const Eigen::Matrix3d& T1, const Eigen::Matrix3d& T2,
+                std::array<Eigen::Matrix3d, FundamentalEightPoint::kMaxModels>* models) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(Matrix3FromVector(f), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Vector3d singular = svd.singularValues();
+  singular(2) = 0.0;
+  const Eigen::Matrix3d F_normalised = svd.matrixU() * singular.asDiagonal() * svd.matrixV().transpose();
+  Eigen::Matrix3d F = T2.transpose() * F_normalised * T1;
+  const double norm = F.norm();
+  if (!(norm > 0.0) || !F.allFinite()) return 0;
+  (*models)[0] = F / norm;
+  return 1;
+}
+
+}  // namespace
+
+int FundamentalEightPoint::EstimateWeighted(const Sample* samples, const double* weights, int count,
+                                            std::array<Model, kMaxModels>* models) {
+  if (count < kMinSamples) return 0;
+  Eigen::Matrix3d T1, T2;
+  if (!HartleyNormalisation(samples, count, &T1, &T2)) return 0;
+  Eigen::Matrix<double, 9, 9> AtA = Eigen::Matrix<double, 9, 9>::Zero();
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Matrix<double, 1, 9> row =
+        EpipolarRow(ApplySimilarity(T1, samples[i].x1), ApplySimilarity(T2, samples[i].x2));
+    AtA.selfadjointView<Eigen::Lower>().rankUpdate(row.transpose(), weights[i]);
+  }
+  AtA.triangularView<Eigen::StrictlyUpper>() = AtA.transpose();
+  return FinishModel(SmallestEigenvectors<1>(AtA), T1, T2, models);
+}
+
 int FundamentalEightPoint::Estimate(const Sample* samples, int count, std::array<Model, kMaxModels>* models) {
   if (count < kMinSamples) return 0;
   Eigen::Matrix3d T1, T2;
@@ -31,17 +64,7 @@ int FundamentalEightPoint::Estimate(const Sample* samples, int count, std::array
     f = SmallestEigenvectors<1>(AtA);
   }
 
-  // Closest rank-2 matrix in the Frobenius norm (Eckart-Young), in normalised coordinates.
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(Matrix3FromVector(f), Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Vector3d singular = svd.singularValues();
-  singular(2) = 0.0;
-  const Eigen::Matrix3d F_normalised = svd.matrixU() * singular.asDiagonal() * svd.matrixV().transpose();
-
-  Eigen::Matrix3d F = T2.transpose() * F_normalised * T1;
-  const double norm = F.norm();
-  if (!(norm > 0.0) || !F.allFinite()) return 0;
-  (*models)[0] = F / norm;
-  return 1;
+  return FinishModel(f, T1, T2, models);
 }
 
 void FundamentalEightPoint::Residuals(const Sample* samples, int count, const Model& F,

@@ -22,6 +22,10 @@ struct FundamentalEightPoint {
   // squares fit. Returns the number of models written (0 for a degenerate sample: coincident
   // points or a non-finite result).
   static int Estimate(const Sample* samples, int count, std::array<Model, kMaxModels>* models);
+  // Weighted least squares: minimises sum_i weights[i] * (x2_i^T F x1_i)^2 in Hartley-normalised
+  // coordinates (count >= kMinSamples, weights >= 0). Used by iteratively reweighted refinement.
+  static int EstimateWeighted(const Sample* samples, const double* weights, int count,
+                              std::array<Model, kMaxModels>* models);
 
   // Squared Sampson error of each sample (pixels^2 for pixel input).
   static void Residuals(const Sample* samples, int count, const Model& F, double* squared_residuals);

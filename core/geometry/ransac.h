@@ -8,9 +8,9 @@
 //  - MSAC scoring (Torr & Zisserman 2000): cost = sum_i min(r_i^2, t^2); lower is better;
 //  - the adaptive iteration count N = log(1 - confidence) / log(1 - w^kMinSamples) from the
 //    inlier ratio w of the best model so far;
-//  - LO-RANSAC (Chum, Matas & Kittler 2003): every new best model is re-estimated by iterated
-//    least squares (LocalEstimator with more than kMinSamples samples) on its inliers under a
-//    threshold shrinking to t;
+//  - LO-RANSAC (Chum, Matas & Kittler 2003): every new best model is locally optimised by least
+//    squares (LocalEstimator with more than kMinSamples samples) on its inliers: inner RANSAC on
+//    non-minimal subsets, iterated fits under a threshold shrinking to t, and a final polish;
 //  - early exit from scoring a hypothesis once its partial cost exceeds the best cost;
 //  - a SplitMix64 sampler seeded from the options: runs are deterministic.
 // The minimal solver is called on a std::array copy of the sample; the per-run buffers
@@ -21,6 +21,7 @@
 #include <limits>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/base/status.h"
@@ -80,8 +81,11 @@ class Ransac {
 
     const double t2 = options.max_residual * options.max_residual;
     std::vector<double> residuals(static_cast<size_t>(count));
-    std::vector<Sample> local_samples;
-    if (options.local_optimisation) local_samples.reserve(static_cast<size_t>(count));
+    LocalBuffers local_buffers;
+    if (options.local_optimisation) {
+      local_buffers.inliers.reserve(static_cast<size_t>(count));
+      local_buffers.pool.reserve(static_cast<size_t>(count));
+    }
 
     SplitMix64 rng(options.seed);
     std::array<int, Estimator::kMinSamples> indices;
@@ -107,8 +111,14 @@ class Ransac {
       }
       if (!improved) continue;
       if (options.local_optimisation && options.local_iterations > 0) {
-        LocalOptimise(samples, count, options, t2, residuals.data(), &local_samples, &best);
-        ++report.local_optimisations;
+        // A model improved by LO is itself a new best: optimise again from it (its inlier set
+        // differs), until a round brings no gain.
+        for (int round = 0; round < kMaxLocalRounds; ++round) {
+          const double before = best.cost;
+          LocalOptimise(samples, count, options, t2, &rng, residuals.data(), &local_buffers, &best);
+          ++report.local_optimisations;
+          if (!(best.cost < before)) break;
+        }
       }
       required = ransac_internal::RequiredIterations(best.num_inliers, count, Estimator::kMinSamples,
                                                      options.confidence, options.max_iterations);
@@ -140,7 +150,14 @@ class Ransac {
     int num_inliers = 0;
   };
 
-  static constexpr int kScoreBlock = 256;  // residuals computed between early-exit checks
+  // Scratch of the LO step, allocated once per Run.
+  struct LocalBuffers {
+    std::vector<Sample> inliers;  // least-squares input
+    std::vector<Sample> pool;     // inliers of the best model, shuffled for inner samples
+  };
+
+  static constexpr int kScoreBlock = 256;
+  static constexpr int kMaxLocalRounds = 5;  // LO rounds per new best model from a minimal sample  // residuals computed between early-exit checks
 
   // kMinSamples distinct indices in [0, count), count >= kMinSamples, by rejection.
   static void DrawSample(SplitMix64* rng, int count, std::array<int, Estimator::kMinSamples>* indices) {
@@ -178,11 +195,14 @@ class Ransac {
     return true;
   }
 
-  // Least-squares fit (LocalEstimator on all samples with squared residual under `threshold2`
-  // for `model`), scored at t2. False when too few samples qualify or no model results.
-  static bool LeastSquaresStep(const Sample* samples, int count, const Model& model, double threshold2, double t2,
-                               double* residuals, std::vector<Sample>* inliers, Candidate* result) {
-    Estimator::Residuals(samples, count, model, residuals);
+  // One least-squares step: LocalEstimator on the samples whose squared residual under `model`
+  // is below `threshold2`, scored at t2. `residuals_current` says that `residuals` already holds
+  // the residuals of `model`. On success `residuals` holds those of result->model; on failure
+  // (too few samples qualify, or no model) its content is unspecified.
+  static bool LeastSquaresStep(const Sample* samples, int count, const Model& model, bool residuals_current,
+                               double threshold2, double t2, double* residuals, std::vector<Sample>* inliers,
+                               Candidate* result) {
+    if (!residuals_current) Estimator::Residuals(samples, count, model, residuals);
     inliers->clear();
     for (int i = 0; i < count; ++i) {
       if (residuals[i] < threshold2) inliers->push_back(samples[i]);
@@ -191,47 +211,99 @@ class Ransac {
     std::array<Model, LocalEstimator::kMaxModels> models;
     const int num_models = LocalEstimator::Estimate(inliers->data(), static_cast<int>(inliers->size()), &models);
     Candidate step_best;
+    int best_index = -1;
     for (int m = 0; m < num_models; ++m) {
       Candidate candidate;
-      if (Score(samples, count, models[m], t2, step_best.cost, residuals, &candidate) &&
+      if (Score(samples, count, models[m], t2, std::numeric_limits<double>::infinity(), residuals, &candidate) &&
           candidate.cost < step_best.cost) {
         step_best = candidate;
+        best_index = m;
       }
     }
-    if (step_best.num_inliers == 0) return false;
+    if (best_index < 0 || step_best.num_inliers == 0) return false;
+    if (best_index != num_models - 1) Estimator::Residuals(samples, count, step_best.model, residuals);
     *result = step_best;
     return true;
   }
 
-  // LO step of Chum et al.: iterated least squares from `best` with the inlier threshold
-  // shrinking from local_threshold_multiplier * t to t over local_iterations steps, then the
-  // best model so far is polished by least squares on its own inliers (threshold t) while that
-  // lowers the cost. The wide early thresholds let the fit escape a poor minimal model; the
-  // polish removes the pull of the near-threshold outliers they admit. `best` is replaced by
-  // any lower-cost model.
-  static void LocalOptimise(const Sample* samples, int count, const RansacOptions& options, double t2,
-                            double* residuals, std::vector<Sample>* inliers, Candidate* best) {
+  // Iterated least squares from best->model with the inlier threshold shrinking from
+  // local_threshold_multiplier * t to t over local_iterations steps (the "iterative" LO of Chum
+  // et al.); `best` is replaced by any lower-cost model on the way.
+  static void ShrinkingThresholdSteps(const Sample* samples, int count, const RansacOptions& options, double t2,
+                                      double* residuals, std::vector<Sample>* inliers, Candidate* best) {
     const int steps = options.local_iterations;
     const double m = options.local_threshold_multiplier;
     Model current = best->model;
+    bool residuals_current = false;
     Candidate candidate;
     for (int step = 0; step < steps; ++step) {
       const double fraction = steps > 1 ? static_cast<double>(step) / (steps - 1) : 1.0;
       const double multiplier = m - (m - 1.0) * fraction;
-      if (!LeastSquaresStep(samples, count, current, t2 * multiplier * multiplier, t2, residuals, inliers,
-                            &candidate)) {
-        break;
+      if (!LeastSquaresStep(samples, count, current, residuals_current, t2 * multiplier * multiplier, t2, residuals,
+                            inliers, &candidate)) {
+        return;
       }
       current = candidate.model;
+      residuals_current = true;
       if (candidate.cost < best->cost) *best = candidate;
     }
-    for (int polish = 0; polish < steps; ++polish) {
-      if (!LeastSquaresStep(samples, count, best->model, t2, t2, residuals, inliers, &candidate) ||
-          !(candidate.cost < best->cost)) {
-        break;
+  }
+
+  // Least squares on the inliers (threshold t) of `model`, repeated while the cost drops.
+  static void Polish(const Sample* samples, int count, const RansacOptions& options, double t2, bool residuals_current,
+                     double* residuals, std::vector<Sample>* inliers, Candidate* model) {
+    Candidate candidate;
+    for (int polish = 0; polish < options.local_iterations; ++polish) {
+      if (!LeastSquaresStep(samples, count, model->model, residuals_current, t2, t2, residuals, inliers,
+                            &candidate) ||
+          !(candidate.cost < model->cost)) {
+        return;
       }
-      *best = candidate;
+      *model = candidate;
+      residuals_current = true;
     }
+  }
+
+  // The LO step, a variant of "inner RANSAC with iteration" (Chum, Matas & Kittler 2003), run on
+  // each new best model:
+  //  1. shrinking-threshold least squares from the best model;
+  //  2. inner RANSAC: local_inner_samples random subsets of the best model's inliers, of size
+  //     min(|inliers| / 2, local_sample_size_factor * LocalEstimator::kMinSamples), are fitted by
+  //     least squares and polished like 3. Subsets that miss the few outliers inside the
+  //     threshold escape the fixed point where least squares keeps fitting them;
+  //  3. polish: least squares on the best model's own inliers (threshold t) while the cost drops.
+  // `best` is replaced by any lower-cost model.
+  static void LocalOptimise(const Sample* samples, int count, const RansacOptions& options, double t2,
+                            SplitMix64* rng, double* residuals, LocalBuffers* buffers, Candidate* best) {
+    ShrinkingThresholdSteps(samples, count, options, t2, residuals, &buffers->inliers, best);
+
+    Estimator::Residuals(samples, count, best->model, residuals);
+    buffers->pool.clear();
+    for (int i = 0; i < count; ++i) {
+      if (residuals[i] < t2) buffers->pool.push_back(samples[i]);
+    }
+    const int pool_size = static_cast<int>(buffers->pool.size());
+    const int subset_size = std::min(pool_size / 2, options.local_sample_size_factor * LocalEstimator::kMinSamples);
+    if (subset_size > LocalEstimator::kMinSamples) {
+      std::array<Model, LocalEstimator::kMaxModels> models;
+      for (int repetition = 0; repetition < options.local_inner_samples; ++repetition) {
+        // Partial Fisher-Yates shuffle: the first subset_size entries become a uniform subset.
+        for (int i = 0; i < subset_size; ++i) {
+          const int j = i + static_cast<int>(rng->UniformInt(static_cast<uint32_t>(pool_size - i)));
+          std::swap(buffers->pool[i], buffers->pool[j]);
+        }
+        const int num_models = LocalEstimator::Estimate(buffers->pool.data(), subset_size, &models);
+        for (int m = 0; m < num_models; ++m) {
+          Candidate candidate;
+          if (!Score(samples, count, models[m], t2, std::numeric_limits<double>::infinity(), residuals, &candidate)) {
+            continue;
+          }
+          Polish(samples, count, options, t2, /*residuals_current=*/true, residuals, &buffers->inliers, &candidate);
+          if (candidate.cost < best->cost) *best = candidate;
+        }
+      }
+    }
+    Polish(samples, count, options, t2, /*residuals_current=*/false, residuals, &buffers->inliers, best);
   }
 };
 

@@ -22,6 +22,13 @@ Status RansacOptions::Check() const {
   if (local_iterations < 0) {
     return InvalidArgument("RansacOptions.local_iterations must be >= 0, got " + std::to_string(local_iterations));
   }
+  if (local_inner_samples < 0) {
+    return InvalidArgument("RansacOptions.local_inner_samples must be >= 0, got " + std::to_string(local_inner_samples));
+  }
+  if (local_sample_size_factor < 1) {
+    return InvalidArgument("RansacOptions.local_sample_size_factor must be >= 1, got " +
+                           std::to_string(local_sample_size_factor));
+  }
   if (!(local_threshold_multiplier >= 1.0) || !std::isfinite(local_threshold_multiplier)) {
     return InvalidArgument("RansacOptions.local_threshold_multiplier must be >= 1, got " +
                            std::to_string(local_threshold_multiplier));

@@ -1,7 +1,8 @@
 #pragma once
 // Seeded synthetic two-view scenes for tests and benchmarks: random 3D points seen by two random
 // pinhole cameras with known K, R, t, Gaussian pixel noise and uniformly random outlier matches.
-// The same options (including the seed) always give the same scene on every platform.
+// The same options (including the seed) always give the same scene (across platforms up to the
+// last-bit rounding of libm functions).
 #include <cstdint>
 #include <vector>
 

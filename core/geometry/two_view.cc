@@ -1,5 +1,7 @@
 #include "core/geometry/two_view.h"
 
+#include "core/geometry/residuals.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -24,31 +26,56 @@ std::vector<int> InlierIndices(const std::vector<double>& squared_residuals, dou
 }
 
 // Least-squares eight-point refits on all inliers while the inlier set does not shrink.
+// Iteratively reweighted least squares on the eight-point system. Each row is divided by its
+// Sampson denominator, so the algebraic residual approximates the geometric (Sampson) distance
+// (Torr & Murray, IJCV 1997), and weighted by Cauchy's function with scale 2.3849 * sigma, sigma
+// being 1.4826 * the median inlier residual (MAD; Holland & Welsch's 95 %-efficiency constant).
+// A refit is kept only when it lowers the truncated Cauchy cost over all matches, so one gross
+// point that slipped under the threshold can no longer pull F towards itself.
 void RefineFundamental(const std::vector<Correspondence>& matches, double t2, int iterations, Eigen::Matrix3d* F,
                        std::vector<int>* inliers) {
-  std::vector<Correspondence> subset;
+  if (inliers->size() < static_cast<size_t>(FundamentalEightPoint::kMinSamples)) return;
   std::vector<double> residuals(matches.size());
-  std::array<Eigen::Matrix3d, FundamentalEightPoint::kMaxModels> models;
-  // MSAC score (Torr & Zisserman 2000): sum of squared residuals truncated at the threshold. A refit
-  // that drops a borderline inlier but fits the rest better still wins; a raw count would refuse it.
-  const auto msac_cost = [&](const Eigen::Matrix3d& model) {
+  FundamentalEightPoint::Residuals(matches.data(), static_cast<int>(matches.size()), *F, residuals.data());
+  std::vector<double> inlier_errors;
+  inlier_errors.reserve(inliers->size());
+  for (int i : *inliers) inlier_errors.push_back(std::sqrt(residuals[i]));
+  std::nth_element(inlier_errors.begin(), inlier_errors.begin() + inlier_errors.size() / 2, inlier_errors.end());
+  const double sigma = 1.4826 * inlier_errors[inlier_errors.size() / 2];
+  if (!(sigma > 0.0)) return;
+  const double c2 = (2.3849 * sigma) * (2.3849 * sigma);
+  const auto robust_cost = [&](const Eigen::Matrix3d& model) {
     FundamentalEightPoint::Residuals(matches.data(), static_cast<int>(matches.size()), model, residuals.data());
     double cost = 0;
-    for (double r2 : residuals) cost += std::min(r2, t2);
+    for (double r2 : residuals) cost += std::log1p(std::min(r2, t2) / c2);
     return cost;
   };
-  double current_cost = msac_cost(*F);
+  double current_cost = robust_cost(*F);
+  std::vector<Correspondence> subset;
+  std::vector<double> weights;
+  std::array<Eigen::Matrix3d, FundamentalEightPoint::kMaxModels> models;
   for (int iteration = 0; iteration < iterations; ++iteration) {
     subset.clear();
-    for (int i : *inliers) subset.push_back(matches[i]);
-    if (FundamentalEightPoint::Estimate(subset.data(), static_cast<int>(subset.size()), &models) == 0) return;
-    const double refined_cost = msac_cost(models[0]);
-    if (refined_cost > current_cost) return;
+    weights.clear();
+    for (int i : *inliers) {
+      const SampsonTerms terms = SampsonParts(*F, matches[i].x1, matches[i].x2);
+      if (!(terms.denominator > 0.0)) continue;
+      subset.push_back(matches[i]);
+      weights.push_back(1.0 / ((1.0 + residuals[i] / c2) * terms.denominator));
+    }
+    if (FundamentalEightPoint::EstimateWeighted(subset.data(), weights.data(), static_cast<int>(subset.size()),
+                                                &models) == 0) {
+      return;
+    }
+    const double refined_cost = robust_cost(models[0]);
+    if (!(refined_cost <= current_cost)) {
+      FundamentalEightPoint::Residuals(matches.data(), static_cast<int>(matches.size()), *F, residuals.data());
+      return;
+    }
+    const bool converged = refined_cost > current_cost * (1.0 - 1e-9);
     current_cost = refined_cost;
-    std::vector<int> refined = InlierIndices(residuals, t2);
-    const bool converged = refined == *inliers;
     *F = models[0];
-    *inliers = std::move(refined);
+    *inliers = InlierIndices(residuals, t2);
     if (converged) return;
   }
 }

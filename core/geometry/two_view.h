@@ -27,9 +27,9 @@ struct TwoViewOptions {
   // explaining at least this fraction of the F-inliers (~270 samples for 0.4). Smaller ratios,
   // far below max_h_inlier_ratio, may be under-estimated. In (0, max_h_inlier_ratio].
   double h_screening_inlier_ratio = 0.4;
-  // Refit F by least squares on all its inliers after RANSAC, keeping the refit when its MSAC
-  // score (squared residuals truncated at the threshold) is no worse (repeated up to this many times).
-  int final_refinement_iterations = 2;
+  // Iterations of the robust final refit of F on its inliers after RANSAC (Sampson-weighted
+  // eight-point with Cauchy weights, kept while the truncated Cauchy cost decreases).
+  int final_refinement_iterations = 10;
   // RANSAC settings for both estimations; max_residual is replaced by the thresholds above and
   // the H run uses seed + 1.
   RansacOptions ransac;

@@ -159,6 +159,9 @@ TEST(Ransac, RejectsInvalidOptions) {
   options = RansacOptions();
   options.min_iterations = options.max_iterations + 1;
   EXPECT_EQ(Ransac<HomographyFourPoint>::Run(samples, options).status().code(), StatusCode::kInvalidArgument);
+  options = RansacOptions();
+  options.local_inner_samples = -1;
+  EXPECT_EQ(Ransac<HomographyFourPoint>::Run(samples, options).status().code(), StatusCode::kInvalidArgument);
   EXPECT_TRUE(RansacOptions().Check().ok());
 }
 
