@@ -1,7 +1,7 @@
 #pragma once
 // SIFT hot loops (blur, DoG, extrema, gradients) behind one table of function pointers.
 // Each instruction set lives in its own translation unit (kernels_ref.cc, kernels_avx2.cc,
-// kernels_neon.cc); BestSiftKernels() is the only place that chooses among them, and
+// kernels_avx512.cc, kernels_neon.cc); BestSiftKernels() is the only place that chooses among them, and
 // tests/core/features/sift/kernels_test.cc compares every available table to the reference.
 #include <cstdint>
 #include <vector>
@@ -15,6 +15,10 @@ struct SiftKernels {
   // rows holds 2r+1 row pointers centred on the output row; k is the half kernel (r+1 taps).
   void (*convolve_columns)(const float* const* rows, const float* half_kernel, int radius, int width,
                            float* out);
+  // Two consecutive output rows in one sweep: rows holds 2r+2 row pointers, out0 is centred on
+  // rows[r] and out1 on rows[r+1]. Each input row is loaded once for both outputs.
+  void (*convolve_columns2)(const float* const* rows, const float* half_kernel, int radius, int width,
+                            float* out0, float* out1);
   // out[x] = k[0]*in[x] + sum_i k[i]*(in[x-i] + in[x+i]); `in` is readable on [-r, width+r).
   void (*convolve_row)(const float* in, const float* half_kernel, int radius, int width, float* out);
   // out[x] = a[x] - b[x]
@@ -48,7 +52,8 @@ constexpr float kAtanC7 = -0.11643287f;
 constexpr float kAtanC9 = 0.05265332f;
 constexpr float kAtanC11 = -0.01172120f;
 constexpr float kPi = 3.14159265358979f;
-const SiftKernels* Avx2SiftKernels();  // nullptr when not built for x86
+const SiftKernels* Avx2SiftKernels();    // nullptr when not built for x86 or the CPU lacks AVX2+FMA
+const SiftKernels* Avx512SiftKernels();  // nullptr when not built for x86 or the CPU lacks AVX-512F
 const SiftKernels* NeonSiftKernels();  // nullptr when not built for aarch64
 }  // namespace sift_internal
 

@@ -34,6 +34,41 @@ void ConvolveColumnsAvx2(const float* const* rows, const float* k, int r, int wi
   }
 }
 
+// Input row j = rows[j] contributes k[|j - r|] to out0 and k[|j - r - 1|] to out1.
+void ConvolveColumns2Avx2(const float* const* rows, const float* k, int r, int width, float* out0, float* out1) {
+  int x = 0;
+  for (; x + 16 <= width; x += 16) {
+    __m256 a0 = _mm256_setzero_ps(), a1 = _mm256_setzero_ps();
+    __m256 b0 = _mm256_setzero_ps(), b1 = _mm256_setzero_ps();
+    for (int j = 0; j <= 2 * r + 1; ++j) {
+      const __m256 v0 = _mm256_loadu_ps(rows[j] + x);
+      const __m256 v1 = _mm256_loadu_ps(rows[j] + x + 8);
+      if (j <= 2 * r) {
+        const __m256 ka = _mm256_set1_ps(k[j > r ? j - r : r - j]);
+        a0 = _mm256_fmadd_ps(ka, v0, a0);
+        a1 = _mm256_fmadd_ps(ka, v1, a1);
+      }
+      if (j >= 1) {
+        const __m256 kb = _mm256_set1_ps(k[j - 1 > r ? j - 1 - r : r + 1 - j]);
+        b0 = _mm256_fmadd_ps(kb, v0, b0);
+        b1 = _mm256_fmadd_ps(kb, v1, b1);
+      }
+    }
+    _mm256_storeu_ps(out0 + x, a0);
+    _mm256_storeu_ps(out0 + x + 8, a1);
+    _mm256_storeu_ps(out1 + x, b0);
+    _mm256_storeu_ps(out1 + x + 8, b1);
+  }
+  if (x < width) {
+    const float* shifted[65];
+    const int taps = 2 * r + 2;
+    if (taps <= 65) {
+      for (int i = 0; i < taps; ++i) shifted[i] = rows[i] + x;
+      ReferenceSiftKernels().convolve_columns2(shifted, k, r, width - x, out0 + x, out1 + x);
+    }
+  }
+}
+
 void ConvolveRowAvx2(const float* in, const float* k, int r, int width, float* out) {
   int x = 0;
   for (; x + 16 <= width; x += 16) {
@@ -133,7 +168,7 @@ void GradientRowAvx2(const float* above, const float* row, const float* below, i
 }  // namespace
 
 const SiftKernels* sift_internal::Avx2SiftKernels() {
-  static const SiftKernels kernels{"avx2", ConvolveColumnsAvx2, ConvolveRowAvx2, SubtractAvx2, FindExtremaAvx2,
+  static const SiftKernels kernels{"avx2", ConvolveColumnsAvx2, ConvolveColumns2Avx2, ConvolveRowAvx2, SubtractAvx2, FindExtremaAvx2,
                                    GradientRowAvx2};
   static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   return supported ? &kernels : nullptr;

@@ -31,6 +31,41 @@ void ConvolveColumnsNeon(const float* const* rows, const float* k, int r, int wi
   }
 }
 
+// Input row j = rows[j] contributes k[|j - r|] to out0 and k[|j - r - 1|] to out1.
+void ConvolveColumns2Neon(const float* const* rows, const float* k, int r, int width, float* out0, float* out1) {
+  int x = 0;
+  for (; x + 8 <= width; x += 8) {
+    float32x4_t a0 = vdupq_n_f32(0.0f), a1 = vdupq_n_f32(0.0f);
+    float32x4_t b0 = vdupq_n_f32(0.0f), b1 = vdupq_n_f32(0.0f);
+    for (int j = 0; j <= 2 * r + 1; ++j) {
+      const float32x4_t v0 = vld1q_f32(rows[j] + x);
+      const float32x4_t v1 = vld1q_f32(rows[j] + x + 4);
+      if (j <= 2 * r) {
+        const float ka = k[j > r ? j - r : r - j];
+        a0 = vfmaq_n_f32(a0, v0, ka);
+        a1 = vfmaq_n_f32(a1, v1, ka);
+      }
+      if (j >= 1) {
+        const float kb = k[j - 1 > r ? j - 1 - r : r + 1 - j];
+        b0 = vfmaq_n_f32(b0, v0, kb);
+        b1 = vfmaq_n_f32(b1, v1, kb);
+      }
+    }
+    vst1q_f32(out0 + x, a0);
+    vst1q_f32(out0 + x + 4, a1);
+    vst1q_f32(out1 + x, b0);
+    vst1q_f32(out1 + x + 4, b1);
+  }
+  if (x < width) {
+    const float* shifted[65];
+    const int taps = 2 * r + 2;
+    if (taps <= 65) {
+      for (int i = 0; i < taps; ++i) shifted[i] = rows[i] + x;
+      ReferenceSiftKernels().convolve_columns2(shifted, k, r, width - x, out0 + x, out1 + x);
+    }
+  }
+}
+
 void ConvolveRowNeon(const float* in, const float* k, int r, int width, float* out) {
   int x = 0;
   for (; x + 8 <= width; x += 8) {
@@ -123,7 +158,7 @@ void GradientRowNeon(const float* above, const float* row, const float* below, i
 }  // namespace
 
 const SiftKernels* sift_internal::NeonSiftKernels() {
-  static const SiftKernels kernels{"neon", ConvolveColumnsNeon, ConvolveRowNeon, SubtractNeon, FindExtremaNeon,
+  static const SiftKernels kernels{"neon", ConvolveColumnsNeon, ConvolveColumns2Neon, ConvolveRowNeon, SubtractNeon, FindExtremaNeon,
                                    GradientRowNeon};
   return &kernels;
 }

@@ -33,6 +33,11 @@ void ConvolveColumnsRef(const float* const* rows, const float* k, int r, int wid
   }
 }
 
+void ConvolveColumns2Ref(const float* const* rows, const float* k, int r, int width, float* out0, float* out1) {
+  ConvolveColumnsRef(rows, k, r, width, out0);
+  ConvolveColumnsRef(rows + 1, k, r, width, out1);
+}
+
 void ConvolveRowRef(const float* in, const float* k, int r, int width, float* out) {
   for (int x = 0; x < width; ++x) {
     float acc = k[0] * in[x];
@@ -79,7 +84,7 @@ void GradientRowRef(const float* above, const float* row, const float* below, in
 }  // namespace
 
 const SiftKernels& ReferenceSiftKernels() {
-  static const SiftKernels kernels{"reference", ConvolveColumnsRef, ConvolveRowRef, SubtractRef, FindExtremaRef,
+  static const SiftKernels kernels{"reference", ConvolveColumnsRef, ConvolveColumns2Ref, ConvolveRowRef, SubtractRef, FindExtremaRef,
                                    GradientRowRef};
   return kernels;
 }

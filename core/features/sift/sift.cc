@@ -84,8 +84,8 @@ int MaxWindowRadius(const SiftOptions& options) {
 struct Scratch {
   float* planes[4];
   bool plane_used[4] = {false, false, false, false};
-  float* padded_row;          // width + 2 * kMaxKernelRadius
-  const float** row_pointers; // 2 * kMaxKernelRadius + 1
+  float* padded_row;          // two rows of width + 3 * kMaxKernelRadius
+  const float** row_pointers; // 2 * kMaxKernelRadius + 2
   float* dog_rows;            // 9 rows
   int32_t* candidates;        // width
   float* magnitude_row;       // width
@@ -111,20 +111,34 @@ void ReleasePlane(Scratch& scratch, const ImageView<float>& plane) {
   }
 }
 
-// Separable blur, row by row: columns into a padded row, then along the row. No temporary plane.
+// Separable blur, two rows at a time: columns into two padded rows, then along each row. No
+// temporary plane; each input row is loaded once per output pair.
 void Blur(const SiftKernels& kernels, ImageView<const float> src, ImageView<float> dst, const GaussianKernel& kernel,
           Scratch& scratch) {
   const int r = kernel.radius;
   const int w = src.width;
-  float* padded = scratch.padded_row + kMaxKernelRadius;
-  for (int y = 0; y < src.height; ++y) {
-    for (int i = -r; i <= r; ++i) scratch.row_pointers[i + r] = src.row(Reflect101(y + i, src.height));
-    kernels.convolve_columns(scratch.row_pointers, kernel.taps.data(), r, w, padded);
+  float* padded[2] = {scratch.padded_row + kMaxKernelRadius,
+                      scratch.padded_row + (w + 3 * kMaxKernelRadius) + kMaxKernelRadius};
+  const auto pad = [&](float* row) {
     for (int i = 1; i <= r; ++i) {
-      padded[-i] = padded[Reflect101(-i, w)];
-      padded[w - 1 + i] = padded[Reflect101(w - 1 + i, w)];
+      row[-i] = row[Reflect101(-i, w)];
+      row[w - 1 + i] = row[Reflect101(w - 1 + i, w)];
     }
-    kernels.convolve_row(padded, kernel.taps.data(), r, w, dst.row(y));
+  };
+  int y = 0;
+  for (; y + 1 < src.height; y += 2) {
+    for (int i = -r; i <= r + 1; ++i) scratch.row_pointers[i + r] = src.row(Reflect101(y + i, src.height));
+    kernels.convolve_columns2(scratch.row_pointers, kernel.taps.data(), r, w, padded[0], padded[1]);
+    for (int k = 0; k < 2; ++k) {
+      pad(padded[k]);
+      kernels.convolve_row(padded[k], kernel.taps.data(), r, w, dst.row(y + k));
+    }
+  }
+  if (y < src.height) {
+    for (int i = -r; i <= r; ++i) scratch.row_pointers[i + r] = src.row(Reflect101(y + i, src.height));
+    kernels.convolve_columns(scratch.row_pointers, kernel.taps.data(), r, w, padded[0]);
+    pad(padded[0]);
+    kernels.convolve_row(padded[0], kernel.taps.data(), r, w, dst.row(y));
   }
 }
 
@@ -409,9 +423,9 @@ size_t SiftExtractor::RequiredArenaBytes(int width, int height, const SiftOption
   const size_t w = static_cast<size_t>(FirstOctaveWidth(width, options.first_octave));
   const size_t h = static_cast<size_t>(FirstOctaveWidth(height, options.first_octave));
   const size_t window = 2 * static_cast<size_t>(MaxWindowRadius(options)) + 1;
-  const size_t floats = 4 * w * h + (w + 2 * kMaxKernelRadius) + 9 * w + 2 * w + 2 * window;
+  const size_t floats = 4 * w * h + 2 * (w + 3 * kMaxKernelRadius) + 9 * w + 2 * w + 2 * window;
   const size_t bytes = floats * sizeof(float) + w * sizeof(int32_t) +
-                       (2 * kMaxKernelRadius + 1) * sizeof(float*);
+                       (2 * kMaxKernelRadius + 2) * sizeof(float*);
   constexpr size_t kAllocations = 16;
   return bytes + kAllocations * Arena::kDefaultAlignment;
 }
@@ -444,8 +458,8 @@ Result<SiftFeatures> SiftExtractor::Extract(ImageView<const float> gray, SiftRep
   const int window = 2 * MaxWindowRadius(options_) + 1;
   Scratch scratch;
   for (auto& plane : scratch.planes) plane = arena_.AllocateArray<float>(static_cast<size_t>(base_w) * base_h);
-  scratch.padded_row = arena_.AllocateArray<float>(base_w + 2 * kMaxKernelRadius);
-  scratch.row_pointers = arena_.AllocateArray<const float*>(2 * kMaxKernelRadius + 1);
+  scratch.padded_row = arena_.AllocateArray<float>(2 * (base_w + 3 * kMaxKernelRadius));
+  scratch.row_pointers = arena_.AllocateArray<const float*>(2 * kMaxKernelRadius + 2);
   scratch.dog_rows = arena_.AllocateArray<float>(9 * static_cast<size_t>(base_w));
   scratch.candidates = arena_.AllocateArray<int32_t>(base_w);
   scratch.magnitude_row = arena_.AllocateArray<float>(base_w);
