@@ -21,8 +21,9 @@ struct SiftKernels {
                             float* out0, float* out1);
   // out[x] = k[0]*in[x] + sum_i k[i]*(in[x-i] + in[x+i]); `in` is readable on [-r, width+r).
   void (*convolve_row)(const float* in, const float* half_kernel, int radius, int width, float* out);
-  // out[x] = a[x] - b[x]
-  void (*subtract)(const float* a, const float* b, int width, float* out);
+  // Three DoG rows from four Gaussian rows of consecutive levels: out_l[x] = g[l+1][x] - g[l][x].
+  // One pass reads each Gaussian row once.
+  void (*difference_of_gaussians)(const float* const* g, int width, float* const* out);
   // dog holds 9 rows: dog[3*l + r] is level l (0 = below, 1 = centre, 2 = above), row r (0 = y-1,
   // 1 = y, 2 = y+1). Writes every x in [x_begin, x_end) whose centre value v has |v| > threshold
   // and is >= all 26 neighbours (v > 0) or <= all of them (v < 0); returns how many.

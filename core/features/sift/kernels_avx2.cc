@@ -87,12 +87,22 @@ void ConvolveRowAvx2(const float* in, const float* k, int r, int width, float* o
   if (x < width) ReferenceSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
 }
 
-void SubtractAvx2(const float* a, const float* b, int width, float* out) {
+void DifferenceOfGaussiansAvx2(const float* const* g, int width, float* const* out) {
   int x = 0;
   for (; x + 8 <= width; x += 8) {
-    _mm256_storeu_ps(out + x, _mm256_sub_ps(_mm256_loadu_ps(a + x), _mm256_loadu_ps(b + x)));
+    const auto g0 = _mm256_loadu_ps(g[0] + x);
+    const auto g1 = _mm256_loadu_ps(g[1] + x);
+    const auto g2 = _mm256_loadu_ps(g[2] + x);
+    const auto g3 = _mm256_loadu_ps(g[3] + x);
+    _mm256_storeu_ps(out[0] + x, _mm256_sub_ps(g1, g0));
+    _mm256_storeu_ps(out[1] + x, _mm256_sub_ps(g2, g1));
+    _mm256_storeu_ps(out[2] + x, _mm256_sub_ps(g3, g2));
   }
-  for (; x < width; ++x) out[x] = a[x] - b[x];
+  for (; x < width; ++x) {
+    out[0][x] = g[1][x] - g[0][x];
+    out[1][x] = g[2][x] - g[1][x];
+    out[2][x] = g[3][x] - g[2][x];
+  }
 }
 
 int FindExtremaAvx2(const float* const* dog, int x_begin, int x_end, float threshold, int32_t* out_x) {
@@ -168,7 +178,7 @@ void GradientRowAvx2(const float* above, const float* row, const float* below, i
 }  // namespace
 
 const SiftKernels* sift_internal::Avx2SiftKernels() {
-  static const SiftKernels kernels{"avx2", ConvolveColumnsAvx2, ConvolveColumns2Avx2, ConvolveRowAvx2, SubtractAvx2, FindExtremaAvx2,
+  static const SiftKernels kernels{"avx2", ConvolveColumnsAvx2, ConvolveColumns2Avx2, ConvolveRowAvx2, DifferenceOfGaussiansAvx2, FindExtremaAvx2,
                                    GradientRowAvx2};
   static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   return supported ? &kernels : nullptr;

@@ -94,12 +94,22 @@ void ConvolveRowAvx512(const float* in, const float* k, int r, int width, float*
   if (x < width) ReferenceSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
 }
 
-void SubtractAvx512(const float* a, const float* b, int width, float* out) {
+void DifferenceOfGaussiansAvx512(const float* const* g, int width, float* const* out) {
   int x = 0;
   for (; x + 16 <= width; x += 16) {
-    _mm512_storeu_ps(out + x, _mm512_sub_ps(_mm512_loadu_ps(a + x), _mm512_loadu_ps(b + x)));
+    const auto g0 = _mm512_loadu_ps(g[0] + x);
+    const auto g1 = _mm512_loadu_ps(g[1] + x);
+    const auto g2 = _mm512_loadu_ps(g[2] + x);
+    const auto g3 = _mm512_loadu_ps(g[3] + x);
+    _mm512_storeu_ps(out[0] + x, _mm512_sub_ps(g1, g0));
+    _mm512_storeu_ps(out[1] + x, _mm512_sub_ps(g2, g1));
+    _mm512_storeu_ps(out[2] + x, _mm512_sub_ps(g3, g2));
   }
-  for (; x < width; ++x) out[x] = a[x] - b[x];
+  for (; x < width; ++x) {
+    out[0][x] = g[1][x] - g[0][x];
+    out[1][x] = g[2][x] - g[1][x];
+    out[2][x] = g[3][x] - g[2][x];
+  }
 }
 
 int FindExtremaAvx512(const float* const* dog, int x_begin, int x_end, float threshold, int32_t* out_x) {
@@ -141,7 +151,7 @@ const SiftKernels* sift_internal::Avx512SiftKernels() {
   static const bool supported = __builtin_cpu_supports("avx512f") && Avx2SiftKernels() != nullptr;
   if (!supported) return nullptr;
   static const SiftKernels kernels{"avx512",       ConvolveColumnsAvx512, ConvolveColumns2Avx512,
-                                   ConvolveRowAvx512, SubtractAvx512,     FindExtremaAvx512,
+                                   ConvolveRowAvx512, DifferenceOfGaussiansAvx512,     FindExtremaAvx512,
                                    Avx2SiftKernels()->gradient_row};
   return &kernels;
 }

@@ -81,10 +81,22 @@ void ConvolveRowNeon(const float* in, const float* k, int r, int width, float* o
   if (x < width) ReferenceSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
 }
 
-void SubtractNeon(const float* a, const float* b, int width, float* out) {
+void DifferenceOfGaussiansNeon(const float* const* g, int width, float* const* out) {
   int x = 0;
-  for (; x + 4 <= width; x += 4) vst1q_f32(out + x, vsubq_f32(vld1q_f32(a + x), vld1q_f32(b + x)));
-  for (; x < width; ++x) out[x] = a[x] - b[x];
+  for (; x + 4 <= width; x += 4) {
+    const auto g0 = vld1q_f32(g[0] + x);
+    const auto g1 = vld1q_f32(g[1] + x);
+    const auto g2 = vld1q_f32(g[2] + x);
+    const auto g3 = vld1q_f32(g[3] + x);
+    vst1q_f32(out[0] + x, vsubq_f32(g1, g0));
+    vst1q_f32(out[1] + x, vsubq_f32(g2, g1));
+    vst1q_f32(out[2] + x, vsubq_f32(g3, g2));
+  }
+  for (; x < width; ++x) {
+    out[0][x] = g[1][x] - g[0][x];
+    out[1][x] = g[2][x] - g[1][x];
+    out[2][x] = g[3][x] - g[2][x];
+  }
 }
 
 int FindExtremaNeon(const float* const* dog, int x_begin, int x_end, float threshold, int32_t* out_x) {
@@ -158,7 +170,7 @@ void GradientRowNeon(const float* above, const float* row, const float* below, i
 }  // namespace
 
 const SiftKernels* sift_internal::NeonSiftKernels() {
-  static const SiftKernels kernels{"neon", ConvolveColumnsNeon, ConvolveColumns2Neon, ConvolveRowNeon, SubtractNeon, FindExtremaNeon,
+  static const SiftKernels kernels{"neon", ConvolveColumnsNeon, ConvolveColumns2Neon, ConvolveRowNeon, DifferenceOfGaussiansNeon, FindExtremaNeon,
                                    GradientRowNeon};
   return &kernels;
 }

@@ -46,8 +46,12 @@ void ConvolveRowRef(const float* in, const float* k, int r, int width, float* ou
   }
 }
 
-void SubtractRef(const float* a, const float* b, int width, float* out) {
-  for (int x = 0; x < width; ++x) out[x] = a[x] - b[x];
+void DifferenceOfGaussiansRef(const float* const* g, int width, float* const* out) {
+  for (int x = 0; x < width; ++x) {
+    out[0][x] = g[1][x] - g[0][x];
+    out[1][x] = g[2][x] - g[1][x];
+    out[2][x] = g[3][x] - g[2][x];
+  }
 }
 
 int FindExtremaRef(const float* const* dog, int x_begin, int x_end, float threshold, int32_t* out_x) {
@@ -84,7 +88,7 @@ void GradientRowRef(const float* above, const float* row, const float* below, in
 }  // namespace
 
 const SiftKernels& ReferenceSiftKernels() {
-  static const SiftKernels kernels{"reference", ConvolveColumnsRef, ConvolveColumns2Ref, ConvolveRowRef, SubtractRef, FindExtremaRef,
+  static const SiftKernels kernels{"reference", ConvolveColumnsRef, ConvolveColumns2Ref, ConvolveRowRef, DifferenceOfGaussiansRef, FindExtremaRef,
                                    GradientRowRef};
   return kernels;
 }

@@ -519,9 +519,9 @@ Result<SiftFeatures> SiftExtractor::Extract(ImageView<const float> gray, SiftRep
       // Rolling DoG rows: ring slot (y mod 3) of each of the three levels.
       auto dog_row = [&](int level, int y) { return scratch.dog_rows + (3 * level + (y % 3)) * static_cast<size_t>(w); };
       auto fill_dog_row = [&](int y) {
-        for (int level = 0; level < 3; ++level) {
-          kernels.subtract(levels[d + level].row(y), levels[d - 1 + level].row(y), w, dog_row(level, y));
-        }
+        const float* g[4] = {levels[d - 1].row(y), levels[d].row(y), levels[d + 1].row(y), levels[d + 2].row(y)};
+        float* out[3] = {dog_row(0, y), dog_row(1, y), dog_row(2, y)};
+        kernels.difference_of_gaussians(g, w, out);
       };
       fill_dog_row(kBorder - 1);
       fill_dog_row(kBorder);

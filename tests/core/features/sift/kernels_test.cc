@@ -73,10 +73,13 @@ TEST_P(SiftKernelsTest, SubtractAndExtremaMatchReferenceExactly) {
       for (int i = 0; i < n; ++i) EXPECT_EQ(actual[i], expected[i]);
       EXPECT_GE(n_ref, 1);
     }
-    std::vector<float> diff_ref(width), diff(width);
-    ref.subtract(rows[0].data(), rows[1].data(), width, diff_ref.data());
-    k.subtract(rows[0].data(), rows[1].data(), width, diff.data());
-    EXPECT_EQ(diff, diff_ref);
+    std::vector<std::vector<float>> dog_ref(3, std::vector<float>(width)), dog(3, std::vector<float>(width));
+    float* out_ref[3] = {dog_ref[0].data(), dog_ref[1].data(), dog_ref[2].data()};
+    float* out[3] = {dog[0].data(), dog[1].data(), dog[2].data()};
+    ref.difference_of_gaussians(pointers.data(), width, out_ref);
+    k.difference_of_gaussians(pointers.data(), width, out);
+    EXPECT_EQ(dog, dog_ref);
+    for (int x = 0; x < width; ++x) EXPECT_EQ(dog_ref[2][x], rows[3][x] - rows[2][x]);
   }
 }
 
