@@ -53,6 +53,13 @@ constexpr float kAtanC7 = -0.11643287f;
 constexpr float kAtanC9 = 0.05265332f;
 constexpr float kAtanC11 = -0.01172120f;
 constexpr float kPi = 3.14159265358979f;
+// Largest blur radius any kernel is called with (bounds the tails' row-pointer arrays).
+constexpr int kMaxKernelRadius = 31;
+// Reference computation of columns [x, width) for the SIMD kernels' tails.
+void ConvolveColumnsTail(const float* const* rows, const float* half_kernel, int radius, int x, int width,
+                         float* out);
+void ConvolveColumns2Tail(const float* const* rows, const float* half_kernel, int radius, int x, int width,
+                          float* out0, float* out1);
 const SiftKernels* Avx2SiftKernels();    // nullptr when not built for x86 or the CPU lacks AVX2+FMA
 const SiftKernels* Avx512SiftKernels();  // nullptr when not built for x86 or the CPU lacks AVX-512F
 const SiftKernels* NeonSiftKernels();  // nullptr when not built for aarch64

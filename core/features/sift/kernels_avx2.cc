@@ -24,14 +24,7 @@ void ConvolveColumnsAvx2(const float* const* rows, const float* k, int r, int wi
     _mm256_storeu_ps(out + x, acc0);
     _mm256_storeu_ps(out + x + 8, acc1);
   }
-  if (x < width) {
-    const float* shifted[64];
-    const int taps = 2 * r + 1;
-    if (taps <= 64) {
-      for (int i = 0; i < taps; ++i) shifted[i] = rows[i] + x;
-      ReferenceSiftKernels().convolve_columns(shifted, k, r, width - x, out + x);
-    }
-  }
+  if (x < width) sift_internal::ConvolveColumnsTail(rows, k, r, x, width, out);
 }
 
 // Input row j = rows[j] contributes k[|j - r|] to out0 and k[|j - r - 1|] to out1.
@@ -59,14 +52,7 @@ void ConvolveColumns2Avx2(const float* const* rows, const float* k, int r, int w
     _mm256_storeu_ps(out1 + x, b0);
     _mm256_storeu_ps(out1 + x + 8, b1);
   }
-  if (x < width) {
-    const float* shifted[65];
-    const int taps = 2 * r + 2;
-    if (taps <= 65) {
-      for (int i = 0; i < taps; ++i) shifted[i] = rows[i] + x;
-      ReferenceSiftKernels().convolve_columns2(shifted, k, r, width - x, out0 + x, out1 + x);
-    }
-  }
+  if (x < width) sift_internal::ConvolveColumns2Tail(rows, k, r, x, width, out0, out1);
 }
 
 void ConvolveRowAvx2(const float* in, const float* k, int r, int width, float* out) {

@@ -21,14 +21,7 @@ void ConvolveColumnsNeon(const float* const* rows, const float* k, int r, int wi
     vst1q_f32(out + x, acc0);
     vst1q_f32(out + x + 4, acc1);
   }
-  if (x < width) {
-    const float* shifted[64];
-    const int taps = 2 * r + 1;
-    if (taps <= 64) {
-      for (int i = 0; i < taps; ++i) shifted[i] = rows[i] + x;
-      ReferenceSiftKernels().convolve_columns(shifted, k, r, width - x, out + x);
-    }
-  }
+  if (x < width) sift_internal::ConvolveColumnsTail(rows, k, r, x, width, out);
 }
 
 // Input row j = rows[j] contributes k[|j - r|] to out0 and k[|j - r - 1|] to out1.
@@ -56,14 +49,7 @@ void ConvolveColumns2Neon(const float* const* rows, const float* k, int r, int w
     vst1q_f32(out1 + x, b0);
     vst1q_f32(out1 + x + 4, b1);
   }
-  if (x < width) {
-    const float* shifted[65];
-    const int taps = 2 * r + 2;
-    if (taps <= 65) {
-      for (int i = 0; i < taps; ++i) shifted[i] = rows[i] + x;
-      ReferenceSiftKernels().convolve_columns2(shifted, k, r, width - x, out0 + x, out1 + x);
-    }
-  }
+  if (x < width) sift_internal::ConvolveColumns2Tail(rows, k, r, x, width, out0, out1);
 }
 
 void ConvolveRowNeon(const float* in, const float* k, int r, int width, float* out) {

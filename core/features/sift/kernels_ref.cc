@@ -87,6 +87,23 @@ void GradientRowRef(const float* above, const float* row, const float* below, in
 
 }  // namespace
 
+namespace sift_internal {
+
+void ConvolveColumnsTail(const float* const* rows, const float* k, int r, int x, int width, float* out) {
+  const float* shifted[2 * kMaxKernelRadius + 2];
+  for (int i = 0; i < 2 * r + 1; ++i) shifted[i] = rows[i] + x;
+  ConvolveColumnsRef(shifted, k, r, width - x, out + x);
+}
+
+void ConvolveColumns2Tail(const float* const* rows, const float* k, int r, int x, int width, float* out0,
+                          float* out1) {
+  const float* shifted[2 * kMaxKernelRadius + 2];
+  for (int i = 0; i < 2 * r + 2; ++i) shifted[i] = rows[i] + x;
+  ConvolveColumns2Ref(shifted, k, r, width - x, out0 + x, out1 + x);
+}
+
+}  // namespace sift_internal
+
 const SiftKernels& ReferenceSiftKernels() {
   static const SiftKernels kernels{"reference", ConvolveColumnsRef, ConvolveColumns2Ref, ConvolveRowRef, DifferenceOfGaussiansRef, FindExtremaRef,
                                    GradientRowRef};

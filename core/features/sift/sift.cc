@@ -13,7 +13,7 @@ namespace reconar {
 namespace {
 
 constexpr int kBorder = 5;              // no keypoints closer than this to an octave's edge
-constexpr int kMaxKernelRadius = 31;    // SIMD tails and scratch assume at most this
+using sift_internal::kMaxKernelRadius;
 constexpr int kMaxRefineSteps = 5;
 constexpr int kOrientationBins = 36;
 constexpr float kOrientationSigmaFactor = 1.5f;  // window sigma = 1.5 * keypoint sigma (Lowe 5)
