@@ -31,14 +31,7 @@ int FundamentalEightPoint::EstimateWeighted(const Sample* samples, const double*
   if (count < kMinSamples) return 0;
   Eigen::Matrix3d T1, T2;
   if (!HartleyNormalisation(samples, count, &T1, &T2)) return 0;
-  Eigen::Matrix<double, 9, 9> AtA = Eigen::Matrix<double, 9, 9>::Zero();
-  for (int i = 0; i < count; ++i) {
-    const Eigen::Matrix<double, 1, 9> row =
-        EpipolarRow(ApplySimilarity(T1, samples[i].x1), ApplySimilarity(T2, samples[i].x2));
-    AtA.selfadjointView<Eigen::Lower>().rankUpdate(row.transpose(), weights[i]);
-  }
-  AtA.triangularView<Eigen::StrictlyUpper>() = AtA.transpose();
-  return FinishModel(SmallestEigenvectors<1>(AtA), T1, T2, models);
+  return FinishModel(SmallestEigenvectors<1>(EpipolarNormalMatrix(samples, count, T1, T2, weights)), T1, T2, models);
 }
 
 int FundamentalEightPoint::Estimate(const Sample* samples, int count, std::array<Model, kMaxModels>* models) {
@@ -54,13 +47,7 @@ int FundamentalEightPoint::Estimate(const Sample* samples, int count, std::array
     }
     f = NullSpaceOfWideMatrix<kMinSamples>(A);
   } else {
-    Eigen::Matrix<double, 9, 9> AtA = Eigen::Matrix<double, 9, 9>::Zero();
-    for (int i = 0; i < count; ++i) {
-      const Eigen::Matrix<double, 1, 9> row =
-          EpipolarRow(ApplySimilarity(T1, samples[i].x1), ApplySimilarity(T2, samples[i].x2));
-      AtA.selfadjointView<Eigen::Lower>().rankUpdate(row.transpose());
-    }
-    AtA.triangularView<Eigen::StrictlyUpper>() = AtA.transpose();
+    const Eigen::Matrix<double, 9, 9> AtA = EpipolarNormalMatrix(samples, count, T1, T2);
     f = SmallestEigenvectors<1>(AtA);
   }
 

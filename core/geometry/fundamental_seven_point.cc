@@ -40,13 +40,7 @@ int FundamentalSevenPoint::Estimate(const Sample* samples, int count, std::array
     }
     basis = NullSpaceOfWideMatrix<kMinSamples>(A);
   } else {
-    Eigen::Matrix<double, 9, 9> AtA = Eigen::Matrix<double, 9, 9>::Zero();
-    for (int i = 0; i < count; ++i) {
-      const Eigen::Matrix<double, 1, 9> row =
-          EpipolarRow(ApplySimilarity(T1, samples[i].x1), ApplySimilarity(T2, samples[i].x2));
-      AtA.selfadjointView<Eigen::Lower>().rankUpdate(row.transpose());
-    }
-    AtA.triangularView<Eigen::StrictlyUpper>() = AtA.transpose();
+    const Eigen::Matrix<double, 9, 9> AtA = EpipolarNormalMatrix(samples, count, T1, T2);
     basis = SmallestEigenvectors<2>(AtA);
   }
   const Eigen::Matrix3d F1 = Matrix3FromVector(basis.col(0));

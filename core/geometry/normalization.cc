@@ -1,5 +1,7 @@
 #include "core/geometry/normalization.h"
 
+#include "core/geometry/null_space.h"
+
 #include <cmath>
 
 namespace reconar {
@@ -29,6 +31,18 @@ bool HartleyNormalisation(const Correspondence* samples, int count, Eigen::Matri
   if (count <= 0) return false;
   return NormalisingTransform(samples, count, [](const Correspondence& c) -> const Eigen::Vector2d& { return c.x1; }, T1) &&
          NormalisingTransform(samples, count, [](const Correspondence& c) -> const Eigen::Vector2d& { return c.x2; }, T2);
+}
+
+Eigen::Matrix<double, 9, 9> EpipolarNormalMatrix(const Correspondence* samples, int count, const Eigen::Matrix3d& T1,
+                                                 const Eigen::Matrix3d& T2, const double* weights) {
+  Eigen::Matrix<double, 9, 9> AtA = Eigen::Matrix<double, 9, 9>::Zero();
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Matrix<double, 1, 9> row =
+        EpipolarRow(ApplySimilarity(T1, samples[i].x1), ApplySimilarity(T2, samples[i].x2));
+    AtA.selfadjointView<Eigen::Lower>().rankUpdate(row.transpose(), weights != nullptr ? weights[i] : 1.0);
+  }
+  AtA.triangularView<Eigen::StrictlyUpper>() = AtA.transpose();
+  return AtA;
 }
 
 }  // namespace reconar
