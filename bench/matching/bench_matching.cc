@@ -273,11 +273,13 @@ void PrintComparisonTable(const Data& data) {
   std::printf("\n");
 }
 
-void BM_OursBuildQuery(benchmark::State& state) {
+// Times build + query of one method (RunOurs or RunFlann) and reports its recall.
+template <RunResult (*Run)(const Data&, int)>
+void BM_BuildQuery(benchmark::State& state) {
   const int checks = static_cast<int>(state.range(0));
   Quality q;
   for (auto _ : state) {
-    RunResult r = RunOurs(*g_data, checks);
+    RunResult r = Run(*g_data, checks);
     benchmark::DoNotOptimize(r.index.data());
     state.PauseTiming();
     q = Evaluate(*g_data, r.index, r.d1, r.d2);
@@ -286,22 +288,6 @@ void BM_OursBuildQuery(benchmark::State& state) {
   state.counters["recall@1"] = q.recall_at_1;
   state.counters["queries/s"] = benchmark::Counter(g_data->num_queries, benchmark::Counter::kIsIterationInvariantRate);
 }
-
-#if defined(RECONAR_BENCH_HAVE_OPENCV)
-void BM_FlannBuildQuery(benchmark::State& state) {
-  const int checks = static_cast<int>(state.range(0));
-  Quality q;
-  for (auto _ : state) {
-    RunResult r = RunFlann(*g_data, checks);
-    benchmark::DoNotOptimize(r.index.data());
-    state.PauseTiming();
-    q = Evaluate(*g_data, r.index, r.d1, r.d2);
-    state.ResumeTiming();
-  }
-  state.counters["recall@1"] = q.recall_at_1;
-  state.counters["queries/s"] = benchmark::Counter(g_data->num_queries, benchmark::Counter::kIsIterationInvariantRate);
-}
-#endif
 
 // Strips our own --name=value flags from argv before Google Benchmark sees them.
 void ParseOwnFlags(int* argc, char** argv) {
@@ -341,9 +327,9 @@ int main(int argc, char** argv) {
   g_data = &data;
   PrintComparisonTable(data);
 
-  benchmark::RegisterBenchmark("KdForest/build+query", BM_OursBuildQuery)->Arg(200)->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("KdForest/build+query", BM_BuildQuery<RunOurs>)->Arg(200)->Unit(benchmark::kMillisecond);
 #if defined(RECONAR_BENCH_HAVE_OPENCV)
-  benchmark::RegisterBenchmark("FlannKdTree/build+query", BM_FlannBuildQuery)->Arg(200)->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("FlannKdTree/build+query", BM_BuildQuery<RunFlann>)->Arg(200)->Unit(benchmark::kMillisecond);
 #endif
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

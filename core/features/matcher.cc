@@ -193,11 +193,16 @@ KdForestOptions MatchOptions::ForestOptions() const {
   return forest;
 }
 
-Result<std::vector<FeatureMatch>> MatchDescriptors(const uint8_t* desc_a, int count_a, const uint8_t* desc_b,
-                                                   int count_b, const MatchOptions& options, MatchReport* report) {
+Status CheckMatchInputs(const uint8_t* desc_a, int count_a, const uint8_t* desc_b, int count_b,
+                        const MatchOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   RECONAR_RETURN_IF_ERROR(CheckInput("A", desc_a, count_a));
-  RECONAR_RETURN_IF_ERROR(CheckInput("B", desc_b, count_b));
+  return CheckInput("B", desc_b, count_b);
+}
+
+Result<std::vector<FeatureMatch>> MatchDescriptors(const uint8_t* desc_a, int count_a, const uint8_t* desc_b,
+                                                   int count_b, const MatchOptions& options, MatchReport* report) {
+  RECONAR_RETURN_IF_ERROR(CheckMatchInputs(desc_a, count_a, desc_b, count_b, options));
   internal::MatchWorkspace workspace(options.num_threads);
   std::unique_ptr<KdForest> forest_a;
   std::unique_ptr<KdForest> forest_b;
@@ -208,9 +213,7 @@ Result<std::vector<FeatureMatch>> MatchDescriptors(const uint8_t* desc_a, int co
 
 Result<std::vector<FeatureMatch>> BruteForceMatch(const uint8_t* desc_a, int count_a, const uint8_t* desc_b,
                                                   int count_b, const MatchOptions& options, MatchReport* report) {
-  RECONAR_RETURN_IF_ERROR(options.Check());
-  RECONAR_RETURN_IF_ERROR(CheckInput("A", desc_a, count_a));
-  RECONAR_RETURN_IF_ERROR(CheckInput("B", desc_b, count_b));
+  RECONAR_RETURN_IF_ERROR(CheckMatchInputs(desc_a, count_a, desc_b, count_b, options));
   internal::MatchWorkspace workspace(options.num_threads);
   const ForestProvider none = [](MatchReport*) -> Result<const KdForest*> {
     return static_cast<const KdForest*>(nullptr);
