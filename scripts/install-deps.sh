@@ -25,7 +25,7 @@ host_packages=(build-essential cmake pkg-config
   libgtest-dev libbenchmark-dev)
 cross_packages=(g++-aarch64-linux-gnu qemu-user libstdc++6:arm64 libgcc-s1:arm64
   libjpeg62-turbo-dev:arm64 libpng-dev:arm64 libgtest-dev:arm64)
-bench_packages=(libopencv-dev)
+bench_packages=(libopencv-dev libceres-dev)
 
 missing() {
   local out=()

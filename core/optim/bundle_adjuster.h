@@ -1,0 +1,96 @@
+#pragma once
+// Bundle adjustment of BAL problems: Levenberg-Marquardt with a trust-region radius update
+// (Nocedal & Wright, "Numerical Optimization", 2nd ed., ch. 4 and 10.3; Madsen, Nielsen &
+// Tingleff, "Methods for Non-Linear Least Squares Problems", 2004, sec. 3.2), Marquardt scaling
+// of the damping by diag(J^T J), analytic Jacobians (bal_camera_model.h), and the Schur
+// complement that eliminates the points (Triggs et al., "Bundle Adjustment - A Modern
+// Synthesis", 2000, sec. 6.1; Brown 1958). The reduced camera system is solved with a dense
+// Cholesky factorisation or, optionally, a block-sparse LDL^T.
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/optim/bal_problem.h"
+#include "core/optim/robust_loss.h"
+
+namespace reconar {
+
+struct BundleAdjustmentOptions {
+  int max_iterations = 100;  // LM iterations, accepted and rejected steps both count
+  // Stop when |cost_old - cost_new| <= function_tolerance * cost_old after an accepted step.
+  double function_tolerance = 1e-6;
+  // Stop when max_k |g_k| <= gradient_tolerance, g = J^T r on the free parameters.
+  double gradient_tolerance = 1e-10;
+  // Stop when |dx| <= parameter_tolerance * (|x| + parameter_tolerance).
+  double parameter_tolerance = 1e-8;
+  // Trust region radius Delta; the damping is diag(J^T J) / Delta (Marquardt 1963).
+  double initial_trust_region_radius = 1e4;
+  double max_trust_region_radius = 1e16;
+  double min_trust_region_radius = 1e-32;
+  // Steps with gain ratio rho = actual / predicted reduction below this are rejected.
+  double min_relative_decrease = 1e-3;
+  // diag(J^T J) is clamped to [min_diagonal, max_diagonal] before scaling the damping.
+  double min_diagonal = 1e-6;
+  double max_diagonal = 1e32;
+  // Consecutive failed Cholesky factorisations tolerated (each shrinks the radius) before
+  // giving up with kNumericFailure.
+  int max_consecutive_numeric_failures = 5;
+  RobustLoss loss;
+  // Solver of the reduced camera system S dc = b (S is 9 * cameras square).
+  enum class LinearSolver {
+    kDenseCholesky,   // Eigen LLT on dense S: best for up to a few hundred cameras
+    kSparseCholesky,  // block-sparse S (camera pairs sharing a point), AMD camera ordering,
+                      // Eigen SimplicialLDLT: for larger problems with sparse camera graphs
+  };
+  LinearSolver linear_solver = LinearSolver::kDenseCholesky;
+  int num_threads = 1;  // <= 0: one per core
+
+  // InvalidArgument naming the first offending field.
+  Status Check() const;
+};
+
+struct BundleAdjustmentSummary {
+  enum class Termination {
+    kFunctionTolerance,    // an accepted step changed the cost by <= function_tolerance * cost
+    kGradientTolerance,    // max |J^T r| over free parameters <= gradient_tolerance
+    kParameterTolerance,   // |dx| <= parameter_tolerance * (|x| + parameter_tolerance)
+    kMaxIterations,        // max_iterations LM iterations ran without another criterion
+    kTrustRegionTooSmall,  // the radius shrank below min_trust_region_radius (no progress)
+    kNumericFailure,       // the initial cost is not finite, or the Cholesky factorisation of
+                           // the reduced camera system failed (or gave a non-finite step)
+                           // max_consecutive_numeric_failures times in a row
+  };
+  Termination termination = Termination::kMaxIterations;
+  double initial_cost = 0.0;  // 1/2 sum rho(|r|^2) at the start
+  double final_cost = 0.0;    // same at the returned parameters
+  int iterations = 0;         // LM iterations run (accepted + rejected)
+  int accepted_steps = 0;
+  double seconds = 0.0;  // wall time of SolveBundleAdjustment (setup included)
+
+  bool converged() const {
+    return termination == Termination::kFunctionTolerance ||
+           termination == Termination::kGradientTolerance ||
+           termination == Termination::kParameterTolerance;
+  }
+};
+
+const char* TerminationName(BundleAdjustmentSummary::Termination termination);
+
+// Which parameter blocks are held constant; empty vectors mean every block is free, otherwise
+// one entry per camera / point (non-zero = constant).
+struct BundleAdjustmentConstancy {
+  std::vector<char> constant_cameras;
+  std::vector<char> constant_points;
+};
+
+// Minimises 1/2 sum_k rho(|u(camera, point) - observed|^2) over the free cameras and points of
+// `problem`, in place. InvalidArgument for bad options, a malformed problem or mis-sized
+// constancy vectors; numeric trouble is reported through summary.termination, with `problem`
+// holding the last accepted parameters.
+Result<BundleAdjustmentSummary> SolveBundleAdjustment(const BundleAdjustmentOptions& options,
+                                                      const BundleAdjustmentConstancy& constancy,
+                                                      BalProblem* problem);
+
+// 1/2 sum_k rho(|r_k|^2) at the current parameters (non-finite if a point projects badly).
+double BundleAdjustmentCost(const BalProblem& problem, const RobustLoss& loss);
+
+}  // namespace reconar
