@@ -50,7 +50,8 @@ Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image
   ThreadPool pool(threads);
   std::vector<WorkerExtractors> extractors(pool.num_threads());
   std::vector<std::optional<ImageFeatureSummary>> summaries(n);
-  std::vector<SiftFeatures> features(n);
+  // Kept only for callers that asked for them; project runs stream each image's features to disk.
+  std::vector<SiftFeatures> features(features_out != nullptr ? n : 0);
   std::vector<std::string> skipped(n);
   std::vector<Status> output_errors(n);
   std::optional<Progress> progress;
@@ -101,7 +102,7 @@ Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image
     }
     const std::string key_path = KeyPathFor(options, path, n);
     if (output_errors[i].ok() && !key_path.empty()) output_errors[i] = WriteLoweKeyFile(key_path, *result);
-    features[i] = std::move(result).value();
+    if (features_out != nullptr) features[i] = std::move(result).value();
     summary.seconds = std::chrono::duration<double>(Clock::now() - image_start).count();
     summaries[i] = std::move(summary);
     if (progress) progress->Advance();
