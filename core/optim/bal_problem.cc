@@ -80,19 +80,6 @@ class Tokenizer {
 
 }  // namespace
 
-Status BalProblem::Check() const {
-  if (cameras.size() % kCameraSize != 0) return InvalidArgument("BalProblem: cameras not 9-blocks");
-  if (points.size() % kPointSize != 0) return InvalidArgument("BalProblem: points not 3-blocks");
-  for (size_t k = 0; k < observations.size(); ++k) {
-    const BalObservation& o = observations[k];
-    if (o.camera < 0 || o.camera >= num_cameras() || o.point < 0 || o.point >= num_points()) {
-      return InvalidArgument("BalProblem: observation " + std::to_string(k) +
-                             " indexes a missing camera or point");
-    }
-  }
-  return Status::Ok();
-}
-
 Result<BalProblem> ParseBalProblem(const std::string& text, const std::string& name) {
   Tokenizer tok(text, name);
   // Bounds keep the array sizes (and Jacobian sizes) representable in int.

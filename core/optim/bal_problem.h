@@ -11,12 +11,16 @@ namespace reconar {
 struct BalObservation {
   int camera = 0;
   int point = 0;
-  double x = 0.0;  // pixels, origin at the principal point, y up (BAL convention)
+  double x = 0.0;  // pixels; BAL: origin at the principal point, y up. Radial: image pixels.
   double y = 0.0;
 };
 
-struct BalProblem {
-  static constexpr int kCameraSize = 9;  // angle-axis r (3), t (3), f, k1, k2
+// Cameras of CameraSize doubles each, points of 3, and the observations linking them. The
+// camera model that gives the doubles their meaning is chosen by the bundle adjuster's overload:
+// BalProblem (bal_camera_model.h) or RadialProblem (radial_camera_model.h).
+template <int CameraSize>
+struct BundleProblem {
+  static constexpr int kCameraSize = CameraSize;
   static constexpr int kPointSize = 3;
 
   std::vector<double> cameras;  // kCameraSize doubles per camera
@@ -33,8 +37,26 @@ struct BalProblem {
   const double* point(int j) const { return points.data() + static_cast<size_t>(j) * kPointSize; }
 
   // InvalidArgument if the arrays are not whole blocks or an observation indexes out of range.
-  Status Check() const;
+  Status Check() const {
+    if (cameras.size() % kCameraSize != 0) {
+      return InvalidArgument("BundleProblem: cameras not " + std::to_string(kCameraSize) + "-blocks");
+    }
+    if (points.size() % kPointSize != 0) return InvalidArgument("BundleProblem: points not 3-blocks");
+    for (size_t k = 0; k < observations.size(); ++k) {
+      const BalObservation& o = observations[k];
+      if (o.camera < 0 || o.camera >= num_cameras() || o.point < 0 || o.point >= num_points()) {
+        return InvalidArgument("BundleProblem: observation " + std::to_string(k) +
+                               " indexes a missing camera or point");
+      }
+    }
+    return Status::Ok();
+  }
 };
+
+// BAL / Bundler cameras: angle-axis r (3), t (3), f, k1, k2.
+using BalProblem = BundleProblem<9>;
+// COLMAP RADIAL cameras: angle-axis r (3), t (3), f, k1, k2, cx, cy.
+using RadialProblem = BundleProblem<11>;
 
 // Parses BAL text: "<num_cameras> <num_points> <num_observations>", then num_observations lines
 // "<camera> <point> <x> <y>", then 9 values per camera and 3 per point (whitespace separated).

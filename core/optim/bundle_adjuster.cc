@@ -17,18 +17,29 @@
 
 #include "core/base/thread_pool.h"
 #include "core/optim/bal_camera_model.h"
+#include "core/optim/radial_camera_model.h"
 
 namespace reconar {
 namespace {
 
-constexpr int kC = BalProblem::kCameraSize;
-constexpr int kP = BalProblem::kPointSize;
-using Mat99 = Eigen::Matrix<double, kC, kC>;
-using Mat93 = Eigen::Matrix<double, kC, kP>;
+struct BalModel {
+  using Problem = BalProblem;
+  static bool Project(const double* camera, const double* point, double* predicted,
+                      double* jac_camera, double* jac_point) {
+    return ProjectBal(camera, point, predicted, jac_camera, jac_point);
+  }
+};
+struct RadialModel {
+  using Problem = RadialProblem;
+  static bool Project(const double* camera, const double* point, double* predicted,
+                      double* jac_camera, double* jac_point) {
+    return ProjectRadial(camera, point, predicted, jac_camera, jac_point);
+  }
+};
+
+constexpr int kP = 3;
 using Mat33 = Eigen::Matrix<double, kP, kP>;
-using Mat29 = Eigen::Matrix<double, 2, kC, Eigen::RowMajor>;
 using Mat23 = Eigen::Matrix<double, 2, kP, Eigen::RowMajor>;
-using Vec9 = Eigen::Matrix<double, kC, 1>;
 using Vec3 = Eigen::Vector3d;
 using Termination = BundleAdjustmentSummary::Termination;
 // The 9x9 block products below use lazyProduct: with 9 + 9 + depth >= 20 Eigen would otherwise
@@ -67,11 +78,20 @@ struct Grouping {
 };
 
 // One solve. Every buffer is sized in the constructor; the iteration loop does not allocate.
+template <typename Model>
 class Solver {
+  using Problem = typename Model::Problem;
+  static constexpr int kC = Problem::kCameraSize;
+  using Mat99 = Eigen::Matrix<double, kC, kC>;
+  using Mat93 = Eigen::Matrix<double, kC, kP>;
+  using Mat29 = Eigen::Matrix<double, 2, kC, Eigen::RowMajor>;
+  using Vec9 = Eigen::Matrix<double, kC, 1>;
+
  public:
   Solver(const BundleAdjustmentOptions& options, const BundleAdjustmentConstancy& constancy,
-         BalProblem* problem)
+         Problem* problem)
       : opt_(options), problem_(problem) {
+    constant_parameters_ = constancy.constant_camera_parameters;
     nc_ = problem->num_cameras();
     np_ = problem->num_points();
     no_ = static_cast<int>(problem->observations.size());
@@ -222,7 +242,7 @@ class Solver {
         double* r = &residual_[2 * static_cast<size_t>(k)];
         Mat29& jc = jc_[static_cast<size_t>(k)];
         Mat23& jp = jp_[static_cast<size_t>(k)];
-        if (!ProjectBal(problem_->camera(o.camera), problem_->point(o.point), r, jc.data(),
+        if (!Model::Project(problem_->camera(o.camera), problem_->point(o.point), r, jc.data(),
                         jp.data())) {
           rho_[static_cast<size_t>(k)] = std::numeric_limits<double>::infinity();
           continue;
@@ -239,7 +259,11 @@ class Solver {
           jc *= sw;
           jp *= sw;
         }
-        if (const_cam_[static_cast<size_t>(o.camera)]) jc.setZero();
+        if (const_cam_[static_cast<size_t>(o.camera)]) {
+          jc.setZero();
+        } else {
+          for (int m : constant_parameters_) jc.col(m).setZero();
+        }
         if (const_pt_[static_cast<size_t>(o.point)]) jp.setZero();
         w_[static_cast<size_t>(k)].noalias() = jc.transpose() * jp;
       }
@@ -327,6 +351,7 @@ class Solver {
         }
         Mat99 sii = u_[static_cast<size_t>(i)];
         sii.diagonal() += lambda * dc_diag_[static_cast<size_t>(i)];
+        for (int m : constant_parameters_) sii(m, m) = 1.0;  // row and column are zero
         AddBlock(diag, sii, values);
         rhs = -gc_[static_cast<size_t>(i)];
         for (int q = by_cam_.offsets[i]; q < by_cam_.offsets[i + 1]; ++q) {
@@ -412,7 +437,7 @@ class Solver {
         const BalObservation& o = obs[static_cast<size_t>(k)];
         double r[2];
         double rho = std::numeric_limits<double>::infinity(), drho;
-        if (ProjectBal(cameras.data() + static_cast<size_t>(o.camera) * kC,
+        if (Model::Project(cameras.data() + static_cast<size_t>(o.camera) * kC,
                        points.data() + static_cast<size_t>(o.point) * kP, r, nullptr, nullptr)) {
           r[0] -= o.x;
           r[1] -= o.y;
@@ -427,7 +452,8 @@ class Solver {
   }
 
   const BundleAdjustmentOptions& opt_;
-  BalProblem* problem_;
+  Problem* problem_;
+  std::vector<int> constant_parameters_;  // indices within every camera block
   int nc_ = 0, np_ = 0, no_ = 0;
   std::vector<char> const_cam_, const_pt_;
   Grouping by_cam_, by_pt_;
@@ -635,11 +661,14 @@ Status BundleAdjustmentOptions::Check() const {
   return Status::Ok();
 }
 
-double BundleAdjustmentCost(const BalProblem& problem, const RobustLoss& loss) {
+namespace {
+
+template <typename Model>
+double CostImpl(const typename Model::Problem& problem, const RobustLoss& loss) {
   double cost = 0.0;
   for (const BalObservation& o : problem.observations) {
     double r[2];
-    if (!ProjectBal(problem.camera(o.camera), problem.point(o.point), r, nullptr, nullptr)) {
+    if (!Model::Project(problem.camera(o.camera), problem.point(o.point), r, nullptr, nullptr)) {
       return std::numeric_limits<double>::infinity();
     }
     r[0] -= o.x;
@@ -651,9 +680,10 @@ double BundleAdjustmentCost(const BalProblem& problem, const RobustLoss& loss) {
   return 0.5 * cost;
 }
 
-Result<BundleAdjustmentSummary> SolveBundleAdjustment(const BundleAdjustmentOptions& options,
-                                                      const BundleAdjustmentConstancy& constancy,
-                                                      BalProblem* problem) {
+template <typename Model>
+Result<BundleAdjustmentSummary> SolveImpl(const BundleAdjustmentOptions& options,
+                                          const BundleAdjustmentConstancy& constancy,
+                                          typename Model::Problem* problem) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   if (problem == nullptr) return InvalidArgument("SolveBundleAdjustment: null problem");
   RECONAR_RETURN_IF_ERROR(problem->Check());
@@ -665,11 +695,37 @@ Result<BundleAdjustmentSummary> SolveBundleAdjustment(const BundleAdjustmentOpti
       constancy.constant_points.size() != static_cast<size_t>(problem->num_points())) {
     return InvalidArgument("SolveBundleAdjustment: constant_points size != point count");
   }
+  for (int m : constancy.constant_camera_parameters) {
+    if (m < 0 || m >= Model::Problem::kCameraSize) {
+      return InvalidArgument("SolveBundleAdjustment: constant camera parameter " +
+                             std::to_string(m) + " out of range");
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
-  Solver solver(options, constancy, problem);
+  Solver<Model> solver(options, constancy, problem);
   BundleAdjustmentSummary summary = solver.Run();
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
+}
+
+}  // namespace
+
+double BundleAdjustmentCost(const BalProblem& problem, const RobustLoss& loss) {
+  return CostImpl<BalModel>(problem, loss);
+}
+double BundleAdjustmentCost(const RadialProblem& problem, const RobustLoss& loss) {
+  return CostImpl<RadialModel>(problem, loss);
+}
+
+Result<BundleAdjustmentSummary> SolveBundleAdjustment(const BundleAdjustmentOptions& options,
+                                                      const BundleAdjustmentConstancy& constancy,
+                                                      BalProblem* problem) {
+  return SolveImpl<BalModel>(options, constancy, problem);
+}
+Result<BundleAdjustmentSummary> SolveBundleAdjustment(const BundleAdjustmentOptions& options,
+                                                      const BundleAdjustmentConstancy& constancy,
+                                                      RadialProblem* problem) {
+  return SolveImpl<RadialModel>(options, constancy, problem);
 }
 
 }  // namespace reconar

@@ -80,6 +80,9 @@ const char* TerminationName(BundleAdjustmentSummary::Termination termination);
 struct BundleAdjustmentConstancy {
   std::vector<char> constant_cameras;
   std::vector<char> constant_points;
+  // Parameters held constant in every camera block, as indices into the block (e.g. 9 and 10,
+  // the principal point of a RadialProblem camera).
+  std::vector<int> constant_camera_parameters;
 };
 
 // Minimises 1/2 sum_k rho(|u(camera, point) - observed|^2) over the free cameras and points of
@@ -89,8 +92,13 @@ struct BundleAdjustmentConstancy {
 Result<BundleAdjustmentSummary> SolveBundleAdjustment(const BundleAdjustmentOptions& options,
                                                       const BundleAdjustmentConstancy& constancy,
                                                       BalProblem* problem);
+// The same for COLMAP RADIAL cameras (radial_camera_model.h), observations in image pixels.
+Result<BundleAdjustmentSummary> SolveBundleAdjustment(const BundleAdjustmentOptions& options,
+                                                      const BundleAdjustmentConstancy& constancy,
+                                                      RadialProblem* problem);
 
 // 1/2 sum_k rho(|r_k|^2) at the current parameters (non-finite if a point projects badly).
 double BundleAdjustmentCost(const BalProblem& problem, const RobustLoss& loss);
+double BundleAdjustmentCost(const RadialProblem& problem, const RobustLoss& loss);
 
 }  // namespace reconar
