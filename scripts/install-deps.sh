@@ -21,10 +21,10 @@ if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive
 
 host_packages=(build-essential cmake pkg-config
-  libjpeg62-turbo-dev libpng-dev libeigen3-dev
+  libjpeg62-turbo-dev libpng-dev libeigen3-dev libsuitesparse-dev
   libgtest-dev libbenchmark-dev)
 cross_packages=(g++-aarch64-linux-gnu qemu-user libstdc++6:arm64 libgcc-s1:arm64
-  libjpeg62-turbo-dev:arm64 libpng-dev:arm64 libgtest-dev:arm64)
+  libjpeg62-turbo-dev:arm64 libpng-dev:arm64 libgtest-dev:arm64 libsuitesparse-dev:arm64)
 bench_packages=(libopencv-dev libceres-dev)
 
 missing() {

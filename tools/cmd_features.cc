@@ -19,6 +19,7 @@ constexpr char kHelp[] =
     "  --key OUT           also write Lowe's ASCII .key format (a file for one image, else a directory)\n"
     "  --first-octave N    -1 (default) doubles the image first for more small-scale features; 0 does not\n"
     "  --max-features N    keep the N strongest per image (default 16384, 0 = all)\n"
+    "  --contrast-threshold C  DoG contrast threshold before division by the 3 levels (default 0.04, Lowe)\n"
     "  --sift-memory-mib M working-memory bound per thread (default 512); larger photos fall back to\n"
     "                      first octave 0 with a warning\n"
     "  --threads N         photos processed in parallel (default: one per core)\n";
@@ -32,6 +33,8 @@ Result<SiftOptions> SiftOptionsFromArgs(const Args& args) {
   RECONAR_ASSIGN_OR_RETURN(const int mib,
                            args.GetInt("sift-memory-mib", static_cast<int>(options.arena_bytes >> 20), 16, 1 << 16));
   options.arena_bytes = static_cast<size_t>(mib) << 20;
+  RECONAR_ASSIGN_OR_RETURN(options.contrast_threshold,
+                           args.GetDouble("contrast-threshold", options.contrast_threshold, 1e-4, 1.0));
   return options;
 }
 

@@ -21,20 +21,27 @@ constexpr char kHelp[] =
     "                    writes DIR/matches/matches.txt\n"
     "  --ratio R         Lowe ratio (default 0.6)   --checks N  leaf checks per query (default 200)\n"
     "  --min-inliers N   inliers a pair needs (default 100)\n"
+    "  --f-threshold T   F inlier threshold as a fraction of the larger image side (default 0.006)\n"
     "  --threads N       worker threads (default: one per core)\n"
     "  plus the SIFT options of `reconar features` for the two-image form\n";
 
-Result<MatchStageOptions> OptionsFromArgs(const Args& args) {
+}  // namespace
+
+Result<MatchStageOptions> MatchOptionsFromArgs(const Args& args) {
   MatchStageOptions options;
   RECONAR_ASSIGN_OR_RETURN(options.match.max_ratio, args.GetDouble("ratio", options.match.max_ratio, 0.01, 1.0));
   RECONAR_ASSIGN_OR_RETURN(options.match.max_leaf_checks,
                            args.GetInt("checks", options.match.max_leaf_checks, 1, 1 << 20));
   RECONAR_ASSIGN_OR_RETURN(options.two_view.min_inliers,
                            args.GetInt("min-inliers", options.two_view.min_inliers, 8, 1 << 20));
+  RECONAR_ASSIGN_OR_RETURN(options.two_view.f_threshold_fraction,
+                           args.GetDouble("f-threshold", options.two_view.f_threshold_fraction, 1e-5, 0.1));
   RECONAR_ASSIGN_OR_RETURN(options.num_threads, args.GetInt("threads", 0, 0, 1024));
   options.match.num_threads = options.num_threads;
   return options;
 }
+
+namespace {
 
 int MatchProject(const Args& args, const MatchStageOptions& options) {
   const Project project(args.Get("project"));
@@ -95,14 +102,15 @@ int MatchTwo(const Args& args, const MatchStageOptions& options) {
 
 int RunMatch(int argc, char** argv, int first) {
   std::set<std::string> valued = kSiftValuedOptions;
-  valued.insert({"project", "pairs", "ratio", "checks", "min-inliers", "threads"});
+  valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
+  valued.insert({"project", "pairs"});
   Args args(valued, {});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
     std::fputs(kHelp, stdout);
     return 0;
   }
-  auto options = OptionsFromArgs(args);
+  auto options = MatchOptionsFromArgs(args);
   if (!options.ok()) return Fail(options.status());
   if (args.Has("project")) {
     if (!args.positionals().empty()) return Fail(InvalidArgument("give either --project DIR or two images, not both"));

@@ -5,17 +5,25 @@ namespace reconar::tools {
 
 int RunFeatures(int argc, char** argv, int first);
 int RunMatch(int argc, char** argv, int first);
+int RunBundleAdjust(int argc, char** argv, int first);
+int RunSfm(int argc, char** argv, int first);
 
 }  // namespace reconar::tools
 
 #include "core/base/status.h"
 #include "core/features/sift/sift.h"
+#include "core/pipeline/match_stage.h"
 #include "tools/args.h"
 
 namespace reconar::tools {
 
 // --first-octave, --max-features and --memory-budget (MiB) shared by features and match.
 Result<SiftOptions> SiftOptionsFromArgs(const Args& args);
-inline const std::set<std::string> kSiftValuedOptions = {"first-octave", "max-features", "sift-memory-mib"};
+inline const std::set<std::string> kSiftValuedOptions = {"first-octave", "max-features", "sift-memory-mib",
+                                                           "contrast-threshold"};
+
+Result<MatchStageOptions> MatchOptionsFromArgs(const Args& args);
+inline const std::set<std::string> kMatchValuedOptions = {"ratio", "checks", "min-inliers", "f-threshold",
+                                                            "threads"};
 
 }  // namespace reconar::tools

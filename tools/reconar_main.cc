@@ -14,6 +14,8 @@ constexpr char kUsage[] =
     "  features IMAGE|DIR... [--project DIR] [--key OUT]   SIFT keypoints and descriptors\n"
     "  match IMAGE_A IMAGE_B [--pairs OUT.txt]             verified matches between two photos\n"
     "  match --project DIR                                 verified matches between all pairs of a project\n"
+    "  sfm IMAGES_DIR PROJECT_DIR                          cameras and sparse points (structure from motion)\n"
+    "  bundle-adjust --bal FILE [--json]                   solve a BAL bundle adjustment problem\n"
     "\n"
     "exit codes: 0 ok, 1 failed run, 2 bad usage or input\n";
 
@@ -27,6 +29,8 @@ int main(int argc, char** argv) {
   const std::string command = argv[1];
   if (command == "features") return reconar::tools::RunFeatures(argc, argv, 2);
   if (command == "match") return reconar::tools::RunMatch(argc, argv, 2);
+  if (command == "sfm") return reconar::tools::RunSfm(argc, argv, 2);
+  if (command == "bundle-adjust") return reconar::tools::RunBundleAdjust(argc, argv, 2);
   std::fprintf(stderr, "reconar: unknown command '%s'\n\n%s", command.c_str(), kUsage);
   return 2;
 }

@@ -12,6 +12,7 @@ const char* StatusCodeName(StatusCode code) {
     case StatusCode::kUnsupported: return "unsupported";
     case StatusCode::kResourceExhausted: return "resource exhausted";
     case StatusCode::kNumericFailure: return "numeric failure";
+    case StatusCode::kFailedPrecondition: return "failed precondition";
     case StatusCode::kInternal: return "internal error";
   }
   return "unknown";
@@ -34,6 +35,7 @@ Status CorruptData(std::string m) { return Status(StatusCode::kCorruptData, std:
 Status Unsupported(std::string m) { return Status(StatusCode::kUnsupported, std::move(m)); }
 Status ResourceExhausted(std::string m) { return Status(StatusCode::kResourceExhausted, std::move(m)); }
 Status NumericFailure(std::string m) { return Status(StatusCode::kNumericFailure, std::move(m)); }
+Status FailedPrecondition(std::string m) { return Status(StatusCode::kFailedPrecondition, std::move(m)); }
 Status Internal(std::string m) { return Status(StatusCode::kInternal, std::move(m)); }
 
 Status FileError(StatusCode code, const std::string& path, const std::string& reason) {

@@ -18,6 +18,7 @@ enum class StatusCode {
   kUnsupported,        // a valid input we deliberately do not handle (e.g. CMYK JPEG)
   kResourceExhausted,  // a configured limit (arena, pixel budget) would be exceeded
   kNumericFailure,     // a factorisation failed or a NaN/Inf appeared
+  kFailedPrecondition, // the input is valid but cannot yield a result (e.g. unrelated photos)
   kInternal,           // a bug: an invariant did not hold
 };
 
@@ -49,6 +50,7 @@ Status CorruptData(std::string message);
 Status Unsupported(std::string message);
 Status ResourceExhausted(std::string message);
 Status NumericFailure(std::string message);
+Status FailedPrecondition(std::string message);
 Status Internal(std::string message);
 // "path: reason" with the given code.
 Status FileError(StatusCode code, const std::string& path, const std::string& reason);

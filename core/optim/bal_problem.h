@@ -13,6 +13,7 @@ struct BalObservation {
   int point = 0;
   double x = 0.0;  // pixels; BAL: origin at the principal point, y up. Radial: image pixels.
   double y = 0.0;
+  double weight = 1.0;  // the residual is multiplied by this (1 / its standard deviation)
 };
 
 // Cameras of CameraSize doubles each, points of 3, and the observations linking them. The
@@ -55,8 +56,8 @@ struct BundleProblem {
 
 // BAL / Bundler cameras: angle-axis r (3), t (3), f, k1, k2.
 using BalProblem = BundleProblem<9>;
-// COLMAP RADIAL cameras: angle-axis r (3), t (3), f, k1, k2, cx, cy.
-using RadialProblem = BundleProblem<11>;
+// SfM cameras (radial_camera_model.h): angle-axis r (3), t (3), f, k1, k2, cx, cy, aspect.
+using RadialProblem = BundleProblem<12>;
 
 // Parses BAL text: "<num_cameras> <num_points> <num_observations>", then num_observations lines
 // "<camera> <point> <x> <y>", then 9 values per camera and 3 per point (whitespace separated).

@@ -121,6 +121,7 @@ class Solver {
     step_c_.resize(n);
     solution_.resize(n);
     BuildReducedSystemLayout();
+    BuildSharedIntrinsics(constancy.intrinsics_group);
     cand_cameras_ = problem->cameras;
     cand_points_ = problem->points;
     const int threads = ThreadPool::ResolveThreadCount(options.num_threads);
@@ -250,10 +251,10 @@ class Solver {
         r[0] -= o.x;
         r[1] -= o.y;
         double rho, drho;
-        opt_.loss.Evaluate(r[0] * r[0] + r[1] * r[1], &rho, &drho);
+        opt_.loss.Evaluate(o.weight * o.weight * (r[0] * r[0] + r[1] * r[1]), &rho, &drho);
         rho_[static_cast<size_t>(k)] = rho;
-        if (opt_.loss.type != LossType::kTrivial) {
-          const double sw = std::sqrt(drho);
+        if (opt_.loss.type != LossType::kTrivial || o.weight != 1.0) {
+          const double sw = o.weight * std::sqrt(drho);
           r[0] *= sw;
           r[1] *= sw;
           jc *= sw;
@@ -377,6 +378,8 @@ class Solver {
       ldlt_.FactorizeInPlace(s_sparse_);  // reads the upper triangle only
       if (ldlt_.info() != Eigen::Success) return false;
       solution_ = ldlt_.solve(rhs_);
+    } else if (!reduced_index_.empty()) {
+      if (!SolveShared()) return false;
     } else {
       dense_llt_->compute(s_dense_);  // reads the upper triangle only
       if (dense_llt_->info() != Eigen::Success) return false;
@@ -397,6 +400,65 @@ class Solver {
         step_p_[static_cast<size_t>(j)].noalias() = vinv_[static_cast<size_t>(j)] * b;
       }
     });
+    return true;
+  }
+
+  // Shared intrinsics replace the camera parameters x by x = P y, P a 0/1 matrix mapping each
+  // shared parameter to one column; the reduced system becomes P^T S P y = P^T b, assembled here
+  // from the upper triangle of S (S_ab with a < b contributes to (P^T S P)_pq and, when p = q,
+  // twice).
+  void BuildSharedIntrinsics(const std::vector<int>& groups) {
+    bool any = false;
+    for (int g : groups) any |= g >= 0;
+    if (!any) return;
+    const int n = kC * nc_;
+    reduced_index_.assign(static_cast<size_t>(n), -1);
+    std::vector<int> group_first_column;
+    int m = 0;
+    for (int i = 0; i < nc_; ++i) {
+      const int g = const_cam_[static_cast<size_t>(i)] ? -1 : groups[static_cast<size_t>(i)];
+      for (int k = 0; k < kC; ++k) {
+        int& index = reduced_index_[static_cast<size_t>(kC * i + k)];
+        if (k < 6 || g < 0) {
+          index = m++;
+          continue;
+        }
+        if (static_cast<size_t>(g) >= group_first_column.size()) group_first_column.resize(static_cast<size_t>(g) + 1, -1);
+        int& first = group_first_column[static_cast<size_t>(g)];
+        if (first < 0) {
+          first = m;
+          m += kC - 6;
+        }
+        index = first + (k - 6);
+      }
+    }
+    s_reduced_.resize(m, m);
+    rhs_reduced_.resize(m);
+    reduced_llt_.emplace(m);
+  }
+
+  bool SolveShared() {
+    const int n = kC * nc_;
+    s_reduced_.setZero();
+    rhs_reduced_.setZero();
+    for (int b = 0; b < n; ++b) {
+      const int q = reduced_index_[static_cast<size_t>(b)];
+      rhs_reduced_[q] += rhs_[b];
+      for (int a = 0; a <= b; ++a) {
+        const double v = s_dense_(a, b);
+        if (v == 0.0) continue;
+        const int p = reduced_index_[static_cast<size_t>(a)];
+        if (p == q) {
+          s_reduced_(p, p) += a == b ? v : 2.0 * v;
+        } else {
+          s_reduced_(std::min(p, q), std::max(p, q)) += v;
+        }
+      }
+    }
+    reduced_llt_->compute(s_reduced_);
+    if (reduced_llt_->info() != Eigen::Success) return false;
+    reduced_llt_->solveInPlace(rhs_reduced_);
+    for (int a = 0; a < n; ++a) solution_[a] = rhs_reduced_[reduced_index_[static_cast<size_t>(a)]];
     return true;
   }
 
@@ -441,7 +503,7 @@ class Solver {
                        points.data() + static_cast<size_t>(o.point) * kP, r, nullptr, nullptr)) {
           r[0] -= o.x;
           r[1] -= o.y;
-          opt_.loss.Evaluate(r[0] * r[0] + r[1] * r[1], &rho, &drho);
+          opt_.loss.Evaluate(o.weight * o.weight * (r[0] * r[0] + r[1] * r[1]), &rho, &drho);
         }
         rho_[static_cast<size_t>(k)] = rho;
       }
@@ -593,6 +655,10 @@ class Solver {
   }
 
   bool sparse_ = false;
+  std::vector<int> reduced_index_;  // shared intrinsics: column of each camera parameter, or empty
+  Eigen::MatrixXd s_reduced_;
+  Eigen::VectorXd rhs_reduced_;
+  std::optional<Eigen::LLT<Eigen::MatrixXd, Eigen::Upper>> reduced_llt_;
   std::vector<int> cam_pos_;
   std::vector<int> pair_offsets_;
   std::vector<PairBlock> pairs_;
@@ -674,7 +740,7 @@ double CostImpl(const typename Model::Problem& problem, const RobustLoss& loss) 
     r[0] -= o.x;
     r[1] -= o.y;
     double rho, drho;
-    loss.Evaluate(r[0] * r[0] + r[1] * r[1], &rho, &drho);
+    loss.Evaluate(o.weight * o.weight * (r[0] * r[0] + r[1] * r[1]), &rho, &drho);
     cost += rho;
   }
   return 0.5 * cost;
@@ -694,6 +760,14 @@ Result<BundleAdjustmentSummary> SolveImpl(const BundleAdjustmentOptions& options
   if (!constancy.constant_points.empty() &&
       constancy.constant_points.size() != static_cast<size_t>(problem->num_points())) {
     return InvalidArgument("SolveBundleAdjustment: constant_points size != point count");
+  }
+  if (!constancy.intrinsics_group.empty()) {
+    if (constancy.intrinsics_group.size() != static_cast<size_t>(problem->num_cameras())) {
+      return InvalidArgument("SolveBundleAdjustment: intrinsics_group size != camera count");
+    }
+    if (options.linear_solver != BundleAdjustmentOptions::LinearSolver::kDenseCholesky) {
+      return InvalidArgument("SolveBundleAdjustment: shared intrinsics need the dense solver");
+    }
   }
   for (int m : constancy.constant_camera_parameters) {
     if (m < 0 || m >= Model::Problem::kCameraSize) {

@@ -83,6 +83,10 @@ struct BundleAdjustmentConstancy {
   // Parameters held constant in every camera block, as indices into the block (e.g. 9 and 10,
   // the principal point of a RadialProblem camera).
   std::vector<int> constant_camera_parameters;
+  // Shared intrinsics: empty, or one entry per camera; free cameras with the same non-negative
+  // group share the intrinsic parameters (index 6 onwards of the block: f, k1, k2 [, cx, cy]),
+  // which must start out equal. Dense solver only.
+  std::vector<int> intrinsics_group;
 };
 
 // Minimises 1/2 sum_k rho(|u(camera, point) - observed|^2) over the free cameras and points of

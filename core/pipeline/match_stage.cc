@@ -113,7 +113,8 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
     }
     const TwoViewGeometry& g = result->geometry;
     out << "pair " << images[result->image_a].name << ' ' << images[result->image_b].name << ' '
-        << TwoViewConfigName(g.config) << ' ' << result->inlier_matches.size();
+        << (g.config == TwoViewGeometry::Config::kVerified ? "verified" : "planar") << ' '
+        << result->inlier_matches.size();
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) out << ' ' << g.F(r, c);
     }
@@ -140,6 +141,10 @@ Result<std::vector<MatchesFilePair>> ReadMatchesFile(const std::string& path) {
     size_t count = 0;
     if (!(fields >> tag >> pair.name_a >> pair.name_b >> pair.config >> count) || tag != "pair") {
       return FileError(StatusCode::kCorruptData, path, "expected a 'pair' line, got: " + line.substr(0, 80));
+    }
+    if (pair.config != "verified" && pair.config != "planar") {
+      return FileError(StatusCode::kCorruptData, path,
+                       "pair config must be 'verified' or 'planar', got: " + line.substr(0, 80));
     }
     for (int k = 0; k < 9; ++k) fields >> pair.F(k / 3, k % 3);
     if (!fields) return FileError(StatusCode::kCorruptData, path, "bad F on pair line: " + line.substr(0, 80));

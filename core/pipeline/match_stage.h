@@ -3,7 +3,8 @@
 // images (exhaustive), then two-view verification (F by LO-RANSAC, H screening). Pairs with at
 // least TwoViewOptions::min_inliers F-inliers go to <project>/matches/matches.txt:
 //   # reconar matches v1
-//   pair NAME_A NAME_B CONFIG NUM_INLIERS f11 f12 ... f33     (x_b^T F x_a = 0, pixels)
+//   pair NAME_A NAME_B CONFIG NUM_INLIERS f11 f12 ... f33     (x_b^T F x_a = 0, pixels;
+//                                                             CONFIG: verified or planar)
 //   INDEX_A INDEX_B                                           (NUM_INLIERS lines, feature indices)
 #include <string>
 #include <vector>
@@ -51,7 +52,7 @@ Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int heigh
 Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageOptions& options);
 
 struct MatchesFilePair {
-  std::string name_a, name_b, config;
+  std::string name_a, name_b, config;  // config: "verified" or "planar"
   Eigen::Matrix3d F;
   std::vector<FeatureMatch> matches;
 };

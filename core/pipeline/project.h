@@ -1,5 +1,6 @@
 #pragma once
-// A project folder: features/ (one .rfeat per image plus images.txt), matches/ (matches.txt).
+// A project folder: features/ (one .rfeat per image plus images.txt), matches/ (matches.txt),
+// sparse/ (the sparse model, see sfm_stage.h) and report.json.
 // images.txt lists, one image per line, "name width height focal_px focal_source path"; names are
 // unique within a project and key every other file.
 #include <string>
@@ -27,6 +28,8 @@ class Project {
   std::string ImageListPath() const { return FeaturesDir() + "/images.txt"; }
   std::string FeaturePath(const std::string& image_name) const { return FeaturesDir() + "/" + image_name + ".rfeat"; }
   std::string MatchesPath() const { return MatchesDir() + "/matches.txt"; }
+  std::string SparseDir() const { return root_ + "/sparse"; }
+  std::string ReportPath() const { return root_ + "/report.json"; }
 
   Status WriteImageList(const std::vector<ProjectImage>& images) const;
   Result<std::vector<ProjectImage>> ReadImageList() const;

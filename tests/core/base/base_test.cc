@@ -5,11 +5,14 @@
 
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
+#include <limits>
 #include <filesystem>
 #include <numeric>
 #include <vector>
 
 #include "core/base/arena.h"
+#include "core/base/json_writer.h"
 #include "core/base/atomic_file.h"
 #include "core/base/image.h"
 #include "core/base/progress.h"
@@ -175,6 +178,35 @@ TEST(AtomicFile, FullDiskLeavesNoHalfFile) {
   EXPECT_NE(status.message().find(path), std::string::npos) << status.message();
   EXPECT_EQ(*ReadFileToString(path), "old");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+}
+
+}  // namespace
+}  // namespace reconar
+
+namespace reconar {
+namespace {
+
+TEST(JsonWriter, WritesNestedValuesWithEscapesAndRoundTripDoubles) {
+  JsonWriter json;
+  json.BeginObject()
+      .Key("name").String("a \"b\"\n\\")
+      .Key("n").Int(-3)
+      .Key("x").Double(0.1)
+      .Key("y").Double(1.0 / 3.0)
+      .Key("bad").Double(std::numeric_limits<double>::quiet_NaN())
+      .Key("list").BeginArray().Bool(true).Null().BeginObject().EndObject().EndArray()
+      .EndObject();
+  EXPECT_EQ(json.str(),
+            "{\"name\":\"a \\\"b\\\"\\n\\\\\",\"n\":-3,\"x\":0.1,\"y\":0.33333333333333331,"
+            "\"bad\":null,\"list\":[true,null,{}]}");
+  EXPECT_EQ(std::strtod("0.33333333333333331", nullptr), 1.0 / 3.0);
+  EXPECT_EQ(JsonQuote(std::string("\x01", 1)), "\"\\u0001\"");
+}
+
+TEST(JsonWriter, PrettyPrintsWithIndent) {
+  JsonWriter json(2);
+  json.BeginObject().Key("a").Int(1).Key("b").BeginArray().Int(2).EndArray().EndObject();
+  EXPECT_EQ(json.str(), "{\n  \"a\": 1,\n  \"b\": [\n    2\n  ]\n}");
 }
 
 }  // namespace

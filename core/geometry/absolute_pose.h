@@ -1,0 +1,212 @@
+#pragma once
+// Absolute pose (camera registration): the pose of a camera from 2D-3D correspondences.
+//  - P3PEstimator: Lambda Twist P3P (Persson & Nordberg, "Lambda Twist: An Accurate Fast Robust
+//    Perspective Three Point (P3P) Solver", ECCV 2018), up to 4 poses from 3 correspondences.
+//  - DltPoseEstimator: the normalised direct linear transform for a 3x4 projection matrix from
+//    >= 6 correspondences (Hartley & Zisserman, "Multiple View Geometry", 2nd ed., sec. 7.1 and
+//    algorithm 7.1), the least-squares step of LO-RANSAC (Chum, Matas & Kittler, DAGM 2003).
+//  - EstimateAbsolutePose: P3P in LO-RANSAC for a camera of known focal length, then a robust
+//    Levenberg-Marquardt refinement of the pose (and optionally the focal) on the pixel
+//    reprojection error of the inliers. EstimateAbsolutePoseUnknownFocal: DLT in RANSAC, P
+//    decomposed by RQ (H&Z sec. 6.2.4) into focal and pose, then the same refinement.
+// Conventions: cam_from_world pose X_cam = R X + t (COLMAP: x right, y down, z forward); the
+// camera maps a point in front of it (X_cam.z > 0) to the pixel f * d(r^2) * p + c with
+// p = X_cam.xy / X_cam.z, r^2 = |p|^2 and d = 1 + k1 r^2 + k2 r^4. "Normalised" coordinates are p.
+#include <array>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/base/status.h"
+#include "core/geometry/pose_refinement.h"
+#include "core/geometry/ransac_options.h"
+
+namespace reconar {
+
+using Matrix34d = Eigen::Matrix<double, 3, 4>;
+
+// One 2D-3D correspondence: the sample of both estimators.
+struct PoseCorrespondence {
+  Eigen::Vector2d point;  // normalised image point p (undistorted, K^-1 x)
+  Eigen::Vector3d world;  // world point X
+};
+
+// |hnormalized(P X) - p|^2 for a projection P with the sign making depths positive in front of
+// the camera; the largest double when X is not in front of it (depth <= 0) or the error is not finite.
+inline double SquaredReprojectionError(const Matrix34d& P, const PoseCorrespondence& c) {
+  const Eigen::Vector3d x = P.leftCols<3>() * c.world + P.col(3);
+  if (!(x.z() > 0.0)) return std::numeric_limits<double>::max();
+  const double inv_z = 1.0 / x.z();
+  const double u = x.x() * inv_z - c.point.x();
+  const double v = x.y() * inv_z - c.point.y();
+  const double squared = u * u + v * v;
+  return squared < std::numeric_limits<double>::infinity() ? squared : std::numeric_limits<double>::max();
+}
+
+// Lambda Twist P3P. The model is cam_from_world [R | t].
+struct P3PEstimator {
+  using Sample = PoseCorrespondence;
+  using Model = Matrix34d;
+  static constexpr int kMinSamples = 3;
+  static constexpr int kMaxModels = 4;
+
+  // Uses the first 3 samples. Returns the number of poses (0..4) that put all three points at
+  // positive depth; 0 for degenerate samples (collinear or coincident world points).
+  static int Estimate(const Sample* samples, int count, std::array<Model, kMaxModels>* models);
+
+  // SquaredReprojectionError of each sample (normalised units squared).
+  static void Residuals(const Sample* samples, int count, const Model& cam_from_world, double* squared_residuals);
+};
+
+// Normalised DLT for P (11 degrees of freedom, so it also absorbs an unknown calibration: in
+// normalised coordinates it is the least-squares local step for P3P, in focal-scaled coordinates it
+// is the unknown-focal solver). P is scaled so that |P(2, 0:3)| = 1 and det(P(:, 0:3)) > 0, which
+// makes P X's third coordinate the depth. Residuals are those of P3PEstimator.
+struct DltPoseEstimator {
+  using Sample = PoseCorrespondence;
+  using Model = Matrix34d;
+  static constexpr int kMinSamples = 6;
+  static constexpr int kMaxModels = 1;
+
+  // count >= kMinSamples; the right singular vector of the stacked 2 x 12 constraints for the
+  // smallest singular value. Returns 0 for degenerate samples: coincident image or world points,
+  // coplanar world points (a rank deficiency of at least 2), a non-finite result.
+  static int Estimate(const Sample* samples, int count, std::array<Model, kMaxModels>* models);
+
+  static void Residuals(const Sample* samples, int count, const Model& P, double* squared_residuals);
+};
+
+// The nearest rotation and matching translation to a projection P ~ [R | t] (normalised
+// coordinates): P(:, 0:3) = U S V^T, R = U V^T, t = P(:, 3) / mean(S). False when det(P(:, 0:3)) <= 0
+// or the result is not finite.
+bool NearestPose(const Matrix34d& P, Eigen::Matrix3d* R, Eigen::Vector3d* t);
+
+// RQ decomposition of a finite projection P = K [R | t] (H&Z sec. 6.2.4): K upper triangular with
+// positive diagonal and K(2, 2) = 1, R a rotation. False when det(P(:, 0:3)) <= 0 or not finite.
+bool DecomposeProjection(const Matrix34d& P, Eigen::Matrix3d* K, Eigen::Matrix3d* R, Eigen::Vector3d* t);
+
+// Pinhole camera with two radial distortion coefficients (see the header comment).
+struct AbsolutePoseCamera {
+  double focal = 1.0;  // pixels
+  double cx = 0.0;     // principal point, pixels
+  double cy = 0.0;
+  double k1 = 0.0;
+  double k2 = 0.0;
+
+  // InvalidArgument unless focal > 0 and every value is finite.
+  Status Check() const;
+  // f * d(|p|^2) * p + c.
+  Eigen::Vector2d Distort(const Eigen::Vector2d& normalised) const;
+  // The normalised point p whose pixel is `pixel`: |p| solves |q| = |p| d(|p|^2) for
+  // q = (pixel - c) / f by Newton's method from |p| = |q|. False when it does not converge to a
+  // point where the distortion is still monotonic (d(r^2) r increasing), i.e. beyond the valid image.
+  bool Undistort(const Eigen::Vector2d& pixel, Eigen::Vector2d* normalised) const;
+};
+
+// Squared pixel error of X under the camera and cam_from_world (R, t); the largest double when
+// X is not in front of the camera.
+double SquaredPixelError(const AbsolutePoseCamera& camera, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                         const Eigen::Vector3d& world_point, const Eigen::Vector2d& pixel);
+
+struct PoseRefinementOptions {
+  enum class Loss {
+    kTrivial,  // rho(s) = s
+    kHuber,    // rho(s) = s for s <= c^2, 2 c sqrt(s) - c^2 beyond
+    kCauchy,   // rho(s) = c^2 log(1 + s / c^2)
+  };
+  Loss loss = Loss::kHuber;
+  double loss_scale_px = 1.0;  // c
+  bool refine_focal = false;   // also refine camera.focal (as log f); k1, k2 stay fixed
+  NormalLmOptions lm;
+
+  // InvalidArgument naming the first offending field.
+  Status Check() const;
+};
+
+// Minimises 1/2 sum_i rho(|camera(R X_i + t) - x_i|^2) over the correspondences `indices` (pixel
+// x_i = points_px[indices[i]], X_i = world_points[indices[i]], i < count) with respect to the pose
+// (rotation updated as R <- exp(dw) R, translation t <- t + dt) and, with refine_focal, the
+// focal. *R, *t and camera->focal are updated when the summary's termination is not
+// kNumericFailure. Steps that put a point behind the camera are rejected. No heap allocation;
+// the caller validates the input (see RefineAbsolutePose below).
+NormalLmSummary RefineAbsolutePoseInPlace(const Eigen::Vector2d* points_px, const Eigen::Vector3d* world_points,
+                                          const int* indices, int count, const PoseRefinementOptions& options,
+                                          AbsolutePoseCamera* camera, Eigen::Matrix3d* R, Eigen::Vector3d* t);
+
+// RefineAbsolutePoseInPlace on validated input. InvalidArgument when the vectors differ in
+// length, an index is out of range, fewer than 4 indices are given (7 parameters need more than
+// 3 points), the options or camera fail Check(), or a point lies behind the initial camera;
+// NumericFailure when the initial cost or system is not finite.
+Result<NormalLmSummary> RefineAbsolutePose(const std::vector<Eigen::Vector2d>& points_px,
+                                           const std::vector<Eigen::Vector3d>& world_points,
+                                           const std::vector<int>& indices, const PoseRefinementOptions& options,
+                                           AbsolutePoseCamera* camera, Eigen::Matrix3d* R, Eigen::Vector3d* t);
+
+struct AbsolutePoseOptions {
+  // Inlier threshold on the pixel reprojection error; RANSAC uses max_error_px / focal in
+  // normalised units (ransac.max_residual is replaced by it).
+  double max_error_px = 4.0;
+  RansacOptions ransac;
+  // Inliers (after refinement, at max_error_px) the pose needs; also the least number of
+  // correspondences accepted. >= 4.
+  int min_inliers = 12;
+  // Robust refinement of the RANSAC pose on its inliers (the loss and LM settings come from
+  // `refinement`; its refine_focal is replaced by refine_focal below).
+  bool refine = true;
+  bool refine_focal = false;  // EstimateAbsolutePose only; the unknown-focal path always refines the focal
+  PoseRefinementOptions refinement;
+
+  // InvalidArgument naming the first offending field.
+  Status Check() const;
+};
+
+struct AbsolutePoseResult {
+  enum class Outcome {
+    kSuccess,                // a pose with >= min_inliers inliers
+    kTooFewCorrespondences,  // fewer than max(min_inliers, kMinSamples + 1) usable correspondences
+                             // (finite, and undistortable pixels)
+    kNoModel,                // RANSAC found no pose with enough inliers to fit: every minimal sample was
+                             // degenerate (collinear or coplanar-for-DLT world points) or no pose put
+                             // the points in front of the camera
+    kTooFewInliers,          // the best pose has fewer than min_inliers inliers
+  };
+  Outcome outcome = Outcome::kNoModel;
+  std::string reason;  // why it failed (empty on success)
+  Eigen::Matrix3d cam_from_world_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
+  double focal = 0.0;                // the camera's focal, or the estimate (unknown-focal path, refine_focal)
+  std::vector<int> inliers;          // indices into the input with pixel error < max_error_px, ascending
+  int num_inliers = 0;
+  double mean_inlier_error_px = 0.0;  // mean pixel reprojection error of the inliers
+  int ransac_iterations = 0;
+  bool refined = false;              // the refinement ran and its result was kept
+  NormalLmSummary refinement;        // valid when `refined`
+
+  bool success() const { return outcome == Outcome::kSuccess; }
+};
+
+const char* AbsolutePoseOutcomeName(AbsolutePoseResult::Outcome outcome);
+
+// The pose of a camera of known intrinsics from points_px[i] <-> world_points[i]. InvalidArgument
+// when the vectors differ in length or the camera or options fail Check(); every other outcome is
+// an AbsolutePoseResult whose `outcome` and `reason` say what happened. Non-finite or
+// non-undistortable correspondences are never inliers. The RANSAC model may be a DLT projection
+// from the local optimisation; it is made a pose by NearestPose before the refinement.
+Result<AbsolutePoseResult> EstimateAbsolutePose(const std::vector<Eigen::Vector2d>& points_px,
+                                                const std::vector<Eigen::Vector3d>& world_points,
+                                                const AbsolutePoseCamera& camera,
+                                                const AbsolutePoseOptions& options);
+
+// The same for an unknown focal length: camera.focal is only a prior that scales the coordinates
+// (and the pixel threshold) for the DLT; the principal point is taken as known. Distortion is
+// ignored by the DLT and modelled (with k1, k2 fixed) by the refinement. Needs non-coplanar
+// world points. result.focal is the mean of K(0, 0) and K(1, 1) of the RQ decomposition, refined
+// with the pose when options.refine.
+Result<AbsolutePoseResult> EstimateAbsolutePoseUnknownFocal(const std::vector<Eigen::Vector2d>& points_px,
+                                                            const std::vector<Eigen::Vector3d>& world_points,
+                                                            const AbsolutePoseCamera& camera,
+                                                            const AbsolutePoseOptions& options);
+
+}  // namespace reconar

@@ -1,0 +1,155 @@
+#include "core/pipeline/sfm_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "core/base/atomic_file.h"
+#include "core/base/progress.h"
+#include "core/base/thread_pool.h"
+#include "core/features/sift/sift_io.h"
+#include "core/io/image_io.h"
+#include "core/pipeline/match_stage.h"
+#include "core/sfm/model_io.h"
+
+namespace reconar {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Each point takes the colour of the pixel under its first observation.
+Status ColourPoints(const std::vector<ProjectImage>& list, int num_threads, Reconstruction* rec) {
+  std::vector<std::vector<std::pair<int, int>>> wanted(rec->images.size());  // (point, keypoint)
+  for (size_t p = 0; p < rec->points.size(); ++p) {
+    const SfmPoint& point = rec->points[p];
+    if (point.deleted || point.track.empty()) continue;
+    wanted[static_cast<size_t>(point.track.front().image_id)].emplace_back(static_cast<int>(p),
+                                                                           point.track.front().keypoint_id);
+  }
+  std::vector<Status> errors(rec->images.size());
+  ThreadPool pool(ThreadPool::ResolveThreadCount(num_threads));
+  pool.ParallelFor(0, rec->images.size(), [&](size_t i, int) {
+    if (wanted[i].empty()) return;
+    auto decoded = ReadImage(list[i].path);
+    if (!decoded.ok()) {
+      errors[i] = decoded.status();
+      return;
+    }
+    const Image<uint8_t>& rgb = decoded->rgb;
+    for (const auto& [point_id, keypoint] : wanted[i]) {
+      const Eigen::Vector2d& x = rec->images[i].keypoints[static_cast<size_t>(keypoint)];
+      const int u = std::clamp(static_cast<int>(std::lround(x.x())), 0, rgb.width() - 1);
+      const int v = std::clamp(static_cast<int>(std::lround(x.y())), 0, rgb.height() - 1);
+      const uint8_t* pixel = rgb.row(v) + 3 * u;
+      rec->points[static_cast<size_t>(point_id)].color = {pixel[0], pixel[1], pixel[2]};
+    }
+  });
+  for (const Status& status : errors) RECONAR_RETURN_IF_ERROR(status);
+  return Status::Ok();
+}
+
+void FocalStatistics(const Reconstruction& rec, SfmStageReport* report) {
+  std::vector<double> ratios;
+  for (const SfmImage& image : rec.images) {
+    if (!image.registered) continue;
+    const SfmCamera& camera = rec.cameras[static_cast<size_t>(image.camera_id)];
+    ratios.push_back(camera.focal / std::max(camera.width, camera.height));
+  }
+  if (ratios.empty()) return;
+  double mean = 0.0;
+  for (double r : ratios) mean += r;
+  mean /= static_cast<double>(ratios.size());
+  double squares = 0.0;
+  for (double r : ratios) squares += (r - mean) * (r - mean);
+  report->mean_focal_ratio = mean;
+  report->rmse_focal_ratio = std::sqrt(squares / static_cast<double>(ratios.size()));
+  report->focal_35mm_equivalent = 36.0 * mean;  // the long side of a 36 x 24 mm frame
+}
+
+}  // namespace
+
+Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions& options,
+                                   Reconstruction* reconstruction_out) {
+  SfmStageReport report;
+  auto start = Clock::now();
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<ProjectImage> list, project.ReadImageList());
+  std::map<std::string, int> index_of;
+  std::vector<MapperImage> images(list.size());
+  for (size_t i = 0; i < list.size(); ++i) {
+    index_of[list[i].name] = static_cast<int>(i);
+    MapperImage& image = images[i];
+    image.name = list[i].name;
+    image.width = list[i].width;
+    image.height = list[i].height;
+    image.focal_prior = list[i].focal_px;
+    image.focal_from_exif = list[i].focal_source.rfind("exif", 0) == 0;
+    const std::string path = project.FeaturePath(list[i].name);
+    RECONAR_ASSIGN_OR_RETURN(const FeatureFile features, ReadFeatureFile(path));
+    if (features.image_width != image.width || features.image_height != image.height) {
+      return FileError(StatusCode::kCorruptData, path, "image size differs from " + project.ImageListPath());
+    }
+    image.keypoints.reserve(features.features.keypoints.size());
+    for (const SiftKeypoint& k : features.features.keypoints) {
+      image.keypoints.emplace_back(k.x, k.y);
+      image.keypoint_scales.push_back(k.scale);
+    }
+  }
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<MatchesFilePair> matches, ReadMatchesFile(project.MatchesPath()));
+  std::vector<MapperPair> pairs;
+  pairs.reserve(matches.size());
+  for (const MatchesFilePair& m : matches) {
+    const auto a = index_of.find(m.name_a), b = index_of.find(m.name_b);
+    if (a == index_of.end() || b == index_of.end()) {
+      return FileError(StatusCode::kCorruptData, project.MatchesPath(),
+                       "pair " + m.name_a + " " + m.name_b + " names an image missing from " + project.ImageListPath());
+    }
+    MapperPair pair;
+    pair.matches.image_a = a->second;
+    pair.matches.image_b = b->second;
+    pair.matches.matches = m.matches;
+    pair.planar = m.config == "planar";
+    pairs.push_back(std::move(pair));
+  }
+  report.seconds_load = SecondsSince(start);
+
+  start = Clock::now();
+  std::unique_ptr<Progress> progress;
+  size_t shown = 0;
+  if (options.show_progress) progress = std::make_unique<Progress>("mapping", images.size());
+  const MapperProgress on_progress = [&](int registered, int) {
+    if (!progress) return;
+    const auto done = static_cast<size_t>(registered);
+    if (done > shown) progress->Advance(done - shown);
+    shown = std::max(shown, done);
+  };
+  auto reconstruction = RunIncrementalMapper(images, pairs, options.mapper, &report.mapper, on_progress);
+  if (progress) progress->Finish();
+  if (!reconstruction.ok()) return reconstruction.status();
+  report.seconds_mapping = SecondsSince(start);
+  FocalStatistics(*reconstruction, &report);
+
+  start = Clock::now();
+  RECONAR_RETURN_IF_ERROR(ColourPoints(list, options.mapper.num_threads, &*reconstruction));
+  report.seconds_colour = SecondsSince(start);
+
+  start = Clock::now();
+  const std::string sparse = project.SparseDir();
+  RECONAR_RETURN_IF_ERROR(CreateDirectories(sparse));
+  std::vector<std::string> paths;
+  for (const ProjectImage& image : list) paths.push_back(image.path);
+  RECONAR_RETURN_IF_ERROR(WriteBundlerModel(*reconstruction, sparse + "/bundle.out", sparse + "/list.txt", paths));
+  RECONAR_RETURN_IF_ERROR(WritePointsPly(*reconstruction, sparse + "/points.ply"));
+  // points3D.txt last: its presence marks a finished model (see the sfm command's reuse check).
+  RECONAR_RETURN_IF_ERROR(WriteColmapTextModel(*reconstruction, sparse));
+  report.seconds_write = SecondsSince(start);
+  if (reconstruction_out != nullptr) *reconstruction_out = std::move(*reconstruction);
+  return report;
+}
+
+}  // namespace reconar

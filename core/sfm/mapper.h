@@ -1,0 +1,120 @@
+#pragma once
+// Incremental structure from motion (Snavely, Seitz & Szeliski, "Photo Tourism", 2006; the
+// paper's sections 2.1.4-2.1.5; Schoenberger & Frahm, "Structure-from-Motion Revisited", CVPR
+// 2016): an initial pair with enough parallax, then one image at a time registered from its
+// 2D-3D correspondences (P3P in LO-RANSAC), new tracks triangulated, local bundle adjustment
+// around the new image, global bundle adjustment at growth milestones, and outlier filtering.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/sfm/reconstruction.h"
+#include "core/sfm/tracks.h"
+
+namespace reconar {
+
+struct MapperImage {
+  std::string name;
+  int width = 0;
+  int height = 0;
+  double focal_prior = 0.0;     // pixels
+  bool focal_from_exif = false; // the prior came from EXIF (trusted by the 0.7-1.4 rule)
+  std::vector<Eigen::Vector2d> keypoints;  // pixels
+  std::vector<float> keypoint_scales;      // optional: detection scale (sigma, pixels) per keypoint
+};
+
+struct MapperPair {
+  PairMatches matches;  // verified (F-inlier) matches
+  bool planar = false;  // the two-view check found little parallax (H explains most inliers)
+};
+
+struct MapperOptions {
+  // Initial pair: at least this many tracks triangulated, with median triangulation angle at
+  // least init_min_median_angle_deg.
+  int init_min_points = 100;
+  double init_min_median_angle_deg = 4.0;
+  int init_max_pairs_tried = 20;
+  // Registration: P3P LO-RANSAC with this pixel threshold; a pose needs this many inliers.
+  double registration_max_error_px = 4.0;
+  int registration_min_inliers = 30;
+  // Triangulation and filtering.
+  double max_reprojection_error_px = 4.0;
+  double min_triangulation_angle_deg = 1.5;
+  // Local bundle adjustment: the new image and up to this many images sharing the most points.
+  int local_ba_images = 6;
+  int local_ba_iterations = 25;
+  // Global bundle adjustment whenever the registered count reached growth x the last one.
+  double global_ba_growth = 1.25;
+  int global_ba_iterations = 50;
+  // The final global adjustment runs to a tighter relative cost change.
+  int final_ba_iterations = 200;
+  double final_ba_function_tolerance = 1e-10;
+  // Scale (pixels) of the Cauchy loss in every bundle adjustment. Observations beyond
+  // max_reprojection_error_px are dropped by filtering; the loss only tempers those near the bound.
+  double ba_loss_scale_px = 3.0;
+  // With keypoint scales given, an observation's standard deviation grows with its detection
+  // scale beyond this one (pixels): weight = min(1, base_scale / scale).
+  bool weight_by_scale = true;
+  double base_scale_px = 1.6;
+  // Intrinsics: focal, k1, k2 per image are refined once three images are registered.
+  bool refine_focal = true;
+  bool refine_distortion = true;
+  // Principal point: fixed at the image centre, refined in the final bundle adjustment, or
+  // (kAuto) refined there when the Bayesian information criterion prefers it. With
+  // refine_distortion the final adjustment likewise chooses between k1 = k2 = 0 and free k1, k2.
+  enum class PrincipalPoint { kFixed, kAuto, kRefine };
+  PrincipalPoint principal_point = PrincipalPoint::kAuto;
+  // The final adjustment may also refine the pixel aspect ratio fy / fx (chosen the same way).
+  bool refine_aspect = true;
+  // EXIF focal priors outside [focal_prior_min_ratio, focal_prior_max_ratio] x the data's
+  // estimate are distrusted (paper eq. 5).
+  double focal_prior_min_ratio = 0.7;
+  double focal_prior_max_ratio = 1.4;
+  // Which images share one camera (one set of intrinsics):
+  //  kAuto: images of the same size whose focal priors agree and come from EXIF, or that all
+  //         lack EXIF (one unknown camera, the usual case of a single device without metadata);
+  //  kPerImage: every image has its own intrinsics;
+  //  kSingle: all images of the same size share one camera.
+  enum class CameraSharing { kAuto, kPerImage, kSingle };
+  CameraSharing camera_sharing = CameraSharing::kAuto;
+  int num_threads = 0;  // <= 0: one per core
+
+  Status Check() const;
+};
+
+struct MapperReport {
+  struct Unregistered {
+    std::string name;
+    std::string reason;
+  };
+  int num_images = 0;
+  int num_registered = 0;
+  int num_points = 0;
+  int num_tracks = 0;
+  int num_inconsistent_tracks = 0;
+  std::string initial_pair;  // "a.jpg + b.jpg"
+  std::vector<Unregistered> unregistered;
+  int num_local_ba = 0;
+  int num_global_ba = 0;
+  double seconds_ba = 0.0;
+  double seconds_total = 0.0;
+  double mean_reprojection_error_px = 0.0;
+  double mean_track_length = 0.0;
+  bool principal_point_refined = false;  // the final model's choices (see MapperOptions)
+  bool distortion_refined = false;
+  bool aspect_refined = false;
+};
+
+// Called after each registration with (registered, total).
+using MapperProgress = std::function<void(int, int)>;
+
+// Builds a model from the images and their verified pairwise matches. InvalidArgument for bad
+// options or inconsistent input (a match indexing a missing keypoint); FailedPrecondition, with
+// the reason, when no initial pair can be found (e.g. unrelated photos or too few matches).
+Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& images,
+                                            const std::vector<MapperPair>& pairs,
+                                            const MapperOptions& options, MapperReport* report,
+                                            const MapperProgress& progress = nullptr);
+
+}  // namespace reconar

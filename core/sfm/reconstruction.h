@@ -1,0 +1,93 @@
+#pragma once
+// The sparse model that structure from motion builds and every later stage reads: cameras
+// (intrinsics), images (poses and 2D keypoints) and 3D points with their tracks.
+//
+// Conventions (DESIGN.md):
+//  - Pixel coordinates have the centre of the top-left pixel at (0, 0), x right, y down (the
+//    SIFT convention). COLMAP's files put that centre at (0.5, 0.5); model_io converts.
+//  - A pose is cam_from_world: X_cam = R X_world + t, camera looking down +z, y down.
+//  - The camera model is Bundler's radial model (paper eq. 9) with a principal point and a pixel
+//    aspect ratio a: p = X_cam.xy / X_cam.z, d = 1 + k1 |p|^2 + k2 |p|^4,
+//    u = f d p.x + cx, v = a f d p.y + cy. With a = 1 it is COLMAP's RADIAL model, otherwise
+//    COLMAP's OPENCV model with fx = f, fy = a f and no tangential distortion.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace reconar {
+
+struct SfmCamera {
+  int width = 0;
+  int height = 0;
+  double focal = 0.0;  // pixels
+  double cx = 0.0;     // principal point, pixels
+  double cy = 0.0;
+  double k1 = 0.0;
+  double k2 = 0.0;
+  double aspect = 1.0;  // fy / fx
+
+  // Pixel of a point in camera coordinates (z > 0 assumed).
+  Eigen::Vector2d Project(const Eigen::Vector3d& cam_point) const {
+    const Eigen::Vector2d p = cam_point.head<2>() / cam_point.z();
+    const double r2 = p.squaredNorm();
+    const double d = 1.0 + r2 * (k1 + k2 * r2);
+    return Eigen::Vector2d(focal * d * p.x() + cx, aspect * focal * d * p.y() + cy);
+  }
+};
+
+struct SfmPose {
+  Eigen::Matrix3d cam_from_world_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d CamFromWorld(const Eigen::Vector3d& world_point) const {
+    return cam_from_world_rotation * world_point + cam_from_world_translation;
+  }
+  // The projection centre in world coordinates: -R^T t.
+  Eigen::Vector3d Center() const {
+    return -cam_from_world_rotation.transpose() * cam_from_world_translation;
+  }
+};
+
+struct SfmImage {
+  std::string name;    // file name, unique within the project (images.txt of the feature stage)
+  int camera_id = -1;  // index into Reconstruction::cameras
+  bool registered = false;
+  SfmPose pose;        // meaningful when registered
+  std::vector<Eigen::Vector2d> keypoints;  // pixels
+  std::vector<int> point3d_ids;            // per keypoint: index into Reconstruction::points, or -1
+};
+
+struct TrackElement {
+  int image_id = -1;     // index into Reconstruction::images
+  int keypoint_id = -1;  // index into SfmImage::keypoints
+};
+
+struct SfmPoint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  std::array<uint8_t, 3> color = {0, 0, 0};  // RGB
+  double error = 0.0;                        // mean reprojection error over the track, pixels
+  std::vector<TrackElement> track;
+  bool deleted = false;  // removed points keep their slot so that ids stay stable; writers skip them
+};
+
+struct Reconstruction {
+  std::vector<SfmCamera> cameras;
+  std::vector<SfmImage> images;
+  std::vector<SfmPoint> points;
+
+  int NumRegisteredImages() const {
+    int n = 0;
+    for (const SfmImage& image : images) n += image.registered ? 1 : 0;
+    return n;
+  }
+  int NumPoints() const {
+    int n = 0;
+    for (const SfmPoint& point : points) n += point.deleted ? 0 : 1;
+    return n;
+  }
+};
+
+}  // namespace reconar

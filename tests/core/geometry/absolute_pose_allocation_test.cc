@@ -1,0 +1,143 @@
+// The pose refinement runs after every registration and bundle adjustment, and the P3P / DLT
+// solvers thousands of times per image: none of them may touch the heap. This executable compiles
+// absolute_pose.cc itself with EIGEN_RUNTIME_NO_MALLOC and assertions on, so any Eigen heap
+// allocation aborts, and it replaces the global operator new to count every other allocation
+// (the technique of allocation_test.cc).
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "core/geometry/absolute_pose.h"
+
+#ifndef EIGEN_RUNTIME_NO_MALLOC
+#error "absolute_pose_allocation_test.cc must be compiled with EIGEN_RUNTIME_NO_MALLOC"
+#endif
+
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+
+void* CountedAllocate(std::size_t size) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return CountedAllocate(size); }
+void* operator new[](std::size_t size) { return CountedAllocate(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace reconar {
+namespace {
+
+// Counts operator-new calls and forbids Eigen heap allocation within its lifetime.
+class NoAllocationScope {
+ public:
+  NoAllocationScope() {
+    g_allocations = 0;
+    Eigen::internal::set_is_malloc_allowed(false);
+    g_counting = true;
+  }
+  ~NoAllocationScope() {
+    g_counting = false;
+    Eigen::internal::set_is_malloc_allowed(true);
+  }
+  long allocations() const { return g_allocations.load(); }
+};
+
+// 100 points on a grid of depths in front of a distorted camera, noise-free pixels.
+struct Data {
+  AbsolutePoseCamera camera{750.0, 320.0, 240.0, -0.1, 0.02};
+  Eigen::Matrix3d R = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  Eigen::Vector3d t = Eigen::Vector3d(0.3, -0.2, 1.0);
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> world;
+  std::vector<PoseCorrespondence> normalised;
+  std::vector<int> indices;
+
+  Data() {
+    for (int i = 0; i < 100; ++i) {
+      const Eigen::Vector2d p(-0.4 + 0.08 * (i % 10), -0.3 + 0.06 * (i / 10));
+      const Eigen::Vector3d X_cam = (3.0 + 0.37 * (i % 7)) * p.homogeneous();
+      world.push_back(R.transpose() * (X_cam - t));
+      pixels.push_back(camera.Distort(p));
+      normalised.push_back(PoseCorrespondence{p, world.back()});
+      indices.push_back(i);
+    }
+  }
+};
+
+TEST(AbsolutePoseAllocation, EigenHeapGuardIsActive) {
+  EXPECT_DEATH(
+      {
+        NoAllocationScope scope;
+        Eigen::MatrixXd heap(20, 20);
+        heap.setZero();
+      },
+      "heap allocation is forbidden");
+}
+
+TEST(AbsolutePoseAllocation, RefinementOfPoseAndFocal) {
+  const Data data;
+  for (bool refine_focal : {false, true}) {
+    SCOPED_TRACE(refine_focal);
+    PoseRefinementOptions options;
+    options.refine_focal = refine_focal;
+    AbsolutePoseCamera camera = data.camera;
+    camera.focal *= refine_focal ? 1.05 : 1.0;
+    Eigen::Matrix3d R = Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitY()) * data.R;
+    Eigen::Vector3d t = data.t + Eigen::Vector3d(0.05, 0.0, -0.05);
+    NormalLmSummary summary;
+    long allocations = 0;
+    {
+      NoAllocationScope scope;
+      summary = RefineAbsolutePoseInPlace(data.pixels.data(), data.world.data(), data.indices.data(),
+                                          static_cast<int>(data.indices.size()), options, &camera, &R, &t);
+      allocations = scope.allocations();
+    }
+    EXPECT_EQ(allocations, 0);
+    EXPECT_TRUE(summary.converged());
+    EXPECT_GT(summary.iterations, 2);
+    EXPECT_LT((R - data.R).norm(), 1e-9);
+    EXPECT_LT((t - data.t).norm(), 1e-9);
+  }
+}
+
+TEST(AbsolutePoseAllocation, MinimalAndLeastSquaresSolvers) {
+  const Data data;
+  std::array<Matrix34d, P3PEstimator::kMaxModels> p3p_models;
+  std::array<Matrix34d, DltPoseEstimator::kMaxModels> dlt_models;
+  std::array<double, 100> residuals;
+  // Spread over the grid (rows of the grid are coplanar with the camera centre).
+  const std::array<PoseCorrespondence, 6> sample = {data.normalised[0], data.normalised[47], data.normalised[93],
+                                                    data.normalised[15], data.normalised[62], data.normalised[38]};
+  int num_p3p = 0, num_dlt = 0, num_least_squares = 0;
+  long allocations = 0;
+  {
+    NoAllocationScope scope;
+    num_p3p = P3PEstimator::Estimate(sample.data(), 3, &p3p_models);
+    P3PEstimator::Residuals(data.normalised.data(), 100, p3p_models[0], residuals.data());
+    num_dlt = DltPoseEstimator::Estimate(sample.data(), 6, &dlt_models);
+    num_least_squares = DltPoseEstimator::Estimate(data.normalised.data(), 100, &dlt_models);
+    DltPoseEstimator::Residuals(data.normalised.data(), 100, dlt_models[0], residuals.data());
+    allocations = scope.allocations();
+  }
+  EXPECT_EQ(allocations, 0);
+  EXPECT_GE(num_p3p, 1);
+  EXPECT_EQ(num_dlt, 1);
+  EXPECT_EQ(num_least_squares, 1);
+}
+
+}  // namespace
+}  // namespace reconar

@@ -1,0 +1,148 @@
+#include "tests/support/sfm_evaluation.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numeric>
+#include <sstream>
+
+#include "core/base/atomic_file.h"
+
+namespace reconar::testing {
+
+namespace {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  if (values.size() % 2 == 1) return values[mid];
+  return 0.5 * (values[mid] + *std::max_element(values.begin(), values.begin() + mid));
+}
+
+double Mean(const std::vector<double>& values) {
+  return values.empty() ? 0.0 : std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+}
+
+double Max(const std::vector<double>& values) {
+  return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
+}
+
+double RotationAngleDeg(const Eigen::Matrix3d& rotation) {
+  const double cosine = std::clamp(0.5 * (rotation.trace() - 1.0), -1.0, 1.0);
+  return std::acos(cosine) * 180.0 / M_PI;
+}
+
+}  // namespace
+
+Result<Similarity3> AlignSimilarity(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to) {
+  if (from.size() != to.size()) return InvalidArgument("AlignSimilarity: point sets differ in size");
+  if (from.size() < 3) return InvalidArgument("AlignSimilarity: needs at least 3 point pairs");
+  const double n = static_cast<double>(from.size());
+  Eigen::Vector3d mean_from = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mean_to = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < from.size(); ++i) {
+    mean_from += from[i] / n;
+    mean_to += to[i] / n;
+  }
+  // Covariance Sigma = 1/n sum (to - mean_to)(from - mean_from)^T and variance of `from` (eq. 36-38).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double variance_from = 0.0;
+  for (size_t i = 0; i < from.size(); ++i) {
+    covariance += (to[i] - mean_to) * (from[i] - mean_from).transpose() / n;
+    variance_from += (from[i] - mean_from).squaredNorm() / n;
+  }
+  if (!(variance_from > 0.0)) return InvalidArgument("AlignSimilarity: all source points coincide");
+
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Vector3d s = Eigen::Vector3d::Ones();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) s.z() = -1.0;  // a reflection otherwise
+  Similarity3 similarity;
+  similarity.rotation = svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
+  similarity.scale = svd.singularValues().dot(s) / variance_from;
+  similarity.translation = mean_to - similarity.scale * similarity.rotation * mean_from;
+  return similarity;
+}
+
+CameraPose PoseOf(const GroundTruthCamera& camera) { return {camera.cam_from_world_rotation, camera.Centre()}; }
+
+Result<CameraPoseErrors> CameraCenterErrors(const std::vector<CameraPose>& estimated,
+                                            const std::vector<CameraPose>& ground_truth) {
+  if (estimated.size() != ground_truth.size()) return InvalidArgument("CameraCenterErrors: camera lists differ in size");
+  std::vector<Eigen::Vector3d> from;
+  std::vector<Eigen::Vector3d> to;
+  for (size_t i = 0; i < estimated.size(); ++i) {
+    from.push_back(estimated[i].centre);
+    to.push_back(ground_truth[i].centre);
+  }
+  CameraPoseErrors errors;
+  RECONAR_ASSIGN_OR_RETURN(errors.gt_from_estimate, AlignSimilarity(from, to));
+  const Similarity3& similarity = errors.gt_from_estimate;
+  for (size_t i = 0; i < estimated.size(); ++i) {
+    errors.centre_errors.push_back((similarity.Apply(from[i]) - to[i]).norm());
+    // The estimate's camera in the ground-truth world: cam_from_gt = cam_from_estimate * estimate_from_gt.
+    const Eigen::Matrix3d cam_from_gt = estimated[i].cam_from_world_rotation * similarity.rotation.transpose();
+    errors.rotation_errors_deg.push_back(
+        RotationAngleDeg(cam_from_gt * ground_truth[i].cam_from_world_rotation.transpose()));
+  }
+  errors.centre_mean = Mean(errors.centre_errors);
+  errors.centre_median = Median(errors.centre_errors);
+  errors.centre_max = Max(errors.centre_errors);
+  errors.rotation_mean_deg = Mean(errors.rotation_errors_deg);
+  errors.rotation_median_deg = Median(errors.rotation_errors_deg);
+  errors.rotation_max_deg = Max(errors.rotation_errors_deg);
+  std::vector<double> relative_errors;
+  for (size_t i = 0; i < estimated.size(); ++i) {
+    for (size_t j = i + 1; j < estimated.size(); ++j) {
+      const Eigen::Matrix3d estimated_i_from_j =
+          estimated[i].cam_from_world_rotation * estimated[j].cam_from_world_rotation.transpose();
+      const Eigen::Matrix3d true_i_from_j =
+          ground_truth[i].cam_from_world_rotation * ground_truth[j].cam_from_world_rotation.transpose();
+      relative_errors.push_back(RotationAngleDeg(estimated_i_from_j * true_i_from_j.transpose()));
+    }
+  }
+  errors.relative_rotation_mean_deg = Mean(relative_errors);
+  return errors;
+}
+
+Result<GroundTruthByName> ReadStrechaGroundTruth(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::directory_iterator entries(dir, ec);
+  if (ec) return FileError(StatusCode::kNotFound, dir, "cannot list directory: " + ec.message());
+  GroundTruthByName cameras;
+  for (const fs::directory_entry& entry : entries) {
+    if (entry.path().extension() != ".camera") continue;
+    RECONAR_ASSIGN_OR_RETURN(GroundTruthCamera camera, ReadStrechaCamera(entry.path().string()));
+    cameras.emplace(entry.path().stem().string(), camera);
+  }
+  if (cameras.empty()) return FileError(StatusCode::kNotFound, dir, "no *.camera files");
+  return cameras;
+}
+
+Result<GroundTruthByName> ReadMiddleburyPar(const std::string& path) {
+  RECONAR_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  std::istringstream in(text);
+  int count = 0;
+  if (!(in >> count) || count <= 0) return FileError(StatusCode::kCorruptData, path, "line 1: expected the image count");
+  GroundTruthByName cameras;
+  for (int i = 0; i < count; ++i) {
+    std::string name;
+    double v[21];
+    in >> name;
+    for (double& x : v) in >> x;
+    if (!in) {
+      return FileError(StatusCode::kCorruptData, path,
+                       "line " + std::to_string(i + 2) + ": expected a name and 21 numbers (K, R, t)");
+    }
+    GroundTruthCamera camera;
+    camera.K << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
+    camera.cam_from_world_rotation << v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16], v[17];
+    camera.cam_from_world_translation << v[18], v[19], v[20];
+    cameras.emplace(name, camera);
+  }
+  return cameras;
+}
+
+}  // namespace reconar::testing

@@ -1,0 +1,66 @@
+#pragma once
+// Accuracy of estimated camera poses against ground truth, for the SfM tests and benchmarks:
+// a 7-DoF similarity aligns the estimated camera centres to the true ones, then each camera gets
+// a centre error (ground-truth units) and a rotation error (degrees). Test support only.
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/base/status.h"
+#include "tests/support/ground_truth.h"
+
+namespace reconar::testing {
+
+// to = scale * rotation * from + translation.
+struct Similarity3 {
+  double scale = 1.0;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d Apply(const Eigen::Vector3d& from) const { return scale * rotation * from + translation; }
+};
+
+// Least-squares similarity with to_i ~ Apply(from_i) (Umeyama, "Least-squares estimation of
+// transformation parameters between two point patterns", PAMI 1991). Needs at least 3 pairs and
+// a `from` set that is not a single point.
+Result<Similarity3> AlignSimilarity(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to);
+
+// A camera's orientation and position: X_cam = cam_from_world_rotation * (X_world - centre).
+struct CameraPose {
+  Eigen::Matrix3d cam_from_world_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+};
+
+CameraPose PoseOf(const GroundTruthCamera& camera);
+
+struct CameraPoseErrors {
+  Similarity3 gt_from_estimate;
+  std::vector<double> centre_errors;        // per camera, ground-truth units
+  std::vector<double> rotation_errors_deg;  // per camera
+  double centre_mean = 0.0;
+  double centre_median = 0.0;
+  double centre_max = 0.0;
+  double rotation_mean_deg = 0.0;
+  double rotation_median_deg = 0.0;
+  double rotation_max_deg = 0.0;
+  // Alignment-free: mean over camera pairs of the angle between estimated and true i_from_j.
+  double relative_rotation_mean_deg = 0.0;
+};
+
+// Aligns estimated[i] to ground_truth[i] by their centres, then measures each camera.
+Result<CameraPoseErrors> CameraCenterErrors(const std::vector<CameraPose>& estimated,
+                                            const std::vector<CameraPose>& ground_truth);
+
+// Ground truth by image name ("0000.jpg", "templeR0001.png").
+using GroundTruthByName = std::map<std::string, GroundTruthCamera>;
+
+// Every NAME.camera in `dir` (Strecha gt_cameras/), keyed by NAME.
+Result<GroundTruthByName> ReadStrechaGroundTruth(const std::string& dir);
+
+// Middlebury "*_par.txt": a count, then "name k11..k33 r11..r33 t1 t2 t3" per image, with
+// x ~ K [R | t] X. The file has no image size: width and height stay 0.
+Result<GroundTruthByName> ReadMiddleburyPar(const std::string& path);
+
+}  // namespace reconar::testing

@@ -1,0 +1,148 @@
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "core/optim/bal_problem.h"
+#include "core/optim/bundle_adjuster.h"
+#include "tools/commands.h"
+
+namespace reconar::tools {
+
+namespace {
+
+constexpr char kHelp[] =
+    "usage: reconar bundle-adjust --bal FILE [options]\n"
+    "\n"
+    "Reads a 'Bundle Adjustment in the Large' problem (cameras: angle-axis, translation, f, k1, k2)\n"
+    "and minimises 1/2 sum rho(|reprojection error|^2) with Levenberg-Marquardt over the Schur\n"
+    "complement of the points.\n"
+    "  --bal FILE            the BAL problem (text)\n"
+    "  --solver S            reduced camera system: dense, sparse or auto (default auto: dense up to\n"
+    "                        200 cameras, sparse beyond)\n"
+    "  --loss L              trivial, huber or cauchy (default trivial)\n"
+    "  --loss-scale S        robust loss scale in pixels (default 1)\n"
+    "  --max-iterations N    LM iterations, accepted and rejected (default 100)\n"
+    "  --threads N           worker threads (default: one per core)\n"
+    "  --json                print one JSON object: file, cameras, points, observations,\n"
+    "                        initial_cost, final_cost, iterations, seconds, termination\n"
+    "exit codes: 0 ok (also when stopped by --max-iterations), 1 numeric failure, 2 bad usage or input\n";
+
+constexpr int kMaxDenseCameras = 200;  // --solver auto
+
+Result<BundleAdjustmentOptions::LinearSolver> SolverFromArgs(const Args& args, int num_cameras) {
+  using LinearSolver = BundleAdjustmentOptions::LinearSolver;
+  const std::string name = args.Get("solver", "auto");
+  if (name == "dense") return LinearSolver::kDenseCholesky;
+  if (name == "sparse") return LinearSolver::kSparseCholesky;
+  if (name == "auto") {
+    return num_cameras <= kMaxDenseCameras ? LinearSolver::kDenseCholesky : LinearSolver::kSparseCholesky;
+  }
+  return InvalidArgument("--solver expects dense, sparse or auto, got '" + name + "'");
+}
+
+Result<RobustLoss> LossFromArgs(const Args& args) {
+  RobustLoss loss;
+  const std::string name = args.Get("loss", "trivial");
+  if (name == "trivial") {
+    loss.type = LossType::kTrivial;
+  } else if (name == "huber") {
+    loss.type = LossType::kHuber;
+  } else if (name == "cauchy") {
+    loss.type = LossType::kCauchy;
+  } else {
+    return InvalidArgument("--loss expects trivial, huber or cauchy, got '" + name + "'");
+  }
+  RECONAR_ASSIGN_OR_RETURN(loss.scale, args.GetDouble("loss-scale", 1.0, 1e-12, 1e12));
+  return loss;
+}
+
+std::string JsonString(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+// Shortest text that reads back as the same double; null for NaN/Inf (not JSON numbers).
+std::string JsonNumber(double value) {
+  if (!std::isfinite(value)) return "null";
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.17g", value);
+  return text;
+}
+
+void PrintJson(const std::string& path, const BalProblem& problem, const BundleAdjustmentSummary& s) {
+  std::printf(
+      "{\"file\": %s, \"cameras\": %d, \"points\": %d, \"observations\": %zu, \"initial_cost\": %s, "
+      "\"final_cost\": %s, \"iterations\": %d, \"seconds\": %.6f, \"termination\": %s}\n",
+      JsonString(path).c_str(), problem.num_cameras(), problem.num_points(), problem.observations.size(),
+      JsonNumber(s.initial_cost).c_str(), JsonNumber(s.final_cost).c_str(), s.iterations, s.seconds,
+      JsonString(TerminationName(s.termination)).c_str());
+}
+
+void PrintSummary(const std::string& path, const BalProblem& problem, const BundleAdjustmentOptions& options,
+                  const BundleAdjustmentSummary& s) {
+  const bool dense = options.linear_solver == BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
+  std::printf("%s: %d cameras, %d points, %zu observations\n", path.c_str(), problem.num_cameras(),
+              problem.num_points(), problem.observations.size());
+  std::printf("cost (1/2 sum of squared residuals): %.2f -> %.2f in %d iterations (%d accepted), %.2f s, %s solver\n",
+              s.initial_cost, s.final_cost, s.iterations, s.accepted_steps, s.seconds, dense ? "dense" : "sparse");
+  std::printf("termination: %s\n", TerminationName(s.termination));
+}
+
+}  // namespace
+
+int RunBundleAdjust(int argc, char** argv, int first) {
+  Args args({"bal", "solver", "loss", "loss-scale", "max-iterations", "threads"}, {"json"});
+  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
+  if (args.Has("help")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  if (!args.Has("bal") || !args.positionals().empty()) {
+    std::fputs(kHelp, stderr);
+    return 2;
+  }
+  BundleAdjustmentOptions options;
+  auto loss = LossFromArgs(args);
+  if (!loss.ok()) return Fail(loss.status());
+  options.loss = *loss;
+  auto max_iterations = args.GetInt("max-iterations", options.max_iterations, 1, 1000000);
+  if (!max_iterations.ok()) return Fail(max_iterations.status());
+  options.max_iterations = *max_iterations;
+  auto threads = args.GetInt("threads", 0, 0, 1024);
+  if (!threads.ok()) return Fail(threads.status());
+  options.num_threads = *threads;
+  // Check the solver name before the (possibly long) read; `auto` is resolved after it.
+  if (auto solver = SolverFromArgs(args, 0); !solver.ok()) return Fail(solver.status());
+
+  const std::string path = args.Get("bal");
+  auto problem = ReadBalProblem(path);
+  if (!problem.ok()) return Fail(problem.status());
+  auto solver = SolverFromArgs(args, problem->num_cameras());
+  if (!solver.ok()) return Fail(solver.status());
+  options.linear_solver = *solver;
+
+  auto summary = SolveBundleAdjustment(options, {}, &*problem);
+  if (!summary.ok()) return Fail(summary.status());
+  if (args.Has("json")) {
+    PrintJson(path, *problem, *summary);
+  } else {
+    PrintSummary(path, *problem, options, *summary);
+  }
+  const bool failed = summary->termination == BundleAdjustmentSummary::Termination::kNumericFailure;
+  if (failed) std::fprintf(stderr, "reconar: error: %s: bundle adjustment failed numerically\n", path.c_str());
+  return failed ? 1 : 0;
+}
+
+}  // namespace reconar::tools

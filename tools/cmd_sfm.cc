@@ -1,0 +1,203 @@
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/base/atomic_file.h"
+#include "core/base/json_writer.h"
+#include "core/pipeline/feature_stage.h"
+#include "core/pipeline/match_stage.h"
+#include "core/pipeline/sfm_stage.h"
+#include "tools/commands.h"
+
+namespace reconar::tools {
+namespace {
+
+constexpr char kHelp[] =
+    "usage: reconar sfm IMAGES_DIR|IMAGE... PROJECT_DIR [options]\n"
+    "\n"
+    "Structure from motion: SIFT features, kd-forest matching with two-view verification, then\n"
+    "incremental mapping with bundle adjustment (focal, k1, k2 per image; principal point in the\n"
+    "final adjustment when the data supports it). Writes into PROJECT_DIR:\n"
+    "  features/ matches/                      the earlier stages (reused when up to date)\n"
+    "  sparse/cameras.txt images.txt points3D.txt   COLMAP text model\n"
+    "  sparse/bundle.out list.txt              Bundler v0.3\n"
+    "  sparse/points.ply                       coloured sparse points\n"
+    "  report.json                             counts, focal statistics, timings per stage\n"
+    "Re-running reuses every finished stage; --force redoes all of them.\n"
+    "  --principal-point fixed|auto|refine   (default auto)\n"
+    "  --fixed-distortion    keep k1 = k2 = 0 (for photos that are already undistorted)\n"
+    "  --max-error PX        reprojection error bound for triangulation and filtering (default 4)\n"
+    "  --ratio R             Lowe ratio (default 0.8 here)\n"
+    "  --min-inliers N       inliers a pair needs (default 30 here)\n"
+    "  --threads N           worker threads (default: one per core)\n"
+    "  --force               recompute every stage\n"
+    "  plus the options of `reconar features` and `reconar match`\n";
+
+bool Exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+// Features are up to date when the image list names exactly these files and every feature file
+// is present.
+bool FeaturesUpToDate(const Project& project, const std::vector<std::string>& paths) {
+  auto list = project.ReadImageList();
+  if (!list.ok() || list->size() != paths.size()) return false;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    if ((*list)[i].path != paths[i] || !Exists(project.FeaturePath((*list)[i].name))) return false;
+  }
+  return true;
+}
+
+struct StageTiming {
+  std::string name;
+  bool reused = false;
+  double seconds = 0.0;
+};
+
+std::string ReportJson(const SfmStageReport& sfm, const std::vector<StageTiming>& stages) {
+  const MapperReport& m = sfm.mapper;
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("images").Int(m.num_images);
+  json.Key("registered").Int(m.num_registered);
+  json.Key("points").Int(m.num_points);
+  json.Key("mean_track_length").Double(m.mean_track_length);
+  json.Key("mean_reprojection_error_px").Double(m.mean_reprojection_error_px);
+  json.Key("mean_focal_ratio").Double(sfm.mean_focal_ratio);
+  json.Key("rmse_focal_ratio").Double(sfm.rmse_focal_ratio);
+  json.Key("focal_35mm_equivalent_mm").Double(sfm.focal_35mm_equivalent);
+  json.Key("initial_pair").String(m.initial_pair);
+  json.Key("principal_point_refined").Bool(m.principal_point_refined);
+  json.Key("distortion_refined").Bool(m.distortion_refined);
+  json.Key("aspect_refined").Bool(m.aspect_refined);
+  json.Key("tracks").Int(m.num_tracks);
+  json.Key("inconsistent_tracks_dropped").Int(m.num_inconsistent_tracks);
+  json.Key("unregistered").BeginArray();
+  for (const MapperReport::Unregistered& u : m.unregistered) {
+    json.BeginObject().Key("image").String(u.name).Key("reason").String(u.reason).EndObject();
+  }
+  json.EndArray();
+  json.Key("stages").BeginObject();
+  for (const StageTiming& stage : stages) {
+    json.Key(stage.name).BeginObject().Key("reused").Bool(stage.reused).Key("seconds").Double(stage.seconds);
+    if (stage.name == "mapping") {
+      json.Key("seconds_bundle_adjustment").Double(m.seconds_ba);
+      json.Key("local_bundle_adjustments").Int(m.num_local_ba);
+      json.Key("global_bundle_adjustments").Int(m.num_global_ba);
+    }
+    json.EndObject();
+  }
+  json.EndObject();
+  json.EndObject();
+  return json.str() + "\n";
+}
+
+}  // namespace
+
+int RunSfm(int argc, char** argv, int first) {
+  std::set<std::string> valued = kSiftValuedOptions;
+  valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
+  valued.insert({"principal-point", "max-error"});
+  Args args(valued, {"force", "fixed-distortion"});
+  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
+  if (args.Has("help")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  if (args.positionals().size() < 2) {
+    std::fputs(kHelp, stderr);
+    return 2;
+  }
+  std::vector<std::string> inputs = args.positionals();
+  const Project project(inputs.back());
+  inputs.pop_back();
+
+  FeatureStageOptions feature_options;
+  auto sift = SiftOptionsFromArgs(args);
+  if (!sift.ok()) return Fail(sift.status());
+  feature_options.sift = *sift;
+  auto match_options = MatchOptionsFromArgs(args);
+  if (!match_options.ok()) return Fail(match_options.status());
+  feature_options.num_threads = match_options->num_threads;
+  // Lowe's 0.8 (his paper's recommendation, and COLMAP's) rather than the stricter 0.6 of
+  // `reconar match`: mapping wants the extra matches, and RANSAC plus track triangulation
+  // remove the extra outliers.
+  if (!args.Has("ratio")) match_options->match.max_ratio = 0.8;
+  // Wide-baseline pairs with few matches still tie tracks together (COLMAP keeps pairs from 15).
+  if (!args.Has("min-inliers")) match_options->two_view.min_inliers = 30;
+
+  SfmStageOptions sfm_options;
+  sfm_options.mapper.num_threads = match_options->num_threads;
+  const std::string pp = args.Get("principal-point", "auto");
+  if (pp == "fixed") {
+    sfm_options.mapper.principal_point = MapperOptions::PrincipalPoint::kFixed;
+  } else if (pp == "refine") {
+    sfm_options.mapper.principal_point = MapperOptions::PrincipalPoint::kRefine;
+  } else if (pp != "auto") {
+    return Fail(InvalidArgument("--principal-point must be fixed, auto or refine, got '" + pp + "'"));
+  }
+  sfm_options.mapper.refine_distortion = !args.Has("fixed-distortion");
+  auto max_error = args.GetDouble("max-error", sfm_options.mapper.max_reprojection_error_px, 0.1, 100.0);
+  if (!max_error.ok()) return Fail(max_error.status());
+  sfm_options.mapper.max_reprojection_error_px = *max_error;
+  sfm_options.mapper.registration_max_error_px = *max_error;
+
+  auto paths = CollectImagePaths(inputs);
+  if (!paths.ok()) return Fail(paths.status());
+  if (Status s = CreateDirectories(project.root()); !s.ok()) return Fail(s);
+  const bool force = args.Has("force");
+  std::vector<StageTiming> stages;
+
+  bool redo = force || !FeaturesUpToDate(project, *paths);
+  if (redo) {
+    auto features = RunFeatureStage(*paths, &project, feature_options);
+    if (!features.ok()) return Fail(features.status());
+    for (const std::string& skipped : features->skipped) std::fprintf(stderr, "warning: skipped %s\n", skipped.c_str());
+    std::printf("features: %zu images, %zu skipped, %.1fs\n", features->extracted.size(), features->skipped.size(),
+                features->seconds);
+    stages.push_back({"features", false, features->seconds});
+  } else {
+    std::printf("features: up to date, reused\n");
+    stages.push_back({"features", true, 0.0});
+  }
+
+  redo = redo || !Exists(project.MatchesPath());
+  if (redo) {
+    auto matches = RunMatchStage(project, *match_options);
+    if (!matches.ok()) return Fail(matches.status());
+    std::printf("matching: %d pairs: %d verified, %d planar or rotation-only; %.1fs\n", matches->num_pairs,
+                matches->num_verified, matches->num_planar, matches->seconds);
+    stages.push_back({"matching", false, matches->seconds});
+  } else {
+    std::printf("matching: up to date, reused\n");
+    stages.push_back({"matching", true, 0.0});
+  }
+
+  redo = redo || !Exists(project.SparseDir() + "/points3D.txt") || !Exists(project.ReportPath());
+  if (!redo) {
+    std::printf("mapping: up to date, reused (%s); --force recomputes\n", project.ReportPath().c_str());
+    return 0;
+  }
+  auto sfm = RunSfmStage(project, sfm_options);
+  if (!sfm.ok()) return Fail(sfm.status());
+  const MapperReport& m = sfm->mapper;
+  stages.push_back({"mapping", false,
+                    sfm->seconds_load + sfm->seconds_mapping + sfm->seconds_colour + sfm->seconds_write});
+  std::printf("mapping: %d of %d images registered, %d points, mean track length %.2f, reprojection error %.3f px; "
+              "%.1fs (bundle adjustment %.1fs)\n",
+              m.num_registered, m.num_images, m.num_points, m.mean_track_length, m.mean_reprojection_error_px,
+              sfm->seconds_mapping, m.seconds_ba);
+  std::printf("focal ratio (focal / long side): mean %.4f, rmse %.4f (35 mm equivalent %.1f mm)\n",
+              sfm->mean_focal_ratio, sfm->rmse_focal_ratio, sfm->focal_35mm_equivalent);
+  for (const MapperReport::Unregistered& u : m.unregistered) {
+    std::fprintf(stderr, "warning: %s not registered: %s\n", u.name.c_str(), u.reason.c_str());
+  }
+  if (Status s = WriteFileAtomically(project.ReportPath(), ReportJson(*sfm, stages)); !s.ok()) return Fail(s);
+  std::printf("written to %s and %s\n", project.SparseDir().c_str(), project.ReportPath().c_str());
+  return 0;
+}
+
+}  // namespace reconar::tools
