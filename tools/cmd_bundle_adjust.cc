@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/base/json_writer.h"
 #include "core/optim/bal_problem.h"
 #include "core/optim/bundle_adjuster.h"
 #include "tools/commands.h"
@@ -56,38 +57,20 @@ Result<RobustLoss> LossFromArgs(const Args& args) {
   return loss;
 }
 
-std::string JsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
-// Shortest text that reads back as the same double; null for NaN/Inf (not JSON numbers).
-std::string JsonNumber(double value) {
-  if (!std::isfinite(value)) return "null";
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.17g", value);
-  return text;
-}
-
 void PrintJson(const std::string& path, const BalProblem& problem, const BundleAdjustmentSummary& s) {
-  std::printf(
-      "{\"file\": %s, \"cameras\": %d, \"points\": %d, \"observations\": %zu, \"initial_cost\": %s, "
-      "\"final_cost\": %s, \"iterations\": %d, \"seconds\": %.6f, \"termination\": %s}\n",
-      JsonString(path).c_str(), problem.num_cameras(), problem.num_points(), problem.observations.size(),
-      JsonNumber(s.initial_cost).c_str(), JsonNumber(s.final_cost).c_str(), s.iterations, s.seconds,
-      JsonString(TerminationName(s.termination)).c_str());
+  JsonWriter json;
+  json.BeginObject()
+      .Key("file").String(path)
+      .Key("cameras").Int(problem.num_cameras())
+      .Key("points").Int(problem.num_points())
+      .Key("observations").Int(static_cast<long long>(problem.observations.size()))
+      .Key("initial_cost").Double(s.initial_cost)
+      .Key("final_cost").Double(s.final_cost)
+      .Key("iterations").Int(s.iterations)
+      .Key("seconds").Double(s.seconds)
+      .Key("termination").String(TerminationName(s.termination))
+      .EndObject();
+  std::printf("%s\n", json.str().c_str());
 }
 
 void PrintSummary(const std::string& path, const BalProblem& problem, const BundleAdjustmentOptions& options,

@@ -1,6 +1,9 @@
 #include <sys/stat.h>
 
 #include <cstdio>
+#include <initializer_list>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,7 +28,8 @@ constexpr char kHelp[] =
     "  sparse/bundle.out list.txt              Bundler v0.3\n"
     "  sparse/points.ply                       coloured sparse points\n"
     "  report.json                             counts, focal statistics, timings per stage\n"
-    "Re-running reuses every finished stage; --force redoes all of them.\n"
+    "Re-running reuses every stage finished with the same settings (PROJECT_DIR/stages.txt);\n"
+    "--force redoes all of them.\n"
     "  --principal-point fixed|auto|refine   (default auto)\n"
     "  --fixed-distortion    keep k1 = k2 = 0 (for photos that are already undistorted)\n"
     "  --max-error PX        reprojection error bound for triangulation and filtering (default 4)\n"
@@ -49,6 +53,48 @@ bool FeaturesUpToDate(const Project& project, const std::vector<std::string>& pa
     if ((*list)[i].path != paths[i] || !Exists(project.FeaturePath((*list)[i].name))) return false;
   }
   return true;
+}
+
+// PROJECT/stages.txt: one "STAGE SETTINGS" line per finished stage, so that a re-run reuses a
+// stage only when it was made with the same settings.
+std::string StagesPath(const Project& project) { return project.root() + "/stages.txt"; }
+
+std::map<std::string, std::string> ReadStages(const Project& project) {
+  std::map<std::string, std::string> stages;
+  auto text = ReadFileToString(StagesPath(project));
+  if (!text.ok()) return stages;
+  std::istringstream in(*text);
+  std::string line;
+  while (std::getline(in, line)) {
+    const size_t space = line.find(' ');
+    if (space != std::string::npos) stages[line.substr(0, space)] = line.substr(space + 1);
+  }
+  return stages;
+}
+
+Status RecordStage(const Project& project, const std::string& stage, const std::string& settings) {
+  std::map<std::string, std::string> stages = ReadStages(project);
+  stages[stage] = settings;
+  // A redone stage invalidates the ones after it.
+  const std::vector<std::string> order = {"features", "matching", "mapping"};
+  bool after = false;
+  for (const std::string& name : order) {
+    if (after) stages.erase(name);
+    after |= name == stage;
+  }
+  std::string text;
+  for (const auto& [name, value] : stages) text += name + " " + value + "\n";
+  return WriteFileAtomically(StagesPath(project), text);
+}
+
+std::string Settings(std::initializer_list<std::pair<const char*, double>> values) {
+  std::string text;
+  char buffer[64];
+  for (const auto& [name, value] : values) {
+    std::snprintf(buffer, sizeof(buffer), "%s%s=%.12g", text.empty() ? "" : " ", name, value);
+    text += buffer;
+  }
+  return text;
 }
 
 struct StageTiming {
@@ -151,7 +197,27 @@ int RunSfm(int argc, char** argv, int first) {
   const bool force = args.Has("force");
   std::vector<StageTiming> stages;
 
-  bool redo = force || !FeaturesUpToDate(project, *paths);
+
+  const std::map<std::string, std::string> done = ReadStages(project);
+  const auto finished = [&](const std::string& stage, const std::string& settings) {
+    const auto it = done.find(stage);
+    return !force && it != done.end() && it->second == settings;
+  };
+  const SiftOptions& sift_used = feature_options.sift;
+  const std::string feature_settings =
+      Settings({{"first_octave", sift_used.first_octave}, {"max_features", sift_used.max_features},
+                {"contrast_threshold", sift_used.contrast_threshold}});
+  const std::string match_settings =
+      Settings({{"ratio", match_options->match.max_ratio}, {"checks", match_options->match.max_leaf_checks},
+                {"min_inliers", match_options->two_view.min_inliers},
+                {"f_threshold", match_options->two_view.f_threshold_fraction}});
+  const MapperOptions& mapper = sfm_options.mapper;
+  const std::string mapping_settings =
+      Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
+                {"max_error", mapper.max_reprojection_error_px},
+                {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0}});
+
+  bool redo = !finished("features", feature_settings) || !FeaturesUpToDate(project, *paths);
   if (redo) {
     auto features = RunFeatureStage(*paths, &project, feature_options);
     if (!features.ok()) return Fail(features.status());
@@ -159,24 +225,27 @@ int RunSfm(int argc, char** argv, int first) {
     std::printf("features: %zu images, %zu skipped, %.1fs\n", features->extracted.size(), features->skipped.size(),
                 features->seconds);
     stages.push_back({"features", false, features->seconds});
+    if (Status s = RecordStage(project, "features", feature_settings); !s.ok()) return Fail(s);
   } else {
     std::printf("features: up to date, reused\n");
     stages.push_back({"features", true, 0.0});
   }
 
-  redo = redo || !Exists(project.MatchesPath());
+  redo = redo || !finished("matching", match_settings) || !Exists(project.MatchesPath());
   if (redo) {
     auto matches = RunMatchStage(project, *match_options);
     if (!matches.ok()) return Fail(matches.status());
     std::printf("matching: %d pairs: %d verified, %d planar or rotation-only; %.1fs\n", matches->num_pairs,
                 matches->num_verified, matches->num_planar, matches->seconds);
     stages.push_back({"matching", false, matches->seconds});
+    if (Status s = RecordStage(project, "matching", match_settings); !s.ok()) return Fail(s);
   } else {
     std::printf("matching: up to date, reused\n");
     stages.push_back({"matching", true, 0.0});
   }
 
-  redo = redo || !Exists(project.SparseDir() + "/points3D.txt") || !Exists(project.ReportPath());
+  redo = redo || !finished("mapping", mapping_settings) || !Exists(project.SparseDir() + "/points3D.txt") ||
+         !Exists(project.ReportPath());
   if (!redo) {
     std::printf("mapping: up to date, reused (%s); --force recomputes\n", project.ReportPath().c_str());
     return 0;
@@ -196,6 +265,7 @@ int RunSfm(int argc, char** argv, int first) {
     std::fprintf(stderr, "warning: %s not registered: %s\n", u.name.c_str(), u.reason.c_str());
   }
   if (Status s = WriteFileAtomically(project.ReportPath(), ReportJson(*sfm, stages)); !s.ok()) return Fail(s);
+  if (Status s = RecordStage(project, "mapping", mapping_settings); !s.ok()) return Fail(s);
   std::printf("written to %s and %s\n", project.SparseDir().c_str(), project.ReportPath().c_str());
   return 0;
 }

@@ -17,6 +17,7 @@
 
 #include "core/base/thread_pool.h"
 #include "core/optim/bal_camera_model.h"
+#include "core/optim/cholmod_ldlt.h"
 #include "core/optim/radial_camera_model.h"
 
 namespace reconar {
@@ -375,9 +376,14 @@ class Solver {
       }
     });
     if (sparse_) {
-      ldlt_.FactorizeInPlace(s_sparse_);  // reads the upper triangle only
-      if (ldlt_.info() != Eigen::Success) return false;
-      solution_ = ldlt_.solve(rhs_);
+      if (use_cholmod_) {
+        if (!cholmod_.Factorize(s_sparse_.valuePtr())) return false;
+        cholmod_.Solve(rhs_.data(), solution_.data());
+      } else {
+        ldlt_.FactorizeInPlace(s_sparse_);  // reads the upper triangle only
+        if (ldlt_.info() != Eigen::Success) return false;
+        solution_ = ldlt_.solve(rhs_);
+      }
     } else if (!reduced_index_.empty()) {
       if (!SolveShared()) return false;
     } else {
@@ -622,7 +628,11 @@ class Solver {
         }
       }
       s_sparse_.makeCompressed();
-      ldlt_.analyzePattern(s_sparse_);
+      // CHOLMOD's supernodal factorisation when built with it; Eigen's simplicial LDL^T otherwise
+      // (or if CHOLMOD refuses the pattern).
+      use_cholmod_ = SparseCholesky::IsAvailable() &&
+                     cholmod_.Analyze(n, s_sparse_.outerIndexPtr(), s_sparse_.innerIndexPtr()).ok();
+      if (!use_cholmod_) ldlt_.analyzePattern(s_sparse_);
     } else {
       s_dense_.resize(n, n);
       // Constructed in place: Eigen's LLT leaves its status member unset until compute(), so
@@ -666,6 +676,8 @@ class Solver {
   std::optional<Eigen::LLT<Eigen::MatrixXd, Eigen::Upper>> dense_llt_;
   Eigen::SparseMatrix<double> s_sparse_;
   InPlaceLdlt ldlt_;
+  SparseCholesky cholmod_;
+  bool use_cholmod_ = false;
   Eigen::VectorXd rhs_, step_c_, solution_;
   std::vector<double> cand_cameras_, cand_points_;
   double cost_ = 0.0;

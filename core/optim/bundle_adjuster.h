@@ -39,7 +39,8 @@ struct BundleAdjustmentOptions {
   enum class LinearSolver {
     kDenseCholesky,   // Eigen LLT on dense S: best for up to a few hundred cameras
     kSparseCholesky,  // block-sparse S (camera pairs sharing a point), AMD camera ordering,
-                      // Eigen SimplicialLDLT: for larger problems with sparse camera graphs
+                      // CHOLMOD supernodal Cholesky (Eigen SimplicialLDLT when built without
+                      // CHOLMOD): for larger problems with sparse camera graphs
   };
   LinearSolver linear_solver = LinearSolver::kDenseCholesky;
   int num_threads = 1;  // <= 0: one per core
