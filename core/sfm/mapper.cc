@@ -278,11 +278,16 @@ class Mapper {
                      [](const auto& x, const auto& y) { return x.first > y.first; });
     for (const auto& [visible, image] : candidates) {
       tried_with_[static_cast<size_t>(image)] = visible;
+      needs_global_adjustment_ = false;
       if (RegisterImage(image)) {
         TriangulateImage(image);
-        std::vector<int> local = LocalBundle(image);
-        BundleAdjust(local, opt_.local_ba_iterations, /*refine_principal_point=*/false);
-        FilterPoints(PointsSeenBy(local));
+        if (needs_global_adjustment_) {
+          GlobalRefinement(opt_.global_ba_iterations, /*refine_principal_point=*/false);
+        } else {
+          std::vector<int> local = LocalBundle(image);
+          BundleAdjust(local, opt_.local_ba_iterations, /*refine_principal_point=*/false);
+          FilterPoints(PointsSeenBy(local));
+        }
         return true;
       }
     }
@@ -343,14 +348,18 @@ class Mapper {
     pose_camera.cy = camera.cy;
     pose_camera.k1 = camera.k1;
     pose_camera.k2 = camera.k2;
-    AbsolutePoseOptions options;
-    options.max_error_px = opt_.registration_max_error_px;
-    options.min_inliers = opt_.registration_min_inliers;
+    // Until three images confirm a camera's focal, the model is shaped by a prior the data has not
+    // checked: register with the focal free, under a looser bound, falling back to the DLT for an
+    // unknown focal; a global adjustment with the focal free follows (RegisterNextImage).
     const int camera_id = img.camera_id;
-    const bool camera_in_use = CameraUsers(camera_id) > 0;
-    options.refine_focal = opt_.refine_focal && !camera_in_use && !images_[static_cast<size_t>(image)].focal_from_exif;
+    const bool exif = images_[static_cast<size_t>(image)].focal_from_exif;
+    const bool focal_confirmed = CameraUsers(camera_id) >= 3 || !opt_.refine_focal;
+    AbsolutePoseOptions options;
+    options.max_error_px = opt_.registration_max_error_px * (focal_confirmed ? 1.0 : 2.0);
+    options.min_inliers = opt_.registration_min_inliers;
+    options.refine_focal = !focal_confirmed;
     auto result = EstimateAbsolutePose(pixels, world, pose_camera, options);
-    if (result.ok() && !result->success() && !camera_in_use && !images_[static_cast<size_t>(image)].focal_from_exif) {
+    if (result.ok() && !result->success() && !focal_confirmed) {
       result = EstimateAbsolutePoseUnknownFocal(pixels, world, pose_camera, options);
     }
     if (!result.ok() || !result->success()) {
@@ -359,16 +368,16 @@ class Mapper {
           (result.ok() ? result->reason : result.status().message());
       return false;
     }
-    // Paper eq. 5: an EXIF focal far from what the data says is not trusted.
-    double focal = result->focal > 0.0 ? result->focal : camera.focal;
-    const double ratio = focal / images_[static_cast<size_t>(image)].focal_prior;
-    if (images_[static_cast<size_t>(image)].focal_from_exif &&
-        (ratio >= opt_.focal_prior_min_ratio && ratio <= opt_.focal_prior_max_ratio)) {
-      focal = images_[static_cast<size_t>(image)].focal_prior;
-    }
-    if (!camera_in_use) {
+    if (!focal_confirmed && result->focal > 0.0) {
+      // Paper eq. 5: the EXIF focal is kept when it lies within 0.7-1.4 of the data's estimate.
+      double focal = result->focal;
+      const double prior = images_[static_cast<size_t>(image)].focal_prior;
+      if (exif && prior > opt_.focal_prior_min_ratio * focal && prior < opt_.focal_prior_max_ratio * focal) {
+        focal = prior;
+      }
       camera.focal = focal;
       rec_.cameras[static_cast<size_t>(camera_id)] = camera;
+      needs_global_adjustment_ = true;
     }
     img.pose.cam_from_world_rotation = result->cam_from_world_rotation;
     img.pose.cam_from_world_translation = result->cam_from_world_translation;
@@ -889,6 +898,7 @@ class Mapper {
   std::vector<double> camera_prior_;  // per camera: focal prior
   double function_tolerance_ = 1e-6;  // of the bundle adjustments; tighter for the final one
   bool distortion_free_ = true;       // k1, k2 refined (from three registered images on)
+  bool needs_global_adjustment_ = false;  // the last registration changed a camera's focal
   std::vector<bool> camera_from_exif_;
 };
 

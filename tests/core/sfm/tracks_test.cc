@@ -30,7 +30,9 @@ void ExpectConsistent(const std::vector<int>& num_keypoints, const TrackSet& set
     const std::vector<TrackElement>& track = set.tracks[t];
     EXPECT_GE(track.size(), 2u) << "track " << t;
     for (size_t e = 0; e < track.size(); ++e) {
-      if (e > 0) EXPECT_LT(track[e - 1].image_id, track[e].image_id) << "track " << t << " not sorted / repeated";
+      if (e > 0) {
+        EXPECT_LT(track[e - 1].image_id, track[e].image_id) << "track " << t << " not sorted / repeated";
+      }
       ASSERT_GE(track[e].image_id, 0);
       ASSERT_LT(track[e].image_id, static_cast<int>(num_keypoints.size()));
       ASSERT_GE(track[e].keypoint_id, 0);
