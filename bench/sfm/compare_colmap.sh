@@ -111,12 +111,25 @@ run_colmap() {
   timed colmap_mapper "$colmap" mapper \
     --database_path "$project/database.db" --image_path "$images" \
     --output_path "$project/sparse" --Mapper.num_threads "$threads" || return 1
-  # The mapper may split the scene into several models; keep the one with the most images.
-  local best
-  best=$(ls -S "$project"/sparse/*/images.bin 2>/dev/null | head -n 1)
+  # The mapper may split the scene into several models; keep the one with the most registered
+  # images (the size of images.bin is no proxy for that: it holds every keypoint of every image).
+  local model best="" best_count=-1 count
+  : >"$work/colmap_convert.log"
+  for model in "$project"/sparse/*/; do
+    [[ -f $model/images.bin ]] || continue
+    rm -rf "$project/text.tmp" && mkdir -p "$project/text.tmp"
+    "$colmap" model_converter --input_path "$model" \
+      --output_path "$project/text.tmp" --output_type TXT >>"$work/colmap_convert.log" 2>&1 || return 1
+    # images.txt: comment lines, then two lines per registered image.
+    count=$(awk '!/^#/ { n++ } END { print int(n / 2) }' "$project/text.tmp/images.txt")
+    echo "colmap model $model: $count registered images" >&2
+    if ((count > best_count)); then
+      best=$model best_count=$count
+      rm -rf "$project/text" && mv "$project/text.tmp" "$project/text"
+    fi
+  done
+  rm -rf "$project/text.tmp"
   [[ -n $best ]] || { echo "colmap produced no model" >&2; return 1; }
-  "$colmap" model_converter --input_path "$(dirname "$best")" \
-    --output_path "$project/text" --output_type TXT >"$work/colmap_convert.log" 2>&1 || return 1
   wall_seconds "$work"/colmap_{features,matching,mapper}.time >"$work/colmap.wall"
   cpu_seconds "$work"/colmap_{features,matching,mapper}.time >"$work/colmap.cpu"
   peak_rss_mib "$work"/colmap_{features,matching,mapper}.time >"$work/colmap.rss"
@@ -139,10 +152,28 @@ status=0
 if [[ $only != reconar ]]; then run_colmap || status=1; fi
 if [[ $only != colmap ]]; then run_reconar || status=1; fi
 
+# stage_seconds TOOL STAGE: wall seconds of one stage (features, matching, mapping), "-" when
+# missing. COLMAP: its own process per stage (/usr/bin/time); reconar: report.json "stages"
+# (in-process timers, so they exclude start-up and do not add up to the process wall time).
+stage_seconds() {
+  local tool=$1 stage=$2
+  if [[ $tool == colmap ]]; then
+    [[ $stage == mapping ]] && stage=mapper
+    if [[ -s $work/colmap_$stage.time ]]; then wall_seconds "$work/colmap_$stage.time"; else echo -; fi
+  elif [[ -s $work/reconar/report.json ]]; then
+    awk -v stage="\"$stage\":" '$1 == stage { inside = 1 }
+      inside && $1 == "\"seconds\":" { v = $2; sub(/,$/, "", v); printf "%.1f", v; found = 1; exit }
+      END { if (!found) print "-" }' "$work/reconar/report.json"
+  else
+    echo -
+  fi
+}
+
 # value TOOL ROW: one cell of the table, "-" when that run is missing.
 value() {
   local tool=$1 row=$2
   case "$row" in
+    stage_*) stage_seconds "$tool" "${row#stage_}" ;;
     wall) cat "$work/$tool.wall" 2>/dev/null || echo - ;;
     cpu) cat "$work/$tool.cpu" 2>/dev/null || echo - ;;
     rss) cat "$work/$tool.rss" 2>/dev/null || echo - ;;
@@ -158,7 +189,8 @@ if [[ $unit == - ]]; then unit=$(value reconar centre_error_unit); fi
 echo
 echo "dataset: $dataset   (work: $work)"
 printf '%-28s %14s %14s %10s\n' "" reconar colmap reconar/colmap
-rows=(wall:"wall time (s)" cpu:"CPU time, user+sys (s)" rss:"peak RSS (MiB)"
+rows=(stage_features:"features wall (s)" stage_matching:"matching wall (s)"
+  stage_mapping:"mapping wall (s)" wall:"wall time, total (s)" cpu:"CPU time, user+sys (s)" rss:"peak RSS (MiB)"
   registered:"registered images" total:"images"
   num_points:"3D points" mean_track_length:"mean track length"
   centre_error_mean:"centre error mean (${unit//\"/})" centre_error_median:"centre error median"

@@ -14,6 +14,7 @@
 
 #include "core/geometry/polynomial.h"
 #include "core/geometry/ransac.h"
+#include "core/math/adjugate.h"
 
 namespace reconar {
 namespace {
@@ -29,21 +30,6 @@ namespace {
 // three lambdas and R, t follow from the three camera-frame points. Unlike the paper, which
 // eliminates lambda_1 on each plane, the two rays on a plane come from the 2x2 restriction of D2
 // to it (no division by a possibly vanishing coefficient).
-
-// det(A + gamma B) = det A + gamma tr(adj(A) B) + gamma^2 tr(A adj(B)) + gamma^3 det B.
-Eigen::Matrix3d Adjugate(const Eigen::Matrix3d& A) {
-  Eigen::Matrix3d adj;
-  adj(0, 0) = A(1, 1) * A(2, 2) - A(1, 2) * A(2, 1);
-  adj(0, 1) = A(0, 2) * A(2, 1) - A(0, 1) * A(2, 2);
-  adj(0, 2) = A(0, 1) * A(1, 2) - A(0, 2) * A(1, 1);
-  adj(1, 0) = A(1, 2) * A(2, 0) - A(1, 0) * A(2, 2);
-  adj(1, 1) = A(0, 0) * A(2, 2) - A(0, 2) * A(2, 0);
-  adj(1, 2) = A(0, 2) * A(1, 0) - A(0, 0) * A(1, 2);
-  adj(2, 0) = A(1, 0) * A(2, 1) - A(1, 1) * A(2, 0);
-  adj(2, 1) = A(0, 1) * A(2, 0) - A(0, 0) * A(2, 1);
-  adj(2, 2) = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-  return adj;
-}
 
 struct P3PSystem {
   double a12, a13, a23;  // squared world distances
@@ -139,30 +125,6 @@ Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   return S;
 }
 
-// rho(s) and rho'(s) of the loss.
-void EvaluateLoss(const PoseRefinementOptions& options, double s, double* rho, double* drho) {
-  const double c = options.loss_scale_px;
-  const double c2 = c * c;
-  switch (options.loss) {
-    case PoseRefinementOptions::Loss::kTrivial:
-      break;
-    case PoseRefinementOptions::Loss::kHuber:
-      if (s > c2) {
-        const double r = std::sqrt(s);
-        *rho = 2.0 * c * r - c2;
-        *drho = c / r;
-        return;
-      }
-      break;
-    case PoseRefinementOptions::Loss::kCauchy:
-      *rho = c2 * std::log1p(s / c2);
-      *drho = 1.0 / (1.0 + s / c2);
-      return;
-  }
-  *rho = s;
-  *drho = 1.0;
-}
-
 // The NormalLmSolve problem: pose (dw, dt) and, when kRefineFocal, log focal.
 template <bool kRefineFocal>
 class PoseRefinementProblem {
@@ -182,7 +144,7 @@ class PoseRefinementProblem {
         indices_(indices),
         count_(count),
         camera_(camera),
-        options_(options) {}
+        loss_{options.loss, options.loss_scale_px} {}
 
   bool Linearize(const State& x, Eigen::Matrix<double, kDim, kDim>* jtj, Tangent* jtr, double* cost) const {
     jtj->setZero();
@@ -210,7 +172,7 @@ class PoseRefinementProblem {
       if constexpr (kRefineFocal) J.col(6) = x.focal * d * p;  // f = f0 exp(df)
 
       double rho = 0.0, weight = 0.0;
-      EvaluateLoss(options_, e.squaredNorm(), &rho, &weight);
+      loss_.Evaluate(e.squaredNorm(), &rho, &weight);
       jtj->noalias() += weight * J.transpose() * J;
       jtr->noalias() += weight * J.transpose() * e;
       *cost += 0.5 * rho;
@@ -235,7 +197,7 @@ class PoseRefinementProblem {
   const int* indices_;
   int count_;
   AbsolutePoseCamera camera_;
-  PoseRefinementOptions options_;
+  RobustLoss loss_;
 };
 
 template <bool kRefineFocal>

@@ -20,8 +20,9 @@
 #include <Eigen/Core>
 
 #include "core/base/status.h"
-#include "core/geometry/pose_refinement.h"
 #include "core/geometry/ransac_options.h"
+#include "core/math/normal_lm.h"
+#include "core/math/robust_loss.h"
 
 namespace reconar {
 
@@ -111,11 +112,7 @@ double SquaredPixelError(const AbsolutePoseCamera& camera, const Eigen::Matrix3d
                          const Eigen::Vector3d& world_point, const Eigen::Vector2d& pixel);
 
 struct PoseRefinementOptions {
-  enum class Loss {
-    kTrivial,  // rho(s) = s
-    kHuber,    // rho(s) = s for s <= c^2, 2 c sqrt(s) - c^2 beyond
-    kCauchy,   // rho(s) = c^2 log(1 + s / c^2)
-  };
+  using Loss = LossType;       // kTrivial, kHuber or kCauchy (core/math/robust_loss.h)
   Loss loss = Loss::kHuber;
   double loss_scale_px = 1.0;  // c
   bool refine_focal = false;   // also refine camera.focal (as log f); k1, k2 stay fixed

@@ -6,26 +6,9 @@
 #include "core/geometry/null_space.h"
 #include "core/geometry/polynomial.h"
 #include "core/geometry/residuals.h"
+#include "core/math/adjugate.h"
 
 namespace reconar {
-namespace {
-
-// Adjugate (transposed cofactor matrix) of a 3x3 matrix.
-Eigen::Matrix3d Adjugate(const Eigen::Matrix3d& M) {
-  Eigen::Matrix3d adj;
-  adj(0, 0) = M(1, 1) * M(2, 2) - M(1, 2) * M(2, 1);
-  adj(0, 1) = M(0, 2) * M(2, 1) - M(0, 1) * M(2, 2);
-  adj(0, 2) = M(0, 1) * M(1, 2) - M(0, 2) * M(1, 1);
-  adj(1, 0) = M(1, 2) * M(2, 0) - M(1, 0) * M(2, 2);
-  adj(1, 1) = M(0, 0) * M(2, 2) - M(0, 2) * M(2, 0);
-  adj(1, 2) = M(0, 2) * M(1, 0) - M(0, 0) * M(1, 2);
-  adj(2, 0) = M(1, 0) * M(2, 1) - M(1, 1) * M(2, 0);
-  adj(2, 1) = M(0, 1) * M(2, 0) - M(0, 0) * M(2, 1);
-  adj(2, 2) = M(0, 0) * M(1, 1) - M(0, 1) * M(1, 0);
-  return adj;
-}
-
-}  // namespace
 
 int FundamentalSevenPoint::Estimate(const Sample* samples, int count, std::array<Model, kMaxModels>* models) {
   if (count < kMinSamples) return 0;

@@ -16,6 +16,7 @@
 #include <memory>
 
 #include "core/base/thread_pool.h"
+#include "core/math/normal_lm.h"
 #include "core/optim/bal_camera_model.h"
 #include "core/optim/cholmod_ldlt.h"
 #include "core/optim/radial_camera_model.h"
@@ -138,8 +139,7 @@ class Solver {
       summary.termination = Termination::kNumericFailure;
       return summary;
     }
-    double radius = opt_.initial_trust_region_radius;
-    double nu = 2.0;
+    LmTrustRegion region(opt_.initial_trust_region_radius);
     int numeric_failures = 0;
     summary.termination = Termination::kMaxIterations;
     while (true) {
@@ -152,14 +152,13 @@ class Solver {
         break;
       }
       ++summary.iterations;
-      const double lambda = 1.0 / radius;
+      const double lambda = 1.0 / region.radius();
       if (!SolveStep(lambda)) {
         if (++numeric_failures >= opt_.max_consecutive_numeric_failures) {
           summary.termination = Termination::kNumericFailure;
           break;
         }
-        radius /= nu;
-        nu *= 2.0;
+        region.Reject();
         continue;
       }
       numeric_failures = 0;
@@ -181,19 +180,14 @@ class Solver {
         ++summary.accepted_steps;
         const double old_cost = cost_;
         Linearize();
-        // Nielsen's update (Madsen, Nielsen & Tingleff 2004, eq. 3.16) of mu = 1 / radius.
-        const double g = 2.0 * gain - 1.0;
-        radius =
-            std::min(opt_.max_trust_region_radius, radius / std::max(1.0 / 3.0, 1.0 - g * g * g));
-        nu = 2.0;
+        region.Accept(gain, opt_.max_trust_region_radius);
         if (std::abs(change) <= opt_.function_tolerance * old_cost) {
           summary.termination = Termination::kFunctionTolerance;
           break;
         }
       } else {
-        radius /= nu;
-        nu *= 2.0;
-        if (radius < opt_.min_trust_region_radius) {
+        region.Reject();
+        if (region.radius() < opt_.min_trust_region_radius) {
           summary.termination = Termination::kTrustRegionTooSmall;
           break;
         }

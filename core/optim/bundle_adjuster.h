@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/math/robust_loss.h"
 #include "core/optim/bal_problem.h"
-#include "core/optim/robust_loss.h"
 
 namespace reconar {
 

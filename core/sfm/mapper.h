@@ -66,7 +66,7 @@ struct MapperOptions {
   enum class PrincipalPoint { kFixed, kAuto, kRefine };
   PrincipalPoint principal_point = PrincipalPoint::kAuto;
   // The final adjustment may also refine the pixel aspect ratio fy / fx (chosen the same way).
-  bool refine_aspect = true;
+  bool refine_aspect = false;
   // EXIF focal priors outside [focal_prior_min_ratio, focal_prior_max_ratio] x the data's
   // estimate are distrusted (paper eq. 5).
   double focal_prior_min_ratio = 0.7;

@@ -4,12 +4,10 @@
 // The dataset's SOURCE.txt records no reference cost, so the solve is checked on structural
 // facts (counts, finite costs, a convergence termination) and a cost decrease of at least 10x.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -17,18 +15,13 @@
 #include <string>
 
 #include "core/base/atomic_file.h"
+#include "tests/support/run_command.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
 const std::string kLadybug = std::string(RECONAR_SHARED_DATA_DIR) + "/bal_ladybug/problem-49-7776-pre.txt";
-
-struct CommandRun {
-  int exit_code = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
 
 fs::path TempDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("reconar_ba_cli_" + std::to_string(::getpid())) / name;
@@ -37,20 +30,10 @@ fs::path TempDir(const std::string& name) {
   return dir;
 }
 
+using reconar::testing::CommandRun;
+
 CommandRun RunReconar(const std::string& arguments) {
-  const fs::path err_path = TempDir("stderr") / "stderr.txt";
-  const std::string command = std::string(RECONAR_BINARY) + " " + arguments + " 2>" + err_path.string();
-  CommandRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) run.out.append(buffer, n);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  auto err = reconar::ReadFileToString(err_path.string());
-  if (err.ok()) run.err = *err;
-  return run;
+  return reconar::testing::RunReconar(arguments, reconar::testing::StderrMode::kSeparate);
 }
 
 // A flat JSON object whose values are strings, numbers or null (what bundle-adjust prints).
@@ -123,9 +106,9 @@ double Number(const std::map<std::string, std::string>& object, const std::strin
 
 TEST(BundleAdjustCli, LadybugJsonSummary) {
   const CommandRun run = RunReconar("bundle-adjust --bal " + kLadybug + " --json --threads 2");
-  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+  ASSERT_EQ(run.exit_code, 0) << run.output << run.error;
   std::map<std::string, std::string> json;
-  ASSERT_TRUE(ParseFlatJsonObject(run.out, &json)) << "not exactly one JSON object:\n" << run.out;
+  ASSERT_TRUE(ParseFlatJsonObject(run.output, &json)) << "not exactly one JSON object:\n" << run.output;
   for (const char* key : {"file", "cameras", "points", "observations", "initial_cost", "final_cost", "iterations",
                           "seconds", "termination"}) {
     EXPECT_EQ(json.count(key), 1u) << key;
@@ -137,7 +120,7 @@ TEST(BundleAdjustCli, LadybugJsonSummary) {
   EXPECT_EQ(Number(json, "points"), 7776);
   EXPECT_EQ(Number(json, "observations"), 31843);
   const double initial = Number(json, "initial_cost"), final = Number(json, "final_cost");
-  ASSERT_TRUE(std::isfinite(initial) && std::isfinite(final)) << run.out;
+  ASSERT_TRUE(std::isfinite(initial) && std::isfinite(final)) << run.output;
   EXPECT_GT(final, 0.0);
   EXPECT_LT(final, initial);
   EXPECT_LE(10.0 * final, initial) << "expected at least a 10x decrease";
@@ -152,10 +135,10 @@ TEST(BundleAdjustCli, LadybugJsonSummary) {
 TEST(BundleAdjustCli, HumanReadableSummaryAndOptions) {
   const CommandRun run =
       RunReconar("bundle-adjust --bal " + kLadybug + " --solver sparse --loss huber --loss-scale 2 --max-iterations 3");
-  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
-  EXPECT_NE(run.out.find("49 cameras, 7776 points, 31843 observations"), std::string::npos) << run.out;
-  EXPECT_NE(run.out.find("in 3 iterations"), std::string::npos) << run.out;
-  EXPECT_NE(run.out.find("sparse solver"), std::string::npos) << run.out;
+  ASSERT_EQ(run.exit_code, 0) << run.output << run.error;
+  EXPECT_NE(run.output.find("49 cameras, 7776 points, 31843 observations"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("in 3 iterations"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("sparse solver"), std::string::npos) << run.output;
 }
 
 TEST(BundleAdjustCli, UsageErrors) {
@@ -163,18 +146,18 @@ TEST(BundleAdjustCli, UsageErrors) {
   EXPECT_EQ(RunReconar("bundle-adjust").exit_code, 2);
   const CommandRun bad_solver = RunReconar("bundle-adjust --bal " + kLadybug + " --solver qr");
   EXPECT_EQ(bad_solver.exit_code, 2);
-  EXPECT_NE(bad_solver.err.find("--solver"), std::string::npos) << bad_solver.err;
+  EXPECT_NE(bad_solver.error.find("--solver"), std::string::npos) << bad_solver.error;
   const CommandRun bad_loss = RunReconar("bundle-adjust --bal " + kLadybug + " --loss tukey");
   EXPECT_EQ(bad_loss.exit_code, 2);
-  EXPECT_NE(bad_loss.err.find("--loss"), std::string::npos) << bad_loss.err;
+  EXPECT_NE(bad_loss.error.find("--loss"), std::string::npos) << bad_loss.error;
 }
 
 TEST(BundleAdjustCli, MissingFileIsNamed) {
   const std::string missing = "/nonexistent/problem.txt";
   const CommandRun run = RunReconar("bundle-adjust --bal " + missing + " --json");
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_TRUE(run.out.empty()) << run.out;
-  EXPECT_NE(run.err.find(missing), std::string::npos) << run.err;
+  EXPECT_TRUE(run.output.empty()) << run.output;
+  EXPECT_NE(run.error.find(missing), std::string::npos) << run.error;
 }
 
 TEST(BundleAdjustCli, TruncatedFileIsNamed) {
@@ -184,8 +167,8 @@ TEST(BundleAdjustCli, TruncatedFileIsNamed) {
   std::ofstream(truncated, std::ios::binary) << bytes->substr(0, bytes->size() / 2);
   const CommandRun run = RunReconar("bundle-adjust --bal " + truncated.string() + " --json");
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_TRUE(run.out.empty()) << run.out;
-  EXPECT_NE(run.err.find(truncated.string()), std::string::npos) << run.err;
+  EXPECT_TRUE(run.output.empty()) << run.output;
+  EXPECT_NE(run.error.find(truncated.string()), std::string::npos) << run.error;
 }
 
 }  // namespace

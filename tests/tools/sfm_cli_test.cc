@@ -4,7 +4,6 @@
 // 7-DoF similarity alignment (Theia's published figure), every focal within 0.5 % of the ground
 // truth; Herz-Jesu-P8 8/8 with mean <= 3.58 mm.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -15,6 +14,7 @@
 
 #include "core/sfm/model_io.h"
 #include "tests/support/ground_truth.h"
+#include "tests/support/run_command.h"
 #include "tests/support/sfm_evaluation.h"
 
 namespace reconar {
@@ -22,23 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;
-};
-
-CommandResult RunReconar(const std::string& arguments) {
-  const std::string command = std::string(RECONAR_BINARY) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using testing::CommandRun;
+using testing::RunReconar;
 
 fs::path FreshDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("reconar_sfm_cli_" + name + "_" + std::to_string(::getpid()));
@@ -55,7 +40,7 @@ struct Score {
 Score RunAndScore(const std::string& dataset, const fs::path& project) {
   Score score;
   const std::string data = testing::SharedDataPath(dataset);
-  const CommandResult run = RunReconar("sfm " + data + "/images " + project.string() + " --threads 2");
+  const CommandRun run = RunReconar("sfm " + data + "/images " + project.string() + " --threads 2");
   EXPECT_EQ(run.exit_code, 0) << run.output;
   auto model = ReadColmapTextModel((project / "sparse").string());
   EXPECT_TRUE(model.ok()) << model.status().ToString();
@@ -100,8 +85,8 @@ TEST(SfmCli, FountainP11MillimetreCameraCentresAndFocal) {
   std::ifstream before((project / "sparse" / "images.txt").string());
   std::stringstream before_text;
   before_text << before.rdbuf();
-  const CommandResult again = RunReconar("sfm " + testing::SharedDataPath("strecha_fountain-P11") + "/images " +
-                                         project.string());
+  const CommandRun again = RunReconar("sfm " + testing::SharedDataPath("strecha_fountain-P11") + "/images " +
+                                      project.string());
   EXPECT_EQ(again.exit_code, 0) << again.output;
   EXPECT_NE(again.output.find("mapping: up to date, reused"), std::string::npos) << again.output;
   std::ifstream after((project / "sparse" / "images.txt").string());
@@ -129,12 +114,12 @@ TEST(SfmCli, UnrelatedOrTooFewPhotosFailWithAReason) {
   fs::create_directories(images);
   fs::copy_file(testing::SharedDataPath("strecha_fountain-P11/images/0000.jpg"), images / "a.jpg");
   fs::copy_file(testing::SharedDataPath("strecha_herzjesu-P8/images/0000.jpg"), images / "b.jpg");
-  const CommandResult run = RunReconar("sfm " + images.string() + " " + (project / "out").string());
+  const CommandRun run = RunReconar("sfm " + images.string() + " " + (project / "out").string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(run.output.find("no image pair"), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(project / "out" / "sparse" / "points3D.txt"));
   fs::remove(images / "b.jpg");
-  const CommandResult one = RunReconar("sfm " + images.string() + " " + (project / "out1").string());
+  const CommandRun one = RunReconar("sfm " + images.string() + " " + (project / "out1").string());
   EXPECT_NE(one.exit_code, 0) << one.output;
   EXPECT_NE(one.output.find("at least two images"), std::string::npos) << one.output;
   fs::remove_all(project);

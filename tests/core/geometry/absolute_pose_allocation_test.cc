@@ -2,12 +2,9 @@
 // solvers thousands of times per image: none of them may touch the heap. This executable compiles
 // absolute_pose.cc itself with EIGEN_RUNTIME_NO_MALLOC and assertions on, so any Eigen heap
 // allocation aborts, and it replaces the global operator new to count every other allocation
-// (the technique of allocation_test.cc).
+// (tests/support/allocation_counter.h, as allocation_test.cc).
 #include <array>
-#include <atomic>
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,46 +12,12 @@
 #include <gtest/gtest.h>
 
 #include "core/geometry/absolute_pose.h"
-
-#ifndef EIGEN_RUNTIME_NO_MALLOC
-#error "absolute_pose_allocation_test.cc must be compiled with EIGEN_RUNTIME_NO_MALLOC"
-#endif
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* CountedAllocate(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return CountedAllocate(size); }
-void* operator new[](std::size_t size) { return CountedAllocate(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "tests/support/allocation_counter.h"
 
 namespace reconar {
 namespace {
 
-// Counts operator-new calls and forbids Eigen heap allocation within its lifetime.
-class NoAllocationScope {
- public:
-  NoAllocationScope() {
-    g_allocations = 0;
-    Eigen::internal::set_is_malloc_allowed(false);
-    g_counting = true;
-  }
-  ~NoAllocationScope() {
-    g_counting = false;
-    Eigen::internal::set_is_malloc_allowed(true);
-  }
-  long allocations() const { return g_allocations.load(); }
-};
+using testing::NoAllocationScope;
 
 // 100 points on a grid of depths in front of a distorted camera, noise-free pixels.
 struct Data {

@@ -1,11 +1,9 @@
 // The minimal solvers and residual functions must not touch the heap (they run thousands of
 // times per image pair). This executable compiles the estimator sources itself with
 // EIGEN_RUNTIME_NO_MALLOC and assertions on, so any Eigen heap allocation aborts, and it
-// replaces the global operator new to count every other allocation.
+// replaces the global operator new to count every other allocation
+// (tests/support/allocation_counter.h).
 #include <array>
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <vector>
 
 #include <Eigen/Core>
@@ -16,46 +14,12 @@
 #include "core/geometry/fundamental_seven_point.h"
 #include "core/geometry/homography_four_point.h"
 #include "core/geometry/synthetic_scene.h"
-
-#ifndef EIGEN_RUNTIME_NO_MALLOC
-#error "allocation_test.cc must be compiled with EIGEN_RUNTIME_NO_MALLOC"
-#endif
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* CountedAllocate(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return CountedAllocate(size); }
-void* operator new[](std::size_t size) { return CountedAllocate(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "tests/support/allocation_counter.h"
 
 namespace reconar {
 namespace {
 
-// Counts operator-new calls and forbids Eigen heap allocation within its lifetime.
-class NoAllocationScope {
- public:
-  NoAllocationScope() {
-    g_allocations = 0;
-    Eigen::internal::set_is_malloc_allowed(false);
-    g_counting = true;
-  }
-  ~NoAllocationScope() {
-    g_counting = false;
-    Eigen::internal::set_is_malloc_allowed(true);
-  }
-  long allocations() const { return g_allocations.load(); }
-};
+using testing::NoAllocationScope;
 
 template <typename Estimator>
 void ExpectNoAllocation(const std::vector<Correspondence>& samples) {

@@ -1,9 +1,10 @@
 #pragma once
-// Robust losses rho(s) of the squared residual norm s = |r|^2; the bundle cost is
-// 1/2 sum rho(s_k). The solver reweights each residual block by sqrt(rho'(s)) (iteratively
-// reweighted least squares, Triggs, McLauchlan, Hartley & Fitzgibbon, "Bundle Adjustment - A
-// Modern Synthesis", 2000, sec. 3.4), dropping the rho'' term so the Gauss-Newton matrix stays
-// positive semi-definite.
+// Robust losses rho(s) of the squared residual norm s = |r|^2; a robust cost is 1/2 sum rho(s_k)
+// (the bundle adjuster, core/optim/bundle_adjuster.h; the pose refinement,
+// core/geometry/absolute_pose.h). The solvers reweight each residual block by sqrt(rho'(s))
+// (iteratively reweighted least squares, Triggs, McLauchlan, Hartley & Fitzgibbon, "Bundle
+// Adjustment - A Modern Synthesis", 2000, sec. 3.4), dropping the rho'' term so the Gauss-Newton
+// matrix stays positive semi-definite.
 #include <cmath>
 
 namespace reconar {

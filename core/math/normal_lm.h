@@ -1,13 +1,15 @@
 #pragma once
-// Levenberg-Marquardt on accumulated normal equations, for small problems with many residuals
-// (a camera pose against hundreds of points): the problem sums J^T W J (N x N, fixed size) and
-// J^T W r over its residuals itself, so memory is independent of the number of residuals and
-// nothing is allocated. The method is the one of TinyLmSolve (core/optim/tiny_lm.h): Marquardt
-// damping diag(J^T J) / radius, the gain-ratio trust-region update of Madsen, Nielsen & Tingleff
-// (2004, sec. 3.2), Cholesky of the damped system. Two differences: the state lives on a
-// manifold (the problem supplies x [+] dx, e.g. a rotation update R <- exp(dw) R), and a robust
-// loss enters by iteratively reweighted least squares (Triggs et al., "Bundle Adjustment - A
-// Modern Synthesis", 2000, sec. 3.4: weight rho'(s), the rho'' term dropped).
+// Levenberg-Marquardt on accumulated normal equations, for small problems: the problem sums
+// J^T W J (N x N, fixed size) and J^T W r over its residuals itself, so memory is independent of
+// the number of residuals and nothing is allocated. Marquardt damping diag(J^T J) / radius, the
+// gain-ratio trust-region update of Madsen, Nielsen & Tingleff (2004, sec. 3.2), Cholesky of the
+// damped system (the method of the bundle adjuster, core/optim/bundle_adjuster.h). The state may
+// live on a manifold (the problem supplies x [+] dx, e.g. a rotation update R <- exp(dw) R), and a
+// robust loss enters by iteratively reweighted least squares (robust_loss.h).
+//
+// Users: TinyLmSolve (core/optim/tiny_lm.h; vector state, the normal equations formed from a
+// fixed-size residual functor) and the absolute pose refinement (core/geometry/absolute_pose.cc;
+// rotation, translation and focal, hundreds of robustly weighted reprojection residuals).
 //
 // The problem type provides
 //   using State = ...;                          // copyable, fixed size
@@ -16,10 +18,8 @@
 //                  double* cost) const;         // cost = 1/2 sum_i rho(|r_i|^2)
 //   State Plus(const State& x, const Eigen::Matrix<double, N, 1>& dx) const;
 //   double Norm(const State& x) const;          // size of x against which steps are compared
-// Linearize returns false when x is outside the domain (such a step is rejected).
-//
-// Kept in core/geometry instead of next to TinyLmSolve because geometry may not include optim
-// (DESIGN.md layering); the options and termination values mirror TinyLmOptions / TinyLmSummary.
+// Linearize returns false when x is outside the domain (such a step is rejected); it is called
+// once per trial step.
 #include <algorithm>
 #include <cmath>
 
@@ -61,6 +61,32 @@ struct NormalLmSummary {
   }
 };
 
+// The Levenberg-Marquardt trust region, shared with the bundle adjuster: the damping is
+// diag / radius; an accepted step with gain ratio `gain` (actual over predicted cost reduction)
+// scales the radius by Nielsen's rule (Madsen, Nielsen & Tingleff 2004, eq. 3.16 for
+// mu = 1 / radius), a rejected one divides it by nu, which doubles on every consecutive rejection.
+class LmTrustRegion {
+ public:
+  explicit LmTrustRegion(double initial_radius) : radius_(initial_radius) {}
+
+  double radius() const { return radius_; }
+
+  void Accept(double gain, double max_radius) {
+    const double t = 2.0 * gain - 1.0;
+    radius_ = std::min(max_radius, radius_ / std::max(1.0 / 3.0, 1.0 - t * t * t));
+    nu_ = 2.0;
+  }
+
+  void Reject() {
+    radius_ /= nu_;
+    nu_ *= 2.0;
+  }
+
+ private:
+  double radius_;
+  double nu_ = 2.0;
+};
+
 inline const char* NormalLmTerminationName(NormalLmSummary::Termination termination) {
   using Termination = NormalLmSummary::Termination;
   switch (termination) {
@@ -91,8 +117,7 @@ NormalLmSummary NormalLmSolve(const Problem& problem, const NormalLmOptions& opt
     return summary;
   }
   summary.initial_cost = summary.final_cost = cost;
-  double radius = options.initial_trust_region_radius;
-  double nu = 2.0;
+  LmTrustRegion region(options.initial_trust_region_radius);
   Eigen::LLT<MatNN> llt;
   while (true) {
     if (g.cwiseAbs().maxCoeff() <= options.gradient_tolerance) {
@@ -106,6 +131,7 @@ NormalLmSummary NormalLmSolve(const Problem& problem, const NormalLmOptions& opt
     ++summary.iterations;
     const VecN diag = jtj.diagonal().cwiseMax(options.min_diagonal);
     MatNN a = jtj;
+    const double radius = region.radius();
     a.diagonal() += diag / radius;
     llt.compute(a);
     bool accepted = false;
@@ -132,9 +158,7 @@ NormalLmSummary NormalLmSolve(const Problem& problem, const NormalLmOptions& opt
           cost = new_cost;
           jtj = jtj_new;
           g = g_new;
-          const double t = 2.0 * gain - 1.0;
-          radius = std::min(options.max_trust_region_radius, radius / std::max(1.0 / 3.0, 1.0 - t * t * t));
-          nu = 2.0;
+          region.Accept(gain, options.max_trust_region_radius);
           if (std::abs(change) <= options.function_tolerance * old_cost) {
             summary.termination = Termination::kFunctionTolerance;
             break;
@@ -143,9 +167,8 @@ NormalLmSummary NormalLmSolve(const Problem& problem, const NormalLmOptions& opt
       }
     }
     if (!accepted) {
-      radius /= nu;
-      nu *= 2.0;
-      if (radius < options.min_trust_region_radius) {
+      region.Reject();
+      if (region.radius() < options.min_trust_region_radius) {
         summary.termination = Termination::kTrustRegionTooSmall;
         break;
       }

@@ -1,0 +1,45 @@
+#include "tests/support/run_command.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace reconar::testing {
+
+CommandRun RunCommand(const std::string& command, StderrMode stderr_mode) {
+  CommandRun run;
+  std::string err_path;
+  std::string shell_command = command;
+  if (stderr_mode == StderrMode::kSeparate) {
+    std::string path_template = (std::filesystem::temp_directory_path() / "reconar_stderr_XXXXXX").string();
+    const int fd = mkstemp(path_template.data());
+    if (fd < 0) return run;
+    close(fd);
+    err_path = path_template;
+    shell_command += " 2>" + err_path;
+  } else {
+    shell_command += " 2>&1";
+  }
+  if (FILE* pipe = popen(shell_command.c_str(), "r")) {
+    char buffer[4096];
+    size_t n;
+    while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) run.output.append(buffer, n);
+    const int status = pclose(pipe);
+    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  if (!err_path.empty()) {
+    std::ifstream err(err_path, std::ios::binary);
+    std::ostringstream text;
+    text << err.rdbuf();
+    run.error = text.str();
+    std::remove(err_path.c_str());
+  }
+  return run;
+}
+
+}  // namespace reconar::testing

@@ -1,0 +1,29 @@
+#pragma once
+// Runs a shell command and captures its output and exit code: the tests of the `reconar`
+// executable (tests/tools). Test support only.
+#include <string>
+
+namespace reconar::testing {
+
+struct CommandRun {
+  int exit_code = -1;  // -1 when the command could not be started or did not exit normally
+  std::string output;  // stdout; with StderrMode::kMerge also stderr, interleaved as written
+  std::string error;   // stderr with StderrMode::kSeparate, else empty
+};
+
+enum class StderrMode {
+  kMerge,     // 2>&1 into `output`
+  kSeparate,  // into `error` (through a temporary file)
+};
+
+// `command` through /bin/sh (popen).
+CommandRun RunCommand(const std::string& command, StderrMode stderr_mode = StderrMode::kMerge);
+
+#ifdef RECONAR_BINARY
+// The reconar executable (RECONAR_BINARY, defined by the tests in tests/tools) with `arguments`.
+inline CommandRun RunReconar(const std::string& arguments, StderrMode stderr_mode = StderrMode::kMerge) {
+  return RunCommand(std::string(RECONAR_BINARY) + " " + arguments, stderr_mode);
+}
+#endif
+
+}  // namespace reconar::testing
