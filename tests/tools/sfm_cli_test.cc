@@ -66,6 +66,10 @@ Score RunAndScore(const std::string& dataset, const fs::path& project) {
   auto errors = testing::CameraCenterErrors(estimated, reference);
   EXPECT_TRUE(errors.ok()) << errors.status().ToString();
   if (errors.ok()) score.errors = *errors;
+  std::printf("%s: %d registered, mean centre error %.3f mm (median %.3f, max %.3f), rotation %.3f deg\n",
+              dataset.c_str(), score.registered, 1000.0 * score.errors.centre_mean,
+              1000.0 * score.errors.centre_median, 1000.0 * score.errors.centre_max,
+              score.errors.rotation_mean_deg);
   return score;
 }
 
@@ -73,9 +77,6 @@ TEST(SfmCli, FountainP11MillimetreCameraCentresAndFocal) {
   const fs::path project = FreshDir("fountain");
   const Score score = RunAndScore("strecha_fountain-P11", project);
   EXPECT_EQ(score.registered, 11);
-  std::printf("fountain-P11: mean centre error %.3f mm (median %.3f, max %.3f), rotation %.3f deg\n",
-              1000.0 * score.errors.centre_mean, 1000.0 * score.errors.centre_median,
-              1000.0 * score.errors.centre_max, score.errors.rotation_mean_deg);
   EXPECT_LE(1000.0 * score.errors.centre_mean, 2.43);
   for (size_t i = 0; i < score.focals_x.size(); ++i) {
     EXPECT_NEAR(score.focals_x[i] / 2759.48, 1.0, 0.005) << "fx of camera " << i;
@@ -100,9 +101,6 @@ TEST(SfmCli, HerzJesuP8MillimetreCameraCentres) {
   const fs::path project = FreshDir("herzjesu");
   const Score score = RunAndScore("strecha_herzjesu-P8", project);
   EXPECT_EQ(score.registered, 8);
-  std::printf("herzjesu-P8: mean centre error %.3f mm (median %.3f, max %.3f), rotation %.3f deg\n",
-              1000.0 * score.errors.centre_mean, 1000.0 * score.errors.centre_median,
-              1000.0 * score.errors.centre_max, score.errors.rotation_mean_deg);
   EXPECT_LE(1000.0 * score.errors.centre_mean, 3.58);
   fs::remove_all(project);
 }
