@@ -29,9 +29,12 @@ double Max(const std::vector<double>& values) {
   return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
 }
 
+// atan2(|sin|, cos) from the skew and symmetric parts: accurate for small angles, where
+// acos((trace - 1) / 2) loses half the digits.
 double RotationAngleDeg(const Eigen::Matrix3d& rotation) {
-  const double cosine = std::clamp(0.5 * (rotation.trace() - 1.0), -1.0, 1.0);
-  return std::acos(cosine) * 180.0 / M_PI;
+  const Eigen::Vector3d axis_sin(rotation(2, 1) - rotation(1, 2), rotation(0, 2) - rotation(2, 0),
+                                 rotation(1, 0) - rotation(0, 1));
+  return std::atan2(0.5 * axis_sin.norm(), 0.5 * (rotation.trace() - 1.0)) * 180.0 / M_PI;
 }
 
 }  // namespace

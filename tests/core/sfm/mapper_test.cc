@@ -320,11 +320,13 @@ void ExpectRingReconstructed(const SceneOptions& scene_options, const MapperOpti
               errors->centre_mean, errors->centre_max, scene_options.ring_radius, errors->rotation_mean_deg,
               errors->rotation_max_deg);
   EXPECT_LT(errors->centre_max, 0.01 * scene_options.ring_radius);
-  // Orientation: the principal point, refined here, is determined to about a pixel, and a shift
-  // of it trades against a common rotation of the cameras (1 px = 1 / 900 rad = 0.064 degrees);
-  // the directions themselves are good to ~1e-3 rad. Allow 0.15 degrees.
-  EXPECT_LT(errors->rotation_max_deg, 0.15);
-  EXPECT_LT(errors->relative_rotation_mean_deg, 0.15);
+  // Orientation: the directions themselves are good to ~1e-3 degrees, but the principal point,
+  // refined here together with k1 and k2 from ten views, trades against a rotation of each camera
+  // (1 px = 1 / 900 rad = 0.064 degrees) and is only determined to a few pixels: 0.8 px on x86-64,
+  // 2.4 px on aarch64, where fused multiply-adds change the RANSAC samples and so the solution
+  // reached. Allow 4 px (0.25 degrees): a wrongly registered camera is off by degrees.
+  EXPECT_LT(errors->rotation_max_deg, 0.25);
+  EXPECT_LT(errors->relative_rotation_mean_deg, 0.25);
 
   // Points: each should map back to one true point and lie where that point is (after the same
   // alignment). A wrong match that forms a two-view track of its own (one or both ends on
