@@ -1,8 +1,8 @@
 #include "core/base/json_writer.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
 namespace reconar {
 
@@ -101,11 +101,10 @@ JsonWriter& JsonWriter::Double(double value) {
     out_ += "null";
     return *this;
   }
-  // The shortest of 15 or 17 significant digits that reads back as the same double.
+  // Shortest text that reads back as the same double (as core/sfm/model_io writes numbers).
   char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.15g", value);
-  if (std::strtod(buffer, nullptr) != value) std::snprintf(buffer, sizeof(buffer), "%.17g", value);
-  out_ += buffer;
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out_.append(buffer, result.ptr);
   return *this;
 }
 

@@ -197,9 +197,9 @@ TEST(JsonWriter, WritesNestedValuesWithEscapesAndRoundTripDoubles) {
       .Key("list").BeginArray().Bool(true).Null().BeginObject().EndObject().EndArray()
       .EndObject();
   EXPECT_EQ(json.str(),
-            "{\"name\":\"a \\\"b\\\"\\n\\\\\",\"n\":-3,\"x\":0.1,\"y\":0.33333333333333331,"
+            "{\"name\":\"a \\\"b\\\"\\n\\\\\",\"n\":-3,\"x\":0.1,\"y\":0.3333333333333333,"
             "\"bad\":null,\"list\":[true,null,{}]}");
-  EXPECT_EQ(std::strtod("0.33333333333333331", nullptr), 1.0 / 3.0);
+  EXPECT_EQ(std::strtod("0.3333333333333333", nullptr), 1.0 / 3.0);
   EXPECT_EQ(JsonQuote(std::string("\x01", 1)), "\"\\u0001\"");
 }
 
