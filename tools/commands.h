@@ -7,6 +7,10 @@ int RunFeatures(int argc, char** argv, int first);
 int RunMatch(int argc, char** argv, int first);
 int RunBundleAdjust(int argc, char** argv, int first);
 int RunSfm(int argc, char** argv, int first);
+int RunTags(int argc, char** argv, int first);
+int RunTrack(int argc, char** argv, int first);
+int RunCalibrate(int argc, char** argv, int first);
+int RunView(int argc, char** argv, int first);  // defined only with RECONAR_HAVE_VIEW
 
 }  // namespace reconar::tools
 

@@ -16,6 +16,10 @@ constexpr char kUsage[] =
     "  match --project DIR                                 verified matches between all pairs of a project\n"
     "  sfm IMAGES_DIR PROJECT_DIR                          cameras and sparse points (structure from motion)\n"
     "  bundle-adjust --bal FILE [--json]                   solve a BAL bundle adjustment problem\n"
+    "  tags --ids LIST --size METRES --out FILE.{svg,pdf}  printable AprilTag sheet\n"
+    "  track SOURCE --intrinsics K --tag-size M [--json]   6-DoF tag tracking, one line per frame\n"
+    "  view --model M (--camera DEV | --frames DIR) ...    AR overlay: live window or PNGs (--out)\n"
+    "  calibrate IMAGES... --tag-size M --out FILE         camera intrinsics from photos of tags\n"
     "\n"
     "exit codes: 0 ok, 1 failed run, 2 bad usage or input\n";
 
@@ -31,6 +35,17 @@ int main(int argc, char** argv) {
   if (command == "match") return reconar::tools::RunMatch(argc, argv, 2);
   if (command == "sfm") return reconar::tools::RunSfm(argc, argv, 2);
   if (command == "bundle-adjust") return reconar::tools::RunBundleAdjust(argc, argv, 2);
+  if (command == "tags") return reconar::tools::RunTags(argc, argv, 2);
+  if (command == "track") return reconar::tools::RunTrack(argc, argv, 2);
+  if (command == "calibrate") return reconar::tools::RunCalibrate(argc, argv, 2);
+  if (command == "view") {
+#ifdef RECONAR_HAVE_VIEW
+    return reconar::tools::RunView(argc, argv, 2);
+#else
+    std::fputs("reconar: view needs the GLES renderer; this build has RECONAR_WITH_GLES=OFF\n", stderr);
+    return 2;
+#endif
+  }
   std::fprintf(stderr, "reconar: unknown command '%s'\n\n%s", command.c_str(), kUsage);
   return 2;
 }

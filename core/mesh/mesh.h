@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/base/status.h"
+
 namespace reconar {
 
 struct Mesh {
@@ -16,5 +18,15 @@ struct Mesh {
 
   bool is_point_cloud() const { return triangles.empty(); }
 };
+
+// Ok when `normals` and `colors` are empty or hold one entry per position and every triangle index
+// is below positions.size(); otherwise kInvalidArgument naming the first problem. The writers
+// (core/mesh/mesh_io.h, glb_io.h) check this before writing anything.
+Status ValidateMesh(const Mesh& mesh);
+
+// Sets mesh->normals to the area-weighted average of the adjacent triangles' normals, oriented
+// by the counter-clockwise winding. Vertices without a non-degenerate triangle get (0, 0, 1) so
+// that every normal is unit length (glTF requires it). The mesh must pass ValidateMesh.
+void ComputeVertexNormals(Mesh* mesh);
 
 }  // namespace reconar

@@ -1,0 +1,230 @@
+// Tag tracking speed: the 93 frames of ../shared/data/apriltag_ar_video_id12 (decoded once, gray),
+// one thread each, in the same process, alternating runs:
+//   (a) plain full-frame libapriltag with apriltag_detector_create() defaults (tag36h11, 1 thread),
+//   (b) our TagTracker with its defaults (1 thread; a fresh tracker per run, so its first frame is
+//       a full-frame search).
+// At 640x480 (as recorded) and at 1280x720 (the frames upscaled bilinearly, corners and K scaled
+// with them). Reports median ms/frame over the runs, the ratio (b)/(a), and each side's mean corner
+// error against corners.txt (upstream libapriltag, decimate 1).
+//   bench_tracker [repeats=5]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <apriltag/apriltag.h>
+#include <apriltag/tag36h11.h>
+
+#include "core/io/image_io.h"
+#include "tracker/tag_tracker.h"
+
+namespace {
+
+using reconar::Image;
+using Clock = std::chrono::steady_clock;
+
+struct Frame {
+  Image<uint8_t> gray;
+  Eigen::Vector2d corners[4];  // reference, libapriltag pixel convention
+};
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// Bilinear resize in libapriltag's pixel convention (pixel i covers [i, i+1]): output pixel centre
+// (i + 0.5) samples the input at (i + 0.5) / scale, so a point x maps to x * scale.
+Image<uint8_t> Resize(const Image<uint8_t>& in, int width, int height) {
+  Image<uint8_t> out(width, height, 1);
+  const double sx = static_cast<double>(in.width()) / width, sy = static_cast<double>(in.height()) / height;
+  for (int y = 0; y < height; ++y) {
+    const double fy = std::clamp((y + 0.5) * sy - 0.5, 0.0, in.height() - 1.0);
+    const int y0 = std::min(static_cast<int>(fy), in.height() - 2);
+    const double wy = fy - y0;
+    for (int x = 0; x < width; ++x) {
+      const double fx = std::clamp((x + 0.5) * sx - 0.5, 0.0, in.width() - 1.0);
+      const int x0 = std::min(static_cast<int>(fx), in.width() - 2);
+      const double wx = fx - x0;
+      const double v = (1 - wy) * ((1 - wx) * in.row(y0)[x0] + wx * in.row(y0)[x0 + 1]) +
+                       wy * ((1 - wx) * in.row(y0 + 1)[x0] + wx * in.row(y0 + 1)[x0 + 1]);
+      out.row(y)[x] = static_cast<uint8_t>(std::lround(v));
+    }
+  }
+  return out;
+}
+
+double MeanCornerError(const double (*p)[2], const Eigen::Vector2d (&ref)[4]) {
+  double sum = 0.0;
+  for (int k = 0; k < 4; ++k) sum += (Eigen::Vector2d(p[k][0], p[k][1]) - ref[k]).norm();
+  return sum / 4;
+}
+
+struct RunResult {
+  double ms_per_frame = 0.0;
+  double mean_corner_error = 0.0;
+  int found = 0;
+};
+
+RunResult RunPlain(const std::vector<Frame>& frames) {
+  apriltag_family_t* family = tag36h11_create();
+  apriltag_detector_t* detector = apriltag_detector_create();
+  apriltag_detector_add_family(detector, family);
+  detector->nthreads = 1;
+  RunResult result;
+  double error_sum = 0.0;
+  const Clock::time_point start = Clock::now();
+  for (const Frame& frame : frames) {
+    image_u8_t wrapped = {frame.gray.width(), frame.gray.height(), frame.gray.width(),
+                          const_cast<uint8_t*>(frame.gray.data())};
+    zarray_t* detections = apriltag_detector_detect(detector, &wrapped);
+    for (int i = 0; i < zarray_size(detections); ++i) {
+      apriltag_detection_t* det = nullptr;
+      zarray_get(detections, i, &det);
+      if (det->id != 12) continue;
+      ++result.found;
+      error_sum += MeanCornerError(det->p, frame.corners);
+    }
+    apriltag_detections_destroy(detections);
+  }
+  result.ms_per_frame = std::chrono::duration<double, std::milli>(Clock::now() - start).count() / frames.size();
+  result.mean_corner_error = error_sum / std::max(1, result.found);
+  apriltag_detector_destroy(detector);
+  tag36h11_destroy(family);
+  return result;
+}
+
+struct TrackerBreakdown {
+  int region_frames = 0, full_frames = 0, fallback_frames = 0;
+  double detect_ms = 0.0, pose_ms = 0.0, total_ms = 0.0;
+};
+
+RunResult RunTracker(const std::vector<Frame>& frames, const reconar::CameraIntrinsics& camera,
+                     TrackerBreakdown* breakdown) {
+  reconar::TagTrackerOptions options;
+  options.intrinsics = camera;
+  options.tag_size = 0.14;
+  auto tracker = reconar::TagTracker::Create(options);
+  if (!tracker.ok()) {
+    std::fprintf(stderr, "%s\n", tracker.status().ToString().c_str());
+    std::exit(1);
+  }
+  reconar::TagTrackerFrameReport report;
+  RunResult result;
+  double error_sum = 0.0;
+  *breakdown = TrackerBreakdown();
+  const Clock::time_point start = Clock::now();
+  for (const Frame& frame : frames) {
+    if (!(*tracker)->Track(frame.gray.view(), &report).ok()) std::exit(1);
+    for (const reconar::TrackedTag& t : report.tags) {
+      if (t.id != 12 || !t.measured) continue;
+      ++result.found;
+      double p[4][2];
+      for (int k = 0; k < 4; ++k) {
+        p[k][0] = t.detection.corners[k].x();
+        p[k][1] = t.detection.corners[k].y();
+      }
+      error_sum += MeanCornerError(p, frame.corners);
+    }
+    using Search = reconar::TagTrackerFrameReport::Search;
+    breakdown->region_frames += report.search == Search::kRegions;
+    breakdown->full_frames += report.search == Search::kFullFrame;
+    breakdown->fallback_frames += report.search == Search::kRegionsThenFullFrame;
+    breakdown->detect_ms += report.detect_ms / frames.size();
+    breakdown->pose_ms += report.pose_ms / frames.size();
+    breakdown->total_ms += report.total_ms / frames.size();
+  }
+  result.ms_per_frame = std::chrono::duration<double, std::milli>(Clock::now() - start).count() / frames.size();
+  result.mean_corner_error = error_sum / std::max(1, result.found);
+  return result;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+  const std::string dir = std::string(RECONAR_SHARED_DATA_DIR) + "/apriltag_ar_video_id12/";
+  std::ifstream list(dir + "corners.txt");
+  if (!list) {
+    std::fprintf(stderr, "%scorners.txt: cannot open\n", dir.c_str());
+    return 2;
+  }
+  std::vector<Frame> frames;
+  for (std::string line; std::getline(list, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string name;
+    Frame frame;
+    fields >> name;
+    for (Eigen::Vector2d& c : frame.corners) fields >> c.x() >> c.y();
+    auto decoded = reconar::ReadImage(dir + "frames/" + name);
+    if (!decoded.ok()) {
+      std::fprintf(stderr, "%s\n", decoded.status().ToString().c_str());
+      return 2;
+    }
+    frame.gray = reconar::ToGray8(decoded->rgb);
+    frames.push_back(std::move(frame));
+  }
+  reconar::CameraIntrinsics camera;  // SOURCE.txt
+  camera.width = 640;
+  camera.height = 480;
+  camera.fx = 823.8;
+  camera.fy = 822.8;
+  camera.cx = 304.8;
+  camera.cy = 236.3;
+
+  for (const int width : {640, 1280}) {
+    std::vector<Frame> sized;
+    reconar::CameraIntrinsics sized_camera = camera;
+    const int height = width == 640 ? 480 : 720;
+    const double sx = width / 640.0, sy = height / 480.0;
+    if (width == 640) {
+      for (const Frame& f : frames) {
+        Frame copy;
+        copy.gray = f.gray;
+        std::copy(f.corners, f.corners + 4, copy.corners);
+        sized.push_back(std::move(copy));
+      }
+    } else {
+      for (const Frame& f : frames) {
+        Frame scaled;
+        scaled.gray = Resize(f.gray, width, height);
+        for (int k = 0; k < 4; ++k) scaled.corners[k] = Eigen::Vector2d(f.corners[k].x() * sx, f.corners[k].y() * sy);
+        sized.push_back(std::move(scaled));
+      }
+      sized_camera.width = width;
+      sized_camera.height = height;
+      sized_camera.fx *= sx;
+      sized_camera.fy *= sy;
+      sized_camera.cx = (camera.cx + 0.5) * sx - 0.5;
+      sized_camera.cy = (camera.cy + 0.5) * sy - 0.5;
+    }
+    std::vector<double> plain_ms, tracker_ms, ratios;
+    RunResult plain, tracked;
+    TrackerBreakdown breakdown;
+    for (int r = 0; r < repeats; ++r) {
+      plain = RunPlain(sized);
+      tracked = RunTracker(sized, sized_camera, &breakdown);
+      plain_ms.push_back(plain.ms_per_frame);
+      tracker_ms.push_back(tracked.ms_per_frame);
+      ratios.push_back(tracked.ms_per_frame / plain.ms_per_frame);
+    }
+    std::printf("%dx%d, %zu frames, %d runs (median):\n", width, height, sized.size(), repeats);
+    std::printf("  (a) libapriltag defaults, full frame : %7.3f ms/frame, tag 12 in %d frames, mean corner error %.3f px\n",
+                Median(plain_ms), plain.found, plain.mean_corner_error);
+    std::printf("  (b) TagTracker defaults              : %7.3f ms/frame, tag 12 in %d frames, mean corner error %.3f px\n",
+                Median(tracker_ms), tracked.found, tracked.mean_corner_error);
+    std::printf("  ratio (b)/(a): %.3f (median of per-run ratios %.3f)\n", Median(tracker_ms) / Median(plain_ms),
+                Median(ratios));
+    std::printf("  tracker, last run: %d region-only frames, %d full-frame, %d region then full frame; per frame "
+                "detect %.3f ms, pose %.3f ms, Track() total %.3f ms\n",
+                breakdown.region_frames, breakdown.full_frames, breakdown.fallback_frames, breakdown.detect_ms,
+                breakdown.pose_ms, breakdown.total_ms);
+  }
+  return 0;
+}

@@ -1,0 +1,46 @@
+#include "core/mesh/mesh.h"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <string>
+
+namespace reconar {
+
+Status ValidateMesh(const Mesh& mesh) {
+  const size_t num_vertices = mesh.positions.size();
+  if (!mesh.normals.empty() && mesh.normals.size() != num_vertices) {
+    return InvalidArgument("mesh: " + std::to_string(mesh.normals.size()) + " normals for " +
+                           std::to_string(num_vertices) + " vertices");
+  }
+  if (!mesh.colors.empty() && mesh.colors.size() != num_vertices) {
+    return InvalidArgument("mesh: " + std::to_string(mesh.colors.size()) + " colours for " +
+                           std::to_string(num_vertices) + " vertices");
+  }
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (const uint32_t index : mesh.triangles[t]) {
+      if (index >= num_vertices) {
+        return InvalidArgument("mesh: triangle " + std::to_string(t) + " has vertex index " + std::to_string(index) +
+                               " out of range [0, " + std::to_string(num_vertices) + ")");
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+void ComputeVertexNormals(Mesh* mesh) {
+  std::vector<Eigen::Vector3f>& normals = mesh->normals;
+  normals.assign(mesh->positions.size(), Eigen::Vector3f::Zero());
+  for (const std::array<uint32_t, 3>& triangle : mesh->triangles) {
+    const Eigen::Vector3f& a = mesh->positions[triangle[0]];
+    // The cross product's length is twice the triangle's area: the weight comes for free.
+    const Eigen::Vector3f weighted = (mesh->positions[triangle[1]] - a).cross(mesh->positions[triangle[2]] - a);
+    for (const uint32_t index : triangle) normals[index] += weighted;
+  }
+  for (Eigen::Vector3f& normal : normals) {
+    const float length = normal.norm();
+    normal = length > 1e-30f && std::isfinite(length) ? Eigen::Vector3f(normal / length) : Eigen::Vector3f::UnitZ();
+  }
+}
+
+}  // namespace reconar

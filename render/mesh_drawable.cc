@@ -1,0 +1,182 @@
+#include "render/mesh_drawable.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "render/gl_error.h"
+
+namespace reconar {
+namespace {
+
+enum AttributeLocation : GLuint { kPosition = 0, kNormal = 1, kColor = 2 };
+
+// Shading modes of the fragment shader.
+enum ShadingMode : GLint { kVertexNormals = 0, kFlatNormals = 1, kUnlit = 2 };
+
+constexpr const char* kVertexShader = R"(#version 300 es
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec4 a_color;
+uniform mat4 u_clip_from_model;
+uniform mat4 u_cam_from_model;
+uniform mat3 u_cam_normal_from_model;
+uniform float u_point_size;
+out vec3 v_cam_position;
+out vec3 v_cam_normal;
+out vec4 v_color;
+void main() {
+  v_cam_position = (u_cam_from_model * vec4(a_position, 1.0)).xyz;
+  v_cam_normal = u_cam_normal_from_model * a_normal;
+  v_color = a_color;
+  gl_PointSize = u_point_size;
+  gl_Position = u_clip_from_model * vec4(a_position, 1.0);
+}
+)";
+
+constexpr const char* kFragmentShader = R"(#version 300 es
+precision highp float;
+uniform int u_shading_mode;
+in vec3 v_cam_position;
+in vec3 v_cam_normal;
+in vec4 v_color;
+out vec4 o_color;
+void main() {
+  float shade = 1.0;
+  if (u_shading_mode != 2) {
+    vec3 normal = u_shading_mode == 0 ? v_cam_normal
+                                      : cross(dFdx(v_cam_position), dFdy(v_cam_position));
+    float length_n = length(normal);
+    vec3 to_eye = normalize(-v_cam_position);
+    shade = length_n > 0.0 ? 0.2 + 0.8 * abs(dot(normal / length_n, to_eye)) : 1.0;
+  }
+  o_color = vec4(v_color.rgb * shade, 1.0);
+}
+)";
+
+template <typename T>
+GlBuffer MakeArrayBuffer(GLenum target, const T* data, size_t count) {
+  GlBuffer buffer = MakeGlBuffer();
+  glBindBuffer(target, buffer.get());
+  glBufferData(target, static_cast<GLsizeiptr>(count * sizeof(T)), data, GL_STATIC_DRAW);
+  return buffer;
+}
+
+void ToGl(const Eigen::Matrix4d& m, float out[16]) {
+  const Eigen::Matrix4f f = m.cast<float>();
+  std::copy(f.data(), f.data() + 16, out);  // column major, as GL wants
+}
+
+}  // namespace
+
+Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh) {
+  const size_t n = mesh.positions.size();
+  if (n == 0) return InvalidArgument("MeshDrawable::Upload: the mesh has no vertices");
+  if (n > static_cast<size_t>(INT32_MAX)) return InvalidArgument("MeshDrawable::Upload: too many vertices");
+  RECONAR_RETURN_IF_ERROR(ValidateMesh(mesh).WithContext("MeshDrawable::Upload"));
+  for (size_t i = 0; i < n; ++i) {
+    if (!mesh.positions[i].allFinite()) {
+      return InvalidArgument("MeshDrawable::Upload: vertex " + std::to_string(i) + " is not finite");
+    }
+  }
+
+  MeshDrawable drawable;
+  drawable.vertex_count_ = static_cast<int>(n);
+  drawable.index_count_ = static_cast<int64_t>(mesh.triangles.size()) * 3;
+  drawable.has_normals_ = !mesh.normals.empty();
+  drawable.has_colors_ = !mesh.colors.empty();
+  drawable.vertex_array_ = MakeGlVertexArray();
+  glBindVertexArray(drawable.vertex_array_.get());
+
+  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "packed positions");
+  drawable.positions_ = MakeArrayBuffer(GL_ARRAY_BUFFER, mesh.positions.data(), n);
+  glEnableVertexAttribArray(kPosition);
+  glVertexAttribPointer(kPosition, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  if (drawable.has_normals_) {
+    drawable.normals_ = MakeArrayBuffer(GL_ARRAY_BUFFER, mesh.normals.data(), n);
+    glEnableVertexAttribArray(kNormal);
+    glVertexAttribPointer(kNormal, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  }
+  if (drawable.has_colors_) {
+    static_assert(sizeof(std::array<uint8_t, 4>) == 4, "packed colours");
+    drawable.colors_ = MakeArrayBuffer(GL_ARRAY_BUFFER, mesh.colors.data(), n);
+    glEnableVertexAttribArray(kColor);
+    glVertexAttribPointer(kColor, 4, GL_UNSIGNED_BYTE, GL_TRUE, 0, nullptr);
+  }
+  if (!mesh.triangles.empty()) {
+    static_assert(sizeof(std::array<uint32_t, 3>) == 12, "packed triangles");
+    if (n <= 65536) {  // 16-bit indices: half the index traffic
+      std::vector<uint16_t> short_indices;
+      short_indices.reserve(mesh.triangles.size() * 3);
+      for (const auto& triangle : mesh.triangles) {
+        for (uint32_t index : triangle) short_indices.push_back(static_cast<uint16_t>(index));
+      }
+      drawable.indices_ = MakeArrayBuffer(GL_ELEMENT_ARRAY_BUFFER, short_indices.data(), short_indices.size());
+      drawable.index_type_ = GL_UNSIGNED_SHORT;
+    } else {
+      drawable.indices_ = MakeArrayBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.triangles.data(), mesh.triangles.size());
+      drawable.index_type_ = GL_UNSIGNED_INT;
+    }
+  }
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
+  RECONAR_RETURN_IF_ERROR(CheckGlError("MeshDrawable::Upload"));
+  return drawable;
+}
+
+Result<MeshPipeline> MeshPipeline::Create() {
+  MeshPipeline pipeline;
+  RECONAR_ASSIGN_OR_RETURN(pipeline.program_, ShaderProgram::Build("mesh", kVertexShader, kFragmentShader));
+  pipeline.clip_from_model_ = pipeline.program_.Uniform("u_clip_from_model");
+  pipeline.cam_from_model_ = pipeline.program_.Uniform("u_cam_from_model");
+  pipeline.cam_normal_from_model_ = pipeline.program_.Uniform("u_cam_normal_from_model");
+  pipeline.point_size_ = pipeline.program_.Uniform("u_point_size");
+  pipeline.shading_mode_ = pipeline.program_.Uniform("u_shading_mode");
+  return pipeline;
+}
+
+Status MeshPipeline::Draw(const MeshDrawable& mesh, const Eigen::Matrix4d& clip_from_cam,
+                          const Eigen::Matrix4d& cam_from_model, const MeshStyle& style) const {
+  float clip_from_model[16];
+  float cam_from_model_gl[16];
+  ToGl(clip_from_cam * cam_from_model, clip_from_model);
+  ToGl(cam_from_model, cam_from_model_gl);
+  // Normals transform by the inverse transpose; for a similarity that is the rotation up to scale,
+  // and the shader normalises.
+  const Eigen::Matrix3f normal_from_model = cam_from_model.topLeftCorner<3, 3>().inverse().transpose().cast<float>();
+  GLint mode = kUnlit;
+  if (style.shading) {
+    if (mesh.has_normals_) {
+      mode = kVertexNormals;
+    } else if (!mesh.is_point_cloud()) {
+      mode = kFlatNormals;
+    }
+  }
+
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glUseProgram(program_.id());
+  glUniformMatrix4fv(clip_from_model_, 1, GL_FALSE, clip_from_model);
+  glUniformMatrix4fv(cam_from_model_, 1, GL_FALSE, cam_from_model_gl);
+  glUniformMatrix3fv(cam_normal_from_model_, 1, GL_FALSE, normal_from_model.data());
+  glUniform1f(point_size_, style.point_size_px);
+  glUniform1i(shading_mode_, mode);
+  glBindVertexArray(mesh.vertex_array_.get());
+  // Attributes without an array take the current generic value (context state, not VAO state).
+  if (!mesh.has_colors_) glVertexAttrib4f(kColor, style.color[0], style.color[1], style.color[2], 1.0f);
+  if (!mesh.has_normals_) glVertexAttrib3f(kNormal, 0.0f, 0.0f, 0.0f);
+  if (mesh.is_point_cloud()) {
+    glDrawArrays(GL_POINTS, 0, mesh.vertex_count_);
+  } else {
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.index_count_), mesh.index_type_, nullptr);
+  }
+  glBindVertexArray(0);
+  return CheckGlError("MeshPipeline::Draw");
+}
+
+}  // namespace reconar

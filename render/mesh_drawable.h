@@ -1,0 +1,69 @@
+#pragma once
+// MeshDrawable: a Mesh uploaded once to GL buffers (positions, optional normals and RGBA colours,
+// triangle indices, 16-bit when the mesh has at most 65536 vertices). MeshPipeline: the program that draws it with a
+// headlight Lambert shade (light at the camera, two-sided): vertex normals when the mesh has them, otherwise the flat
+// normal of each triangle from screen-space derivatives of the camera-frame position. A mesh without triangles is drawn
+// as GL_POINTS of MeshStyle::point_size_px (unlit without normals).
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+
+#include "core/base/status.h"
+#include "core/mesh/mesh.h"
+#include "render/gl_handles.h"
+#include "render/shader_program.h"
+
+namespace reconar {
+
+class MeshDrawable {
+ public:
+  // Needs a current GLES 3 context. InvalidArgument for an empty mesh, normals or colours whose
+  // count differs from the positions', a triangle index out of range, non-finite positions.
+  static Result<MeshDrawable> Upload(const Mesh& mesh);
+
+  bool is_point_cloud() const { return index_count_ == 0; }
+  bool has_normals() const { return has_normals_; }
+  bool has_colors() const { return has_colors_; }
+  int vertex_count() const { return vertex_count_; }
+  int64_t triangle_count() const { return index_count_ / 3; }
+
+ private:
+  friend class MeshPipeline;
+  GlVertexArray vertex_array_;
+  GlBuffer positions_;
+  GlBuffer normals_;
+  GlBuffer colors_;
+  GlBuffer indices_;
+  int vertex_count_ = 0;
+  int64_t index_count_ = 0;
+  GLenum index_type_ = GL_UNSIGNED_INT;  // GL_UNSIGNED_SHORT for meshes of <= 65536 vertices
+  bool has_normals_ = false;
+  bool has_colors_ = false;
+};
+
+struct MeshStyle {
+  std::array<float, 3> color = {0.85f, 0.75f, 0.6f};  // RGB 0..1 when the mesh has no vertex colours
+  float point_size_px = 3.0f;                         // point clouds
+  bool shading = true;                                // headlight Lambert; false = flat colour
+};
+
+class MeshPipeline {
+ public:
+  // Needs a current GLES 3 context.
+  static Result<MeshPipeline> Create();
+
+  // Draws into the bound framebuffer with depth test. clip_from_cam: render/camera_projection.h;
+  // cam_from_model: a similarity (render/model_placement.h CamFromModel).
+  Status Draw(const MeshDrawable& mesh, const Eigen::Matrix4d& clip_from_cam, const Eigen::Matrix4d& cam_from_model,
+              const MeshStyle& style) const;
+
+ private:
+  ShaderProgram program_;
+  GLint clip_from_model_ = -1;
+  GLint cam_from_model_ = -1;
+  GLint cam_normal_from_model_ = -1;
+  GLint point_size_ = -1;
+  GLint shading_mode_ = -1;
+};
+
+}  // namespace reconar

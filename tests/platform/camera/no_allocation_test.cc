@@ -1,0 +1,81 @@
+// After the first frame, Next() + Release() on a recording of raw YUYV / NV12 buffers makes no
+// heap allocation (the steady state of a tracking loop fed by a camera).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "platform/camera/recorded_frames.h"
+#include "tests/platform/camera/camera_fixture.h"
+#include "tests/platform/camera/jpeg_reference.h"
+#include "tests/support/allocation_counter.h"
+
+namespace reconar {
+namespace {
+
+const std::string kFixture = testing::CameraFixturePath();
+
+// A recording of the fixture's NV12 and YUYV records (frames 1 and 2), repeated `pairs` times.
+std::string MakeRawRecording(int pairs) {
+  const std::string file = testing::ReadFileBytes(kFixture);
+  const std::string raw_records = file.substr(testing::RecordOffset(file, 1));  // skip the MJPEG frame
+  std::string out = file.substr(0, kRecordedFramesHeaderBytes);
+  for (int i = 0; i < pairs; ++i) out += raw_records;
+  const std::string path = ::testing::TempDir() + "camera_no_allocation.frames";
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << out;
+  return path;
+}
+
+struct Loop {
+  long allocations = -1;
+  int frames = 0;
+  bool all_ok = true;
+};
+
+TEST(CameraNoAllocation, RecordedYuyvAndNv12SteadyState) {
+  const std::string path = MakeRawRecording(8);
+  for (const bool want_rgb : {true, false}) {
+    for (const GrayRange gray_range : {GrayRange::kAsDelivered, GrayRange::kFull}) {
+      FrameSourceOptions options;
+      options.want_rgb = want_rgb;
+      options.gray_range = gray_range;
+      auto source = RecordedFrameSource::Open(path, options);
+      ASSERT_TRUE(source.ok()) << source.status().ToString();
+      // Count allocations through the last frame, excluding the end-of-stream status.
+      Loop loop;
+      {
+        auto first = (*source)->Next();
+        ASSERT_TRUE(first.ok()) << first.status().ToString();
+        (*source)->Release(*first);
+        testing::NoAllocationScope scope;
+        for (int i = 1; i < 16; ++i) {
+          Result<Frame> frame = (*source)->Next();
+          if (!frame.ok()) {
+            loop.all_ok = false;
+            break;
+          }
+          ++loop.frames;
+          (*source)->Release(*frame);
+        }
+        loop.allocations = scope.allocations();
+      }
+      EXPECT_TRUE(loop.all_ok);
+      EXPECT_EQ(loop.frames, 15);
+      EXPECT_EQ(loop.allocations, 0) << "want_rgb " << want_rgb;
+      EXPECT_TRUE(IsEndOfStream((*source)->Next().status()));
+    }
+  }
+  std::remove(path.c_str());
+}
+
+TEST(CameraNoAllocation, TheGuardCountsAllocations) {
+  testing::NoAllocationScope scope;
+  std::string* heap = new std::string(100, 'x');
+  const long counted = scope.allocations();
+  delete heap;
+  EXPECT_GE(counted, 1);
+}
+
+}  // namespace
+}  // namespace reconar

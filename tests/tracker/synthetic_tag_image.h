@@ -1,0 +1,45 @@
+#pragma once
+// Synthetic camera frames of AprilTags for the tracker tests: the real tag bitmap (RenderTagBitmap,
+// i.e. libapriltag's apriltag_to_image) seen by a pinhole camera (no distortion) at a known pose,
+// rendered with area coverage (supersampling) and an optional Gaussian blur. Pixel (i, j) covers
+// [i, i+1] x [j, j+1] in the coordinates of the corners returned here (libapriltag's convention,
+// tag_detector.h); CameraIntrinsics projections are shifted by +0.5 accordingly.
+#include <array>
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "core/base/image.h"
+#include "core/math/camera_intrinsics.h"
+#include "core/math/rigid3.h"
+#include "tracker/tag_detector.h"
+
+namespace reconar {
+namespace testing {
+
+struct SyntheticTag {
+  TagFamily family = TagFamily::kTag36h11;
+  int id = 0;
+  double size = 0.1;  // black-square edge, metres
+  Rigid3 cam_from_tag;
+};
+
+struct SyntheticRenderOptions {
+  uint8_t background = 170;
+  int supersampling = 8;     // samples per pixel side
+  double blur_sigma = 0.0;   // pixels; 0 = none
+};
+
+// Draws the tag over `image` (a gray image the caller filled, e.g. with the background).
+// Returns false when the family cannot be rendered or the tag is not in front of the camera.
+bool DrawTag(const SyntheticTag& tag, const CameraIntrinsics& camera, int supersampling, Image<uint8_t>* image);
+
+// A camera.width x camera.height frame of the background with the tags drawn, then blurred.
+Image<uint8_t> RenderTags(const SyntheticTag* tags, int count, const CameraIntrinsics& camera,
+                          const SyntheticRenderOptions& options);
+
+// The tag's corners in libapriltag's order and pixel convention.
+std::array<Eigen::Vector2d, 4> ProjectedCorners(const SyntheticTag& tag, const CameraIntrinsics& camera);
+
+}  // namespace testing
+}  // namespace reconar

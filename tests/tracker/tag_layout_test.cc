@@ -1,0 +1,135 @@
+#include "tracker/tag_layout.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "tests/tracker/synthetic_tag_image.h"
+
+namespace reconar {
+namespace {
+
+using testing::RenderTags;
+using testing::SyntheticRenderOptions;
+using testing::SyntheticTag;
+
+TEST(TagLayoutTest, ParsesBothLineFormsAndComments) {
+  const Result<TagLayout> layout = ParseTagLayout(
+      "# a board\n"
+      "3 0.05 0.1 0.2            # planar, no angle\n"
+      "\n"
+      "1 0.04 -0.1 0.0 90\n"
+      "7 0.06 0 0 0.5 0.7071067811865476 0.7071067811865476 0 0\n",
+      "board.txt");
+  ASSERT_TRUE(layout.ok()) << layout.status().ToString();
+  ASSERT_EQ(layout->tags().size(), 3u);
+  EXPECT_EQ(layout->tags()[0].id, 1);  // sorted by id
+  const LayoutTag* one = layout->Find(1);
+  ASSERT_NE(one, nullptr);
+  EXPECT_DOUBLE_EQ(one->size, 0.04);
+  EXPECT_LT((one->layout_from_tag * Eigen::Vector3d(1, 0, 0) - Eigen::Vector3d(-0.1, 1.0, 0.0)).norm(), 1e-12);
+  const LayoutTag* seven = layout->Find(7);
+  ASSERT_NE(seven, nullptr);
+  EXPECT_LT((seven->layout_from_tag.rotation * Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+  EXPECT_EQ(layout->Find(2), nullptr);
+  EXPECT_FALSE(layout->IsPlanar());
+  EXPECT_TRUE(ParseTagLayout("1 0.1 0 0\n2 0.1 0.2 0 45\n", "x").value().IsPlanar());
+}
+
+TEST(TagLayoutTest, ErrorsNameTheFileAndLine) {
+  const auto message = [](const std::string& text) {
+    const Result<TagLayout> layout = ParseTagLayout(text, "board.txt");
+    EXPECT_FALSE(layout.ok()) << text;
+    return layout.ok() ? std::string() : layout.status().message();
+  };
+  EXPECT_NE(message("1 0.1 0 0\n2 0.1 zero 0\n").find("board.txt:2"), std::string::npos);
+  EXPECT_NE(message("1 0.1 0 0 0 0\n").find("6 fields"), std::string::npos);
+  EXPECT_NE(message("1 0.1 0 0\n1 0.2 1 1\n").find("twice"), std::string::npos);
+  EXPECT_NE(message("1 -0.1 0 0\n").find("size"), std::string::npos);
+  EXPECT_NE(message("1.5 0.1 0 0\n").find("integer"), std::string::npos);
+  EXPECT_NE(message("1 0.1 0 0 0 0 0 0 0\n").find("quaternion"), std::string::npos);
+  EXPECT_NE(message("# nothing\n").find("no tags"), std::string::npos);
+  const Result<TagLayout> missing = ReadTagLayout("/nonexistent/board.txt");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.status().code(), StatusCode::kNotFound);
+}
+
+CameraIntrinsics TestCamera() {
+  CameraIntrinsics camera;
+  camera.width = 640;
+  camera.height = 480;
+  camera.fx = camera.fy = 620.0;
+  camera.cx = 320.0;
+  camera.cy = 240.0;
+  return camera;
+}
+
+// Renders the layout's tags under cam_from_layout and checks the recovered pose.
+void CheckBoardPose(const TagLayout& layout, const Rigid3& cam_from_layout, double max_rotation_deg,
+                    double max_translation_m) {
+  const CameraIntrinsics camera = TestCamera();
+  std::vector<SyntheticTag> tags;
+  for (const LayoutTag& t : layout.tags()) {
+    SyntheticTag tag;
+    tag.id = t.id;
+    tag.size = t.size;
+    tag.cam_from_tag = cam_from_layout * t.layout_from_tag;
+    tags.push_back(tag);
+  }
+  SyntheticRenderOptions render;
+  render.blur_sigma = 0.5;
+  const Image<uint8_t> image = RenderTags(tags.data(), static_cast<int>(tags.size()), camera, render);
+  TagDetectorOptions options;
+  options.quad_decimate = 1.0f;
+  auto detector = TagDetector::Create(options);
+  ASSERT_TRUE(detector.ok());
+  TagDetectionList detections(16);
+  ASSERT_TRUE((*detector)->Detect(image.view(), &detections).ok());
+  ASSERT_EQ(detections.size(), static_cast<int>(tags.size()));
+  const Result<BoardPose> board = EstimateBoardPose(layout, detections, camera);
+  ASSERT_TRUE(board.ok()) << board.status().ToString();
+  EXPECT_EQ(board->tags_used, static_cast<int>(tags.size()));
+  EXPECT_LT(RotationAngle(board->cam_from_layout.rotation, cam_from_layout.rotation) * 180.0 / M_PI,
+            max_rotation_deg);
+  EXPECT_LT((board->cam_from_layout.translation - cam_from_layout.translation).norm(), max_translation_m);
+  EXPECT_LT(board->rms_reprojection_px, 0.3);
+}
+
+TEST(TagLayoutTest, PlanarBoardPoseFromAllCorners) {
+  const Result<TagLayout> layout =
+      ParseTagLayout("0 0.06 -0.05 -0.05\n1 0.06 0.05 -0.05 90\n2 0.06 0.05 0.05\n3 0.06 -0.05 0.05 -30\n", "board");
+  ASSERT_TRUE(layout.ok());
+  Rigid3 cam_from_layout;
+  cam_from_layout.rotation = Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix() *
+                             Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  cam_from_layout.translation = Eigen::Vector3d(0.01, -0.02, 0.45);
+  CheckBoardPose(*layout, cam_from_layout, 0.3, 0.002);
+}
+
+TEST(TagLayoutTest, NonPlanarLayoutPoseFromAllCorners) {
+  // Two tags on the faces of a box corner, 90 deg apart.
+  const Result<TagLayout> layout = ParseTagLayout(
+      "4 0.06 0.05 0 0 1 0 0 0\n"
+      "5 0.06 0 0 -0.05 0.7071067811865476 0 -0.7071067811865476 0\n",
+      "corner");
+  ASSERT_TRUE(layout.ok());
+  EXPECT_FALSE(layout->IsPlanar());
+  Rigid3 cam_from_layout;
+  cam_from_layout.rotation = Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY()).toRotationMatrix() *
+                             Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  cam_from_layout.translation = Eigen::Vector3d(0.0, 0.0, 0.4);
+  CheckBoardPose(*layout, cam_from_layout, 0.3, 0.002);
+}
+
+TEST(TagLayoutTest, BoardPoseNeedsALayoutTag) {
+  const Result<TagLayout> layout = ParseTagLayout("0 0.06 0 0\n", "board");
+  ASSERT_TRUE(layout.ok());
+  TagDetectionList none(4);
+  EXPECT_EQ(EstimateBoardPose(*layout, none, TestCamera()).status().code(), StatusCode::kFailedPrecondition);
+}
+
+}  // namespace
+}  // namespace reconar

@@ -1,0 +1,30 @@
+#pragma once
+// Command-line options shared by the AR subcommands (track, view, calibrate).
+#include <set>
+#include <string>
+
+#include "core/base/status.h"
+#include "core/math/camera_intrinsics.h"
+#include "tools/args.h"
+#include "tracker/tag_tracker.h"
+
+namespace reconar::tools {
+
+// "fx,fy,cx,cy" or "fx,fy,cx,cy,k1,k2" (pixels, the centre of the top-left pixel at (0, 0)), or
+// the path of an intrinsics file written by `reconar calibrate`.
+Result<CameraIntrinsics> IntrinsicsFromArg(const std::string& value);
+
+// --intrinsics, --tag-size, --family, --decimate, --threads, --full-frame-interval, --max-tags.
+Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args);
+inline const std::set<std::string> kTrackerValuedOptions = {"intrinsics", "tag-size", "family", "decimate",
+                                                              "threads", "full-frame-interval", "max-tags"};
+inline constexpr char kTrackerOptionsHelp[] =
+    "  --intrinsics K        fx,fy,cx,cy[,k1,k2] in pixels, or a file from `reconar calibrate`\n"
+    "  --tag-size METRES     edge of the tag's black square (all tags)\n"
+    "  --family F            tag family (default tag36h11)\n"
+    "  --decimate D          quad decimation of full-frame searches (default 2; 1 finds smaller tags)\n"
+    "  --full-frame-interval N   search the whole frame every N frames for new tags (default 10)\n"
+    "  --max-tags N          tags followed at once (default 16)\n"
+    "  --threads N           libapriltag threads (default 1)\n";
+
+}  // namespace reconar::tools

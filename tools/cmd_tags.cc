@@ -1,0 +1,146 @@
+// reconar tags: a printable sheet of AprilTags whose detection border measures exactly --size.
+#include <cctype>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/base/atomic_file.h"
+#include "tools/commands.h"
+#include "tools/tag_sheet.h"
+#include "tracker/tag_detector.h"
+
+namespace reconar::tools {
+namespace {
+
+constexpr char kHelp[] =
+    "usage: reconar tags --ids LIST --size METRES --out FILE.{svg,pdf} [options]\n"
+    "\n"
+    "Writes a printable sheet of AprilTags. The tag size is the edge of the detection border (the\n"
+    "black square of tag36h11: what `--tag-size` means in `reconar track`). Print at 100 %\n"
+    "(no fit-to-page) and check the 100 mm scale bar. SVG writes one file per page (FILE, FILE-2, ...),\n"
+    "PDF one file with a page each.\n"
+    "  --family F        tag family (default tag36h11; also tag25h9, tag16h5, tagStandard41h12, ...)\n"
+    "  --ids LIST        ids, e.g. 0-3 or 0,5,7-9\n"
+    "  --size METRES     tag edge, e.g. 0.16\n"
+    "  --paper NAME      a4 (default), a3, letter, or WIDTHxHEIGHT in mm (e.g. 300x400)\n"
+    "  --margin MM       page margin (default 10)\n"
+    "  --out FILE        .svg or .pdf\n";
+
+Result<std::vector<int>> ParseIds(const std::string& text) {
+  std::vector<int> ids;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    const size_t comma = text.find(',', pos);
+    const std::string item = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    int first = 0;
+    int last = 0;
+    char extra = 0;
+    if (std::sscanf(item.c_str(), "%d-%d%c", &first, &last, &extra) == 2) {
+    } else if (std::sscanf(item.c_str(), "%d%c", &first, &extra) == 1) {
+      last = first;
+    } else {
+      return InvalidArgument("--ids: '" + item + "' is not an id or a range like 0-3");
+    }
+    if (first < 0 || last < first) return InvalidArgument("--ids: '" + item + "' is not an increasing range");
+    for (int id = first; id <= last; ++id) ids.push_back(id);
+    if (comma == std::string::npos) break;
+    pos = comma + 1;
+  }
+  return ids;
+}
+
+Status ApplyPaper(const std::string& name, TagSheetOptions* options) {
+  if (name == "a4") {
+    options->page_width_mm = 210, options->page_height_mm = 297;
+  } else if (name == "a3") {
+    options->page_width_mm = 297, options->page_height_mm = 420;
+  } else if (name == "letter") {
+    options->page_width_mm = 215.9, options->page_height_mm = 279.4;
+  } else {
+    double width = 0, height = 0;
+    char extra = 0;
+    if (std::sscanf(name.c_str(), "%lfx%lf%c", &width, &height, &extra) != 2 || width <= 0 || height <= 0) {
+      return InvalidArgument("--paper: '" + name + "' is not a4, a3, letter or WIDTHxHEIGHT in mm");
+    }
+    options->page_width_mm = width, options->page_height_mm = height;
+  }
+  return Status::Ok();
+}
+
+std::string Lower(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+std::string PagePath(const std::string& out, size_t page) {
+  if (page == 0) return out;
+  return out.substr(0, out.size() - 4) + "-" + std::to_string(page + 1) + ".svg";
+}
+
+}  // namespace
+
+int RunTags(int argc, char** argv, int first) {
+  Args args({"family", "ids", "size", "paper", "margin", "out"}, {});
+  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
+  if (args.Has("help")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  if (!args.positionals().empty() || !args.Has("ids") || !args.Has("size") || !args.Has("out")) {
+    std::fputs(kHelp, stderr);
+    return 2;
+  }
+  const std::string out = args.Get("out");
+  const std::string extension = Lower(out.size() >= 4 ? out.substr(out.size() - 4) : "");
+  if (extension != ".svg" && extension != ".pdf") {
+    return Fail(InvalidArgument("--out: '" + out + "' must end in .svg or .pdf"));
+  }
+  TagSheetOptions options;
+  options.family = args.Get("family", "tag36h11");
+  auto family = ParseTagFamily(options.family);
+  if (!family.ok()) return Fail(family.status());
+  auto size = args.GetDouble("size", 0.0, 1e-4, 10.0);
+  if (!size.ok()) return Fail(size.status());
+  options.tag_size_mm = *size * 1000.0;
+  if (Status s = ApplyPaper(args.Get("paper", "a4"), &options); !s.ok()) return Fail(s);
+  auto margin = args.GetDouble("margin", 10.0, 0.0, 100.0);
+  if (!margin.ok()) return Fail(margin.status());
+  options.margin_mm = *margin;
+  auto ids = ParseIds(args.Get("ids"));
+  if (!ids.ok()) return Fail(ids.status());
+
+  std::vector<SheetTag> bitmaps;
+  for (int id : *ids) {
+    auto rendered = RenderTagBitmap(*family, id);
+    if (!rendered.ok()) return Fail(rendered.status().WithContext("--ids"));
+    SheetTag bitmap;
+    bitmap.id = id;
+    bitmap.total_width = rendered->pixels.width();
+    bitmap.width_at_border = rendered->width_at_border;
+    for (int y = 0; y < rendered->pixels.height(); ++y) {
+      for (int x = 0; x < rendered->pixels.width(); ++x) bitmap.black.push_back(rendered->pixels.row(y)[x] < 128);
+    }
+    bitmaps.push_back(std::move(bitmap));
+  }
+  auto sheet = LayoutTagSheet(std::move(bitmaps), options);
+  if (!sheet.ok()) return Fail(sheet.status());
+
+  std::vector<std::string> written;
+  if (extension == ".pdf") {
+    if (Status s = WriteFileAtomically(out, RenderPdf(*sheet)); !s.ok()) return Fail(s);
+    written.push_back(out);
+  } else {
+    for (size_t page = 0; page < sheet->pages.size(); ++page) {
+      const std::string path = PagePath(out, page);
+      if (Status s = WriteFileAtomically(path, RenderSvgPage(*sheet, page)); !s.ok()) return Fail(s);
+      written.push_back(path);
+    }
+  }
+  std::fprintf(stderr, "reconar tags: %zu %s tag(s) of %.1f mm on %zu page(s):", ids->size(), options.family.c_str(),
+               options.tag_size_mm, sheet->pages.size());
+  for (const std::string& path : written) std::fprintf(stderr, " %s", path.c_str());
+  std::fputc('\n', stderr);
+  return 0;
+}
+
+}  // namespace reconar::tools

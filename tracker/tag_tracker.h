@@ -1,0 +1,133 @@
+#pragma once
+// TagTracker: AprilTags followed through a video. Per frame:
+//  1. predict every followed tag's pose (constant velocity on the last two measurements, or the last
+//     pose), project its square and take the bounding box plus a margin as its search region;
+//  2. detect inside each region only (TagDetector::DetectInRegion, pixels not copied);
+//  3. search the full frame instead when no tag is followed, when a region search missed its tag,
+//     and every full_frame_interval frames (new tags, lost tags);
+//  4. estimate each found tag's pose (tag_pose.h: IPPE + LM) and filter it: translation by an
+//     alpha-beta (constant-velocity) filter, rotation by slerp toward the measurement.
+// Per-tag states: kTracking (measured this frame), kSearching (missed for fewer than
+// lost_after_missed_frames consecutive frames: still predicted and region-searched), kLost (missed
+// that many frames: only a full-frame search finds it again, reported as `reacquired`).
+//
+// Frames and pixels: see tag_pose.h and tag_detector.h (corners in libapriltag's convention, the
+// centre of the top-left pixel at (0.5, 0.5); cam_from_tag with the tag's z axis toward the viewer).
+//
+// Memory: every buffer (tracks, detection lists, the report's tag list) is sized at construction
+// from max_tags; Track() makes no heap allocation in our code in steady state (proved by
+// tests/tracker/tag_tracker_test.cc with a counting operator new). libapriltag itself calls C
+// malloc/free inside every detection (working images, clusters, quads); that is not ours to avoid.
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/base/status.h"
+#include "core/math/camera_intrinsics.h"
+#include "core/math/rigid3.h"
+#include "tracker/tag_detector.h"
+#include "tracker/tag_pose.h"
+
+namespace reconar {
+
+struct TagTrackerOptions {
+  // Used for full-frame searches. Region searches use the same options except quad_decimate.
+  TagDetectorOptions detector;
+  // quad_decimate inside the predicted regions (the full-frame default: a tag found at that
+  // decimation is found again at it in its region).
+  float region_quad_decimate = 2.0f;
+  CameraIntrinsics intrinsics;  // valid() required
+  double tag_size = 0.0;        // edge of the black square in metres (> 0), all tags
+  int max_tags = 16;            // tags followed at once; further ids are counted as dropped
+
+  enum class Prediction {
+    kLastPose,          // the region is the last measured square
+    kConstantVelocity,  // last pose moved by the motion between the last two measurements
+  };
+  Prediction prediction = Prediction::kConstantVelocity;
+  // Margin added on every side of the bounding box of the predicted and the last detected square:
+  // region_margin times the box's larger side plus region_margin_px. 0.25 covers the tag's white
+  // border (1/8 of the black square for tag36h11) plus an error of the prediction of 1/8 of the
+  // tag's size per frame.
+  double region_margin = 0.25;
+  int region_margin_px = 8;
+  int lost_after_missed_frames = 5;
+  // A full-frame search every this many frames even when every region search succeeds (0 = never),
+  // so that new tags and lost ones are found (30: within a second at 30 fps).
+  int full_frame_interval = 30;
+  // Filter gains in (0, 1]: 1 follows the measurement exactly.
+  double translation_alpha = 0.6;  // position correction
+  double translation_beta = 0.2;   // velocity correction
+  double rotation_alpha = 0.6;     // slerp fraction toward the measured rotation
+  PlanarPoseOptions pose;
+
+  Status Check() const;
+};
+
+enum class TagTrackState { kTracking, kSearching, kLost };
+const char* TagTrackStateName(TagTrackState state);
+
+struct TrackedTag {
+  int id = -1;
+  TagTrackState state = TagTrackState::kSearching;
+  bool measured = false;    // detected (and its pose estimated) in this frame
+  bool reacquired = false;  // measured in this frame after having been kLost
+  bool found_in_region = false;
+  int missed_frames = 0;    // consecutive frames without a measurement
+  TagDetection detection;   // this frame's detection (valid when measured)
+  TagPose pose;             // this frame's raw pose estimate (valid when measured)
+  Rigid3 cam_from_tag;      // = pose.cam_from_tag when measured, else the last measurement
+  Rigid3 smoothed_cam_from_tag;  // the filtered pose (predicted forward when not measured)
+};
+
+struct TagTrackerFrameReport {
+  enum class Search {
+    kRegions,              // only the predicted regions were searched
+    kFullFrame,            // only the full frame (nothing followed, or periodic)
+    kRegionsThenFullFrame  // a region search missed its tag and the full frame was searched too
+  };
+  int64_t frame_index = -1;
+  Search search = Search::kFullFrame;
+  int regions_searched = 0;
+  int detections = 0;      // raw detections over all searches
+  int tags_dropped = 0;    // ids not followed because max_tags were already followed
+  double detect_ms = 0.0;  // inside libapriltag
+  double pose_ms = 0.0;
+  double total_ms = 0.0;
+  std::vector<TrackedTag> tags;  // every followed tag (any state); capacity max_tags, reserved once
+};
+
+const char* SearchName(TagTrackerFrameReport::Search search);
+
+class TagTracker {
+ public:
+  // InvalidArgument for bad options; errors of TagDetector::Create.
+  static Result<std::unique_ptr<TagTracker>> Create(const TagTrackerOptions& options);
+  ~TagTracker();
+
+  // Processes the next frame (same size as the previous ones; a size change restarts the tracks).
+  // *report is overwritten; keep one report object across frames so its storage is reused.
+  Status Track(ImageView<const uint8_t> image, TagTrackerFrameReport* report);
+
+  const TagTrackerOptions& options() const { return options_; }
+
+ private:
+  struct FollowedTag;
+  explicit TagTracker(const TagTrackerOptions& options);
+  FollowedTag* FindTrack(int id);
+  bool PredictRegion(FollowedTag& track, int width, int height, int region[4]) const;
+  void Measure(FollowedTag& track, const TagDetection& detection, bool in_region, double* pose_ms);
+
+  TagTrackerOptions options_;
+  std::unique_ptr<TagDetector> full_detector_;
+  std::unique_ptr<TagDetector> region_detector_;
+  std::vector<FollowedTag> tracks_;
+  TagDetectionList scratch_;
+  int64_t frame_index_ = -1;
+  int width_ = 0;
+  int height_ = 0;
+};
+
+}  // namespace reconar
