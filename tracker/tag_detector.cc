@@ -130,6 +130,11 @@ Status TagDetector::Detect(ImageView<const uint8_t> image, TagDetectionList* det
   return DetectView(image, 0, 0, detections);
 }
 
+void TagDetector::SetQuadDecimate(float quad_decimate) {
+  options_.quad_decimate = std::isfinite(quad_decimate) ? std::max(1.0f, quad_decimate) : 1.0f;
+  impl_->detector->quad_decimate = options_.quad_decimate;
+}
+
 Status TagDetector::DetectInRegion(ImageView<const uint8_t> image, int x0, int y0, int width, int height,
                                    TagDetectionList* detections) {
   const int x_begin = std::max(0, x0);

@@ -127,6 +127,9 @@ class TagDetector {
   TagDetector& operator=(const TagDetector&) = delete;
 
   const TagDetectorOptions& options() const { return options_; }
+  // Changes quad_decimate for the following calls (>= 1; other values are clamped to 1). The
+  // tracker picks it per region from the tag's predicted size.
+  void SetQuadDecimate(float quad_decimate);
 
   // Detects tags in the whole view; *detections is cleared first. InvalidArgument for an empty
   // view, a stride < width or a size above libapriltag's int32 image limits.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -55,7 +56,12 @@ const char* SearchName(TagTrackerFrameReport::Search search) {
 
 Status TagTrackerOptions::Check() const {
   RECONAR_RETURN_IF_ERROR(detector.Check());
-  if (!(region_quad_decimate >= 1.0f)) return InvalidArgument("TagTrackerOptions.region_quad_decimate must be >= 1");
+  if (!(region_max_quad_decimate >= 1.0f) || !std::isfinite(region_max_quad_decimate)) {
+    return InvalidArgument("TagTrackerOptions.region_max_quad_decimate must be >= 1");
+  }
+  if (!(region_min_decimated_edge_px > 0.0) || !std::isfinite(region_min_decimated_edge_px)) {
+    return InvalidArgument("TagTrackerOptions.region_min_decimated_edge_px must be > 0");
+  }
   if (!intrinsics.valid()) return InvalidArgument("TagTrackerOptions.intrinsics need fx > 0 and fy > 0");
   if (!(tag_size > 0.0) || !std::isfinite(tag_size)) {
     return InvalidArgument("TagTrackerOptions.tag_size must be > 0 (metres), got " + std::to_string(tag_size));
@@ -81,9 +87,7 @@ Result<std::unique_ptr<TagTracker>> TagTracker::Create(const TagTrackerOptions& 
   RECONAR_RETURN_IF_ERROR(options.Check());
   std::unique_ptr<TagTracker> tracker(new TagTracker(options));
   RECONAR_ASSIGN_OR_RETURN(tracker->full_detector_, TagDetector::Create(options.detector));
-  TagDetectorOptions region_options = options.detector;
-  region_options.quad_decimate = options.region_quad_decimate;
-  RECONAR_ASSIGN_OR_RETURN(tracker->region_detector_, TagDetector::Create(region_options));
+  RECONAR_ASSIGN_OR_RETURN(tracker->region_detector_, TagDetector::Create(options.detector));
   tracker->tracks_.reserve(static_cast<size_t>(options.max_tags));
   // Several tags (and false quads of other ids) may share a region or the frame.
   tracker->scratch_ = TagDetectionList(4 * options.max_tags + 16);
@@ -97,7 +101,8 @@ TagTracker::FollowedTag* TagTracker::FindTrack(int id) {
   return nullptr;
 }
 
-bool TagTracker::PredictRegion(FollowedTag& track, int width, int height, int region[4]) const {
+bool TagTracker::PredictRegion(FollowedTag& track, int width, int height, int region[4],
+                               double* shortest_edge_px) const {
   Rigid3 predicted = track.last;
   if (options_.prediction == TagTrackerOptions::Prediction::kConstantVelocity && track.has_previous) {
     const Rigid3 motion = track.last * track.previous.Inverse();  // per frame, in the camera frame
@@ -107,15 +112,21 @@ bool TagTracker::PredictRegion(FollowedTag& track, int width, int height, int re
   // The box holds the predicted square and the last detected one.
   Eigen::Vector2d lo = track.detection.corners[0];
   Eigen::Vector2d hi = lo;
+  Eigen::Vector2d projected[4];
   for (int k = 0; k < 4; ++k) {
     lo = lo.cwiseMin(track.detection.corners[k]);
     hi = hi.cwiseMax(track.detection.corners[k]);
     const Eigen::Vector3d X = predicted * corners[k];
     if (!(X.z() > 0.0)) return false;
-    const Eigen::Vector2d p = ToAprilTagPixel(options_.intrinsics.Project(X));
-    if (!p.allFinite()) return false;
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
+    projected[k] = ToAprilTagPixel(options_.intrinsics.Project(X));
+    if (!projected[k].allFinite()) return false;
+    lo = lo.cwiseMin(projected[k]);
+    hi = hi.cwiseMax(projected[k]);
+  }
+  *shortest_edge_px = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 4; ++k) {
+    *shortest_edge_px = std::min({*shortest_edge_px, (projected[(k + 1) % 4] - projected[k]).norm(),
+                                  (track.detection.corners[(k + 1) % 4] - track.detection.corners[k]).norm()});
   }
   const double margin = options_.region_margin * (hi - lo).maxCoeff() + options_.region_margin_px;
   const double x0 = std::max(0.0, std::floor(lo.x() - margin));
@@ -199,7 +210,12 @@ Status TagTracker::Track(ImageView<const uint8_t> image, TagTrackerFrameReport* 
     for (FollowedTag& track : tracks_) {
       if (track.state == TagTrackState::kLost || track.measured) continue;
       int region[4];
-      if (PredictRegion(track, image.width, image.height, region)) {
+      double shortest_edge_px = 0.0;
+      if (PredictRegion(track, image.width, image.height, region, &shortest_edge_px)) {
+        const float decimate = std::clamp(
+            static_cast<float>(std::floor(shortest_edge_px / options_.region_min_decimated_edge_px)),
+            options_.detector.quad_decimate, std::max(options_.detector.quad_decimate, options_.region_max_quad_decimate));
+        region_detector_->SetQuadDecimate(decimate);
         const Clock::time_point detect_start = Clock::now();
         RECONAR_RETURN_IF_ERROR(
             region_detector_->DetectInRegion(image, region[0], region[1], region[2], region[3], &scratch_));

@@ -35,9 +35,14 @@ namespace reconar {
 struct TagTrackerOptions {
   // Used for full-frame searches. Region searches use the same options except quad_decimate.
   TagDetectorOptions detector;
-  // quad_decimate inside the predicted regions (the full-frame default: a tag found at that
-  // decimation is found again at it in its region).
-  float region_quad_decimate = 2.0f;
+  // quad_decimate inside a predicted region: the largest factor, up to region_max_quad_decimate,
+  // that keeps the predicted tag's shortest edge at least region_min_decimated_edge_px decimated
+  // pixels long (3 px per module of a tag36h11 border: quads stay well above libapriltag's minimum
+  // size), and never below the full-frame decimation. Edges are refined at full resolution
+  // (detector.refine_edges), so the corners keep their accuracy while quad finding on a near tag
+  // costs a fraction.
+  float region_max_quad_decimate = 4.0f;
+  double region_min_decimated_edge_px = 24.0;
   CameraIntrinsics intrinsics;  // valid() required
   double tag_size = 0.0;        // edge of the black square in metres (> 0), all tags
   int max_tags = 16;            // tags followed at once; further ids are counted as dropped
@@ -117,7 +122,8 @@ class TagTracker {
   struct FollowedTag;
   explicit TagTracker(const TagTrackerOptions& options);
   FollowedTag* FindTrack(int id);
-  bool PredictRegion(FollowedTag& track, int width, int height, int region[4]) const;
+  // The search box and the predicted square's shortest edge in pixels.
+  bool PredictRegion(FollowedTag& track, int width, int height, int region[4], double* shortest_edge_px) const;
   void Measure(FollowedTag& track, const TagDetection& detection, bool in_region, double* pose_ms);
 
   TagTrackerOptions options_;

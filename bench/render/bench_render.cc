@@ -13,38 +13,22 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/bench_images.h"
 #include "core/io/image_io.h"
 #include "core/mesh/mesh_io.h"
 #include "platform/egl/egl_context.h"
 #include "render/overlay_renderer.h"
+#include "tests/support/ar_video.h"
 
 namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using bench::Median;
+using bench::ResizeBilinear;
 
 double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-// The frame scaled to width x height by nearest neighbour (content only matters for realism).
-Image<uint8_t> Resized(const Image<uint8_t>& rgb, int width, int height) {
-  Image<uint8_t> out(width, height, 3);
-  for (int y = 0; y < height; ++y) {
-    const uint8_t* source_row = rgb.row(y * rgb.height() / height);
-    uint8_t* target = out.row(y);
-    for (int x = 0; x < width; ++x) {
-      const uint8_t* source = source_row + 3 * (x * rgb.width() / width);
-      std::copy(source, source + 3, target + 3 * x);
-    }
-  }
-  return out;
 }
 
 struct Timings {
@@ -68,13 +52,7 @@ int Run(int frames, const std::string& data_dir) {
   auto bunny = ReadPly(data_dir + "/stanford_bunny/reconstruction/bun_zipper.ply");
   if (!Check(bunny.ok() ? Status::Ok() : bunny.status())) return 1;
 
-  CameraIntrinsics intrinsics;  // apriltag_ar_video_id12/SOURCE.txt, rescaled to each target
-  intrinsics.width = 640;
-  intrinsics.height = 480;
-  intrinsics.fx = 823.8;
-  intrinsics.fy = 822.8;
-  intrinsics.cx = 304.8;
-  intrinsics.cy = 236.3;
+  const CameraIntrinsics intrinsics = testing::ArVideoCamera();  // rescaled to each target by the renderer
   Rigid3 cam_from_tag;  // a tag 0.7 m away, tilted 50 degrees toward the camera
   cam_from_tag.rotation =
       (Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(-0.9, Eigen::Vector3d::UnitX()))
@@ -89,7 +67,7 @@ int Run(int frames, const std::string& data_dir) {
               bunny->triangles.size(), frames);
   std::printf("%-10s %12s %10s %10s %10s %11s\n", "size", "background", "draw", "readback", "total", "pipelined");
   for (const auto& size : {std::pair<int, int>(640, 480), std::pair<int, int>(1280, 720)}) {
-    const Image<uint8_t> frame = Resized(video->rgb, size.first, size.second);
+    const Image<uint8_t> frame = ResizeBilinear(video->rgb, size.first, size.second);
     OverlayRendererOptions options;
     options.width = size.first;
     options.height = size.second;

@@ -20,44 +20,21 @@
 #include <apriltag/apriltag.h>
 #include <apriltag/tag36h11.h>
 
+#include "bench/common/bench_images.h"
 #include "core/io/image_io.h"
+#include "tests/support/ar_video.h"
 #include "tracker/tag_tracker.h"
 
 namespace {
 
 using reconar::Image;
 using Clock = std::chrono::steady_clock;
+using reconar::bench::Median;
 
 struct Frame {
   Image<uint8_t> gray;
   Eigen::Vector2d corners[4];  // reference, libapriltag pixel convention
 };
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-// Bilinear resize in libapriltag's pixel convention (pixel i covers [i, i+1]): output pixel centre
-// (i + 0.5) samples the input at (i + 0.5) / scale, so a point x maps to x * scale.
-Image<uint8_t> Resize(const Image<uint8_t>& in, int width, int height) {
-  Image<uint8_t> out(width, height, 1);
-  const double sx = static_cast<double>(in.width()) / width, sy = static_cast<double>(in.height()) / height;
-  for (int y = 0; y < height; ++y) {
-    const double fy = std::clamp((y + 0.5) * sy - 0.5, 0.0, in.height() - 1.0);
-    const int y0 = std::min(static_cast<int>(fy), in.height() - 2);
-    const double wy = fy - y0;
-    for (int x = 0; x < width; ++x) {
-      const double fx = std::clamp((x + 0.5) * sx - 0.5, 0.0, in.width() - 1.0);
-      const int x0 = std::min(static_cast<int>(fx), in.width() - 2);
-      const double wx = fx - x0;
-      const double v = (1 - wy) * ((1 - wx) * in.row(y0)[x0] + wx * in.row(y0)[x0 + 1]) +
-                       wy * ((1 - wx) * in.row(y0 + 1)[x0] + wx * in.row(y0 + 1)[x0 + 1]);
-      out.row(y)[x] = static_cast<uint8_t>(std::lround(v));
-    }
-  }
-  return out;
-}
 
 double MeanCornerError(const double (*p)[2], const Eigen::Vector2d (&ref)[4]) {
   double sum = 0.0;
@@ -170,13 +147,7 @@ int main(int argc, char** argv) {
     frame.gray = reconar::ToGray8(decoded->rgb);
     frames.push_back(std::move(frame));
   }
-  reconar::CameraIntrinsics camera;  // SOURCE.txt
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = 823.8;
-  camera.fy = 822.8;
-  camera.cx = 304.8;
-  camera.cy = 236.3;
+  const reconar::CameraIntrinsics camera = reconar::testing::ArVideoCamera();
 
   for (const int width : {640, 1280}) {
     std::vector<Frame> sized;
@@ -193,7 +164,7 @@ int main(int argc, char** argv) {
     } else {
       for (const Frame& f : frames) {
         Frame scaled;
-        scaled.gray = Resize(f.gray, width, height);
+        scaled.gray = reconar::bench::ResizeBilinear(f.gray, width, height);
         for (int k = 0; k < 4; ++k) scaled.corners[k] = Eigen::Vector2d(f.corners[k].x() * sx, f.corners[k].y() * sy);
         sized.push_back(std::move(scaled));
       }

@@ -18,6 +18,7 @@
 #include "core/io/image_write.h"
 #include "core/mesh/mesh_io.h"
 #include "render/overlay_renderer.h"
+#include "tests/support/ar_video.h"
 #include "tests/render/gl_test_context.h"
 
 namespace reconar {
@@ -26,18 +27,6 @@ namespace {
 const std::string kVideo = std::string(RECONAR_SHARED_DATA_DIR) + "/apriltag_ar_video_id12";
 const std::string kBunny = std::string(RECONAR_SHARED_DATA_DIR) + "/stanford_bunny/reconstruction/bun_zipper.ply";
 constexpr double kTagSize = 0.14;  // SOURCE.txt: edge of the black square
-
-// SOURCE.txt: K = [823.8 0 304.8; 0 822.8 236.3; 0 0 1], no distortion.
-CameraIntrinsics VideoIntrinsics() {
-  CameraIntrinsics intrinsics;
-  intrinsics.width = 640;
-  intrinsics.height = 480;
-  intrinsics.fx = 823.8;
-  intrinsics.fy = 822.8;
-  intrinsics.cx = 304.8;
-  intrinsics.cy = 236.3;
-  return intrinsics;
-}
 
 // The reference corners a..d of `frame_name` in corners.txt, converted from libapriltag's pixel
 // convention (centre of the top-left pixel at (0.5, 0.5)) to CameraIntrinsics' ((0, 0)).
@@ -66,7 +55,7 @@ std::vector<Eigen::Vector3d> TagCorners() {
 }
 
 Result<Rigid3> CamFromTagFromCorners(const std::vector<Eigen::Vector2d>& corners) {
-  const CameraIntrinsics intrinsics = VideoIntrinsics();
+  const CameraIntrinsics intrinsics = testing::ArVideoCamera();
   AbsolutePoseCamera camera;
   camera.focal = 0.5 * (intrinsics.fx + intrinsics.fy);
   camera.cx = intrinsics.cx;
@@ -103,7 +92,7 @@ TEST(OverlayOnVideoTest, BunnyOnTag12WithThePoseOfTheReferenceCorners) {
   ASSERT_EQ(corners.size(), 4u);
   auto cam_from_tag = CamFromTagFromCorners(corners);
   ASSERT_TRUE(cam_from_tag.ok()) << cam_from_tag.status().ToString();
-  const CameraIntrinsics intrinsics = VideoIntrinsics();
+  const CameraIntrinsics intrinsics = testing::ArVideoCamera();
   double worst_reprojection = 0.0;
   for (int i = 0; i < 4; ++i) {
     const Eigen::Vector2d projected = intrinsics.Project(*cam_from_tag * TagCorners()[i]);

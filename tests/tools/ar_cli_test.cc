@@ -19,6 +19,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/json_reader.h"
 #include "core/io/image_io.h"
+#include "tests/support/ar_video.h"
 #include "tests/support/run_command.h"
 #include "tracker/calibration.h"
 
@@ -40,18 +41,10 @@ std::string TempDir(const std::string& name) {
   return dir;
 }
 
-// corners.txt: "frameNNNN.jpg ax ay bx by cx cy dx dy", libapriltag's order and pixels.
 std::map<std::string, std::vector<Eigen::Vector2d>> ReferenceCorners() {
   std::map<std::string, std::vector<Eigen::Vector2d>> corners;
-  std::ifstream file(kVideo + "/corners.txt");
-  for (std::string line; std::getline(file, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    std::string name;
-    fields >> name;
-    std::vector<Eigen::Vector2d> four(4);
-    for (auto& c : four) fields >> c.x() >> c.y();
-    if (fields) corners[name] = four;
+  for (const testing::ArVideoFrame& frame : testing::ReadArVideoFrames()) {
+    corners[frame.name].assign(frame.corners, frame.corners + 4);
   }
   return corners;
 }

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "core/io/image_io.h"
+#include "tests/support/ar_video.h"
 #include "tracker/tag_detector.h"
 #include "tracker/tag_pose.h"
 #include "tracker/tag_tracker.h"
@@ -115,33 +116,8 @@ TEST(TrackerE2eTest, SwatboticsMappingWithDefaultOptionsHasNoFalseIds) {
 
 // --- b. AR video, tag 12: corners vs the upstream detector's (decimate 1) -------------------------
 
-struct VideoFrame {
-  std::string name;
-  Eigen::Vector2d corners[4];
-};
-
-std::vector<VideoFrame> ReadVideoCorners() {
-  std::vector<VideoFrame> frames;
-  for (const std::string& line : Lines(kData + "/apriltag_ar_video_id12/corners.txt")) {
-    std::istringstream fields(line);
-    VideoFrame frame;
-    fields >> frame.name;
-    for (Eigen::Vector2d& c : frame.corners) fields >> c.x() >> c.y();
-    frames.push_back(frame);
-  }
-  return frames;
-}
-
-CameraIntrinsics VideoCamera() {  // SOURCE.txt: K = [823.8 0 304.8; 0 822.8 236.3], no distortion
-  CameraIntrinsics camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = 823.8;
-  camera.fy = 822.8;
-  camera.cx = 304.8;
-  camera.cy = 236.3;
-  return camera;
-}
+using testing::ArVideoCamera;
+using testing::ArVideoFrame;
 
 double MeanCornerError(const Eigen::Vector2d (&a)[4], const Eigen::Vector2d (&b)[4]) {
   double sum = 0.0;
@@ -150,11 +126,11 @@ double MeanCornerError(const Eigen::Vector2d (&a)[4], const Eigen::Vector2d (&b)
 }
 
 TEST(TrackerE2eTest, ArVideoCornersPerFrameAndThroughTheTracker) {
-  const std::vector<VideoFrame> reference = ReadVideoCorners();
+  const std::vector<ArVideoFrame> reference = testing::ReadArVideoFrames();
   ASSERT_EQ(reference.size(), 93u);
   std::vector<Image<uint8_t>> frames;
-  for (const VideoFrame& f : reference) frames.push_back(LoadGray(kData + "/apriltag_ar_video_id12/frames/" + f.name));
-  const CameraIntrinsics camera = VideoCamera();
+  for (const ArVideoFrame& f : reference) frames.push_back(LoadGray(kData + "/apriltag_ar_video_id12/frames/" + f.name));
+  const CameraIntrinsics camera = ArVideoCamera();
   constexpr double kTagSize = 0.14;
 
   // Per-frame full detection with the detector's defaults.
