@@ -29,11 +29,13 @@ function(reconar_add_library name)
   target_link_libraries(reconar_${name} PUBLIC ${ARG_PUBLIC_LINKS} PRIVATE ${ARG_PRIVATE_LINKS})
 endfunction()
 
-# reconar_add_test(NAME SOURCES ... [LINKS ...] [LABELS ...] [TIMEOUT seconds])
+# reconar_add_test(NAME SOURCES ... [LINKS ...] [LABELS ...] [TIMEOUT seconds] [COST weight])
+# COST: ctest starts tests of higher cost first, so that long ones (e.g. under qemu) overlap the
+# short ones instead of trailing at the end of a parallel run.
 # A GoogleTest executable; each TEST becomes a CTest case (discovered through the cross emulator too).
 # Label "unit" for fast self-contained tests, "e2e" for tests on ../shared/data.
 function(reconar_add_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LINKS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;COST" "SOURCES;LINKS;LABELS" ${ARGN})
   if(NOT ARG_LABELS)
     set(ARG_LABELS unit)
   endif()
@@ -51,7 +53,10 @@ function(reconar_add_test name)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 600)
   endif()
+  if(NOT ARG_COST)
+    set(ARG_COST 0)
+  endif()
   gtest_discover_tests(${name}
-      PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+      PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST}
       DISCOVERY_TIMEOUT 120)
 endfunction()
