@@ -1,5 +1,7 @@
 #include "tools/args.h"
 
+#include <cctype>
+
 #include <cstdio>
 #include <cstdlib>
 
@@ -69,6 +71,15 @@ Result<double> Args::GetDouble(const std::string& name, double fallback, double 
                            std::to_string(max) + "], got '" + text + "'");
   }
   return value;
+}
+
+std::string LowercaseExtension(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string extension = path.substr(dot);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
 }
 
 int ExitCodeFor(const Status& status) {

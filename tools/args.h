@@ -29,6 +29,9 @@ class Args {
   std::map<std::string, std::string> values_;
 };
 
+// The file name's extension in lower case, dot included ("sheet.PDF" -> ".pdf"); "" without one.
+std::string LowercaseExtension(const std::string& path);
+
 // Exit codes (DESIGN.md): 0 ok, 1 failed run, 2 bad usage or input.
 int ExitCodeFor(const Status& status);
 int Fail(const Status& status);  // prints "reconar: error: ..." and returns the exit code

@@ -1,5 +1,4 @@
 // reconar tags: a printable sheet of AprilTags whose detection border measures exactly --size.
-#include <cctype>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -67,11 +66,6 @@ Status ApplyPaper(const std::string& name, TagSheetOptions* options) {
   return Status::Ok();
 }
 
-std::string Lower(std::string text) {
-  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return text;
-}
-
 std::string PagePath(const std::string& out, size_t page) {
   if (page == 0) return out;
   return out.substr(0, out.size() - 4) + "-" + std::to_string(page + 1) + ".svg";
@@ -91,7 +85,7 @@ int RunTags(int argc, char** argv, int first) {
     return 2;
   }
   const std::string out = args.Get("out");
-  const std::string extension = Lower(out.size() >= 4 ? out.substr(out.size() - 4) : "");
+  const std::string extension = LowercaseExtension(out);
   if (extension != ".svg" && extension != ".pdf") {
     return Fail(InvalidArgument("--out: '" + out + "' must end in .svg or .pdf"));
   }

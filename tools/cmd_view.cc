@@ -80,14 +80,9 @@ Result<Eigen::Vector3d> ParseVector(const std::string& name, const std::string& 
 }
 
 Result<Mesh> ReadModel(const std::string& path) {
-  std::string lower = path;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  auto ends_with = [&](const char* suffix) {
-    const std::string s(suffix);
-    return lower.size() >= s.size() && lower.compare(lower.size() - s.size(), s.size(), s) == 0;
-  };
-  if (ends_with(".ply")) return ReadPly(path);
-  if (ends_with(".glb")) return ReadGlb(path);
+  const std::string extension = LowercaseExtension(path);
+  if (extension == ".ply") return ReadPly(path);
+  if (extension == ".glb") return ReadGlb(path);
   return InvalidArgument(path + ": unknown model format (expected .ply or .glb)");
 }
 

@@ -11,6 +11,13 @@
 
 namespace reconar::testing {
 
+std::string MakeTestDirectory(const std::string& prefix) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / (prefix + "_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
 CommandRun RunCommand(const std::string& command, StderrMode stderr_mode) {
   CommandRun run;
   std::string err_path;

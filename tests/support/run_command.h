@@ -16,6 +16,9 @@ enum class StderrMode {
   kSeparate,  // into `error` (through a temporary file)
 };
 
+// A fresh directory "<gtest temp dir>/<prefix>_<pid>" (created with its parents) for a test's files.
+std::string MakeTestDirectory(const std::string& prefix);
+
 // `command` through /bin/sh (popen).
 CommandRun RunCommand(const std::string& command, StderrMode stderr_mode = StderrMode::kMerge);
 

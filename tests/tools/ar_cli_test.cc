@@ -35,12 +35,6 @@ const std::string kVideo = kData + "/apriltag_ar_video_id12";
 // SOURCE.txt: K = [823.8 0 304.8; 0 822.8 236.3], tag edge 0.14 m.
 const std::string kVideoCamera = "--intrinsics 823.8,822.8,304.8,236.3 --tag-size 0.14";
 
-std::string TempDir(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "/reconar_ar_" + name + "_" + std::to_string(::getpid());
-  EXPECT_TRUE(CreateDirectories(dir).ok());
-  return dir;
-}
-
 std::map<std::string, std::vector<Eigen::Vector2d>> ReferenceCorners() {
   std::map<std::string, std::vector<Eigen::Vector2d>> corners;
   for (const testing::ArVideoFrame& frame : testing::ReadArVideoFrames()) {
@@ -108,7 +102,7 @@ TEST(ArCli, TrackJsonOnRecordedVideoMatchesReferenceCornersAndPoses) {
 }
 
 TEST(ArCli, ViewWritesOneOverlayPerFrameWithTheModelOnTheTag) {
-  const std::string dir = TempDir("view");
+  const std::string dir = testing::MakeTestDirectory("reconar_ar_view");
   const auto run = RunReconar("view --model " + kData + "/stanford_bunny/reconstruction/bun_zipper.ply --frames " +
                               kVideo + "/frames " + kVideoCamera + " --out " + dir);
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -142,7 +136,7 @@ TEST(ArCli, ViewWritesOneOverlayPerFrameWithTheModelOnTheTag) {
 }
 
 TEST(ArCli, CalibrateOnSwatboticsPhotosAgreesWithCheckerboardCalibration) {
-  const std::string dir = TempDir("calibrate");
+  const std::string dir = testing::MakeTestDirectory("reconar_ar_calibrate");
   const auto run = RunReconar("calibrate " + kData + "/apriltag_swatbotics_mapping --tag-size 0.127 --out " + dir +
                               "/intrinsics.txt");
   ASSERT_EQ(run.exit_code, 0) << run.output;

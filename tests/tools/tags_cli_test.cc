@@ -23,12 +23,6 @@ using testing::RunReconar;
 constexpr double kDpi = 300.0;
 constexpr double kPixelsPerMm = kDpi / 25.4;
 
-std::string TempDir(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "/reconar_tags_" + name + "_" + std::to_string(::getpid());
-  EXPECT_TRUE(CreateDirectories(dir).ok());
-  return dir;
-}
-
 bool HaveTool(const std::string& tool) { return RunCommand("command -v " + tool + " >/dev/null").exit_code == 0; }
 
 struct SheetMeasurement {
@@ -78,7 +72,7 @@ void ExpectSheet(const SheetMeasurement& m, double size_mm, int first_id, int la
 
 TEST(TagsCli, SvgRasterisedByLibrsvgHasExactTagSize) {
   if (!HaveTool("rsvg-convert")) GTEST_SKIP() << "rsvg-convert (librsvg2-bin) not installed";
-  const std::string dir = TempDir("svg");
+  const std::string dir = testing::MakeTestDirectory("reconar_tags_svg");
   const auto run = RunReconar("tags --ids 0-3 --size 0.06 --out " + dir + "/sheet.svg");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto raster = RunCommand("rsvg-convert --dpi-x 300 --dpi-y 300 -b white -o " + dir + "/sheet.png " + dir +
@@ -89,7 +83,7 @@ TEST(TagsCli, SvgRasterisedByLibrsvgHasExactTagSize) {
 
 TEST(TagsCli, PdfRasterisedByPopplerHasExactTagSizeAndPages) {
   if (!HaveTool("pdftoppm")) GTEST_SKIP() << "pdftoppm (poppler-utils) not installed";
-  const std::string dir = TempDir("pdf");
+  const std::string dir = testing::MakeTestDirectory("reconar_tags_pdf");
   const auto run = RunReconar("tags --ids 10-13 --size 0.06 --out " + dir + "/sheet.pdf");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto raster = RunCommand("pdftoppm -r 300 -png -singlefile " + dir + "/sheet.pdf " + dir + "/sheet");
@@ -107,7 +101,7 @@ TEST(TagsCli, PdfRasterisedByPopplerHasExactTagSizeAndPages) {
 }
 
 TEST(TagsCli, BadArgumentsFailWithAClearMessageAndWriteNothing) {
-  const std::string dir = TempDir("bad");
+  const std::string dir = testing::MakeTestDirectory("reconar_tags_bad");
   auto run = RunReconar("tags --ids 0-3 --size 0.06 --out " + dir + "/sheet.txt");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.output.find("must end in .svg or .pdf"), std::string::npos) << run.output;
