@@ -5,7 +5,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
 build=${RECONAR_TEST_BUILD_DIR:-build-test}
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON "$@" > "$build.configure.log" 2>&1 \
+# The glTF validator that install-deps.sh put in its cache directory, when it is there.
+gltf_validator_dir=${RECONAR_GLTF_VALIDATOR_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/reconar/gltf-validator}
+validator_args=()
+if [ -f "$gltf_validator_dir/node_modules/gltf-validator/package.json" ]; then
+  validator_args=(-DRECONAR_GLTF_VALIDATOR_DIR="$gltf_validator_dir")
+fi
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON "${validator_args[@]}" "$@" \
+  > "$build.configure.log" 2>&1 \
   || { cat "$build.configure.log"; exit 1; }
 cmake --build "$build" -j"$(nproc)"
 ctest --test-dir "$build" --output-on-failure -j"$(nproc)" --timeout 900

@@ -11,11 +11,15 @@ int RunTags(int argc, char** argv, int first);
 int RunTrack(int argc, char** argv, int first);
 int RunCalibrate(int argc, char** argv, int first);
 int RunView(int argc, char** argv, int first);  // defined only with RECONAR_HAVE_VIEW
+int RunExport(int argc, char** argv, int first);
+int RunMesh(int argc, char** argv, int first);   // defined only with RECONAR_HAVE_POISSON
+int RunDense(int argc, char** argv, int first);  // defined only with RECONAR_HAVE_DENSE
 
 }  // namespace reconar::tools
 
 #include "core/base/status.h"
 #include "core/features/sift/sift.h"
+#include "core/mesh/mesh.h"
 #include "core/pipeline/match_stage.h"
 #include "tools/args.h"
 
@@ -29,5 +33,10 @@ inline const std::set<std::string> kSiftValuedOptions = {"first-octave", "max-fe
 Result<MatchStageOptions> MatchOptionsFromArgs(const Args& args);
 inline const std::set<std::string> kMatchValuedOptions = {"ratio", "checks", "min-inliers", "f-threshold",
                                                             "threads"};
+
+// Shared by export and mesh (cmd_export.cc): creates the parent directory of an output file, and
+// prints "<verb> <path>: N vertices, M triangles[, normals][, colours]" on stdout.
+Status CreateParentDirectory(const std::string& path);
+void PrintMeshSummary(const char* verb, const std::string& path, const Mesh& mesh);
 
 }  // namespace reconar::tools

@@ -15,6 +15,9 @@ constexpr char kUsage[] =
     "  match IMAGE_A IMAGE_B [--pairs OUT.txt]             verified matches between two photos\n"
     "  match --project DIR                                 verified matches between all pairs of a project\n"
     "  sfm IMAGES_DIR PROJECT_DIR                          cameras and sparse points (structure from motion)\n"
+    "  dense PROJECT_DIR                                   dense oriented points (multi-view stereo)\n"
+    "  mesh POINTS.ply OUT.{ply,obj,glb,wrl} [--depth N]   Poisson surface from oriented points\n"
+    "  export IN.{ply,glb,obj} OUT.{ply,obj,glb,wrl}       convert a mesh or point cloud between formats\n"
     "  bundle-adjust --bal FILE [--json]                   solve a BAL bundle adjustment problem\n"
     "  tags --ids LIST --size METRES --out FILE.{svg,pdf}  printable AprilTag sheet\n"
     "  track SOURCE --intrinsics K --tag-size M [--json]   6-DoF tag tracking, one line per frame\n"
@@ -38,6 +41,24 @@ int main(int argc, char** argv) {
   if (command == "tags") return reconar::tools::RunTags(argc, argv, 2);
   if (command == "track") return reconar::tools::RunTrack(argc, argv, 2);
   if (command == "calibrate") return reconar::tools::RunCalibrate(argc, argv, 2);
+  if (command == "export") return reconar::tools::RunExport(argc, argv, 2);
+  if (command == "mesh") {
+#ifdef RECONAR_HAVE_POISSON
+    return reconar::tools::RunMesh(argc, argv, 2);
+#else
+    std::fputs("reconar: mesh needs Poisson reconstruction (core/mesh/poisson), which this build lacks\n", stderr);
+    return 2;
+#endif
+  }
+  if (command == "dense") {
+#ifdef RECONAR_HAVE_DENSE
+    return reconar::tools::RunDense(argc, argv, 2);
+#else
+    std::fputs("reconar: dense needs multi-view stereo (core/mvs, tools/cmd_dense.cc), which this build lacks\n",
+               stderr);
+    return 2;
+#endif
+  }
   if (command == "view") {
 #ifdef RECONAR_HAVE_VIEW
     return reconar::tools::RunView(argc, argv, 2);

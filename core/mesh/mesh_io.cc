@@ -10,6 +10,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/mesh/byte_order.h"
+#include "core/mesh/text_format.h"
 
 namespace reconar {
 
@@ -79,20 +80,6 @@ struct PlyHeader {
   size_t body_offset = 0;
 };
 
-std::vector<std::string_view> SplitFields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  size_t i = 0;
-  while (i < line.size()) {
-    const size_t begin = line.find_first_not_of(" \t\r", i);
-    if (begin == std::string_view::npos) break;
-    size_t end = line.find_first_of(" \t\r", begin);
-    if (end == std::string_view::npos) end = line.size();
-    fields.push_back(line.substr(begin, end - begin));
-    i = end;
-  }
-  return fields;
-}
-
 Result<PlyHeader> ParseHeader(std::string_view bytes, const std::string& path) {
   PlyHeader header;
   size_t position = 0;
@@ -110,7 +97,7 @@ Result<PlyHeader> ParseHeader(std::string_view bytes, const std::string& path) {
     const std::string_view line = bytes.substr(position, end - position);
     position = end + 1;
     ++line_number;
-    const std::vector<std::string_view> fields = SplitFields(line);
+    const std::vector<std::string_view> fields = mesh_internal::SplitFields(line);
     if (line_number == 1) {
       if (fields.size() != 1 || fields[0] != "ply") {
         return FileError(StatusCode::kCorruptData, path, "not a PLY file (no \"ply\" magic line)");
@@ -504,12 +491,6 @@ class PlyBodyParser {
 // ---------------------------------------------------------------------------------------------
 // Writing.
 
-void AppendText(std::string* out, float value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out->append(buffer, result.ptr);
-}
-
 std::string PlyHeaderText(const Mesh& mesh, PlyFormat format) {
   std::string header = "ply\nformat ";
   header += format == PlyFormat::kAscii ? "ascii" : "binary_little_endian";
@@ -545,12 +526,12 @@ void AppendAsciiBody(const Mesh& mesh, std::string* out) {
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     for (int axis = 0; axis < 3; ++axis) {
       if (axis > 0) out->push_back(' ');
-      AppendText(out, mesh.positions[i][axis]);
+      mesh_internal::AppendShortestText(out, mesh.positions[i][axis]);
     }
     if (!mesh.normals.empty()) {
       for (int axis = 0; axis < 3; ++axis) {
         out->push_back(' ');
-        AppendText(out, mesh.normals[i][axis]);
+        mesh_internal::AppendShortestText(out, mesh.normals[i][axis]);
       }
     }
     if (!mesh.colors.empty()) {

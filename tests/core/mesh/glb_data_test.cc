@@ -1,6 +1,7 @@
 // WriteGlb / ReadGlb on the Stanford bunny (../shared/data/stanford_bunny): exact round trip, and
-// the Khronos glTF validator's verdict on the files we write (when node and the npm package
-// gltf-validator are available: RECONAR_GLTF_VALIDATOR_DIR, CMake cache variable or environment).
+// the Khronos glTF validator's verdict on the files we write, also through WriteMeshFile (when node
+// and the npm package gltf-validator are available: RECONAR_GLTF_VALIDATOR_DIR, CMake cache
+// variable or environment; scripts/install-deps.sh installs it and scripts/test.sh passes it).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -10,6 +11,7 @@
 
 #include "core/base/json_reader.h"
 #include "core/mesh/glb_io.h"
+#include "core/mesh/mesh_file.h"
 #include "core/mesh/mesh_io.h"
 #include "tests/core/mesh/mesh_test_util.h"
 #include "tests/support/run_command.h"
@@ -108,6 +110,11 @@ TEST_F(GlbDataTest, KhronosValidatorAcceptsOurFiles) {
     ASSERT_TRUE(WriteGlb(path, mesh).ok()) << name;
     files += " " + path;
   }
+  // The coloured bunny through the extension dispatch the `reconar export` and `mesh` commands use.
+  const std::string dispatched = (dir_ / "bunny_mesh_file.GLB").string();
+  ASSERT_TRUE(WriteMeshFile(dispatched, bunny).ok());
+  files += " " + dispatched;
+  meshes.emplace_back("bunny_mesh_file.GLB", Mesh());
   const testing::CommandRun run = testing::RunCommand("node " + std::string(RECONAR_SOURCE_DIR) +
                                                       "/tests/core/mesh/validate_glb.js " + validator_dir + files,
                                                       testing::StderrMode::kSeparate);

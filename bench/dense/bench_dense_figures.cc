@@ -1,0 +1,155 @@
+// The dense-accuracy figures, printed: the rendered bunny (dense points and their Poisson mesh
+// against bun_zipper.ply, Middlebury accuracy at 90 % and completeness at 1.25 mm) and templeRing
+// with its ground-truth cameras (point count, share inside the README's bounding box).
+// run_dense_figures.sh wraps each scene in /usr/bin/time -v for the peak RSS.
+//
+// Usage: bench_dense_figures bunny|templering [--level L] [--threads N] [--depth D] [--trim T]
+//                            [--stride S] [--project DIR] [shared_data_dir]
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <unistd.h>
+
+#include "core/mesh/mesh_io.h"
+#include "platform/egl/egl_context.h"
+#include "tests/dense/bunny_dense.h"
+#include "tests/dense/dense_runs.h"
+
+namespace reconar {
+namespace {
+
+struct Args {
+  std::string scene;
+  int level = -2;  // -2: the scene's default (bunny 0, templeRing 1)
+  int threads = 0;
+  int depth = 8;
+  double trim = 7.0;
+  int stride = 1;
+  std::string project;
+  std::string data_dir = RECONAR_SHARED_DATA_DIR;
+};
+
+int Usage(const char* message) {
+  std::fprintf(stderr,
+               "bench_dense_figures: %s\n"
+               "usage: bench_dense_figures bunny|templering [--level L] [--threads N] [--depth D] [--trim T]\n"
+               "                           [--stride S] [--project DIR] [shared_data_dir]\n",
+               message);
+  return 2;
+}
+
+void PrintDense(const DenseStageReport& dense) {
+  std::printf("dense: level %d, %d images (%d kept), %d clusters, %zu points (%zu before merge)\n", dense.level,
+              dense.images, dense.kept_images, dense.clusters, dense.points, dense.points_before_merge);
+  std::printf("dense phases s: load %.1f clustering %.1f undistort %.1f mvs %.1f merge %.1f write %.1f; "
+              "pmvs: %zu features, %zu initial, %zu expanded, %zu final patches\n",
+              dense.load.seconds, dense.clustering.seconds, dense.undistort.seconds, dense.mvs.seconds,
+              dense.merge.seconds, dense.write.seconds, dense.pmvs.features, dense.pmvs.initial_patches,
+              dense.pmvs.expanded_patches, dense.pmvs.final_patches);
+}
+
+int RunBunny(const Args& args, const std::string& project) {
+  auto context = EglContext::Create([] {
+    EglContextOptions options;
+    options.kind = EglContextKind::kSurfaceless;
+    return options;
+  }());
+  if (!context.ok()) return Usage(context.status().ToString().c_str());
+  auto bunny = ReadPly(args.data_dir + "/stanford_bunny/reconstruction/bun_zipper.ply");
+  if (!bunny.ok()) return Usage(bunny.status().ToString().c_str());
+  testing::BunnyDenseOptions options;
+  options.level = args.level == -2 ? 0 : args.level;
+  options.num_threads = args.threads;
+  options.poisson.depth = args.depth;
+  options.poisson.trim = args.trim;
+  auto figures = testing::RunBunnyDense(*bunny, project, options);
+  if (!figures.ok()) {
+    std::fprintf(stderr, "bench_dense_figures: %s\n", figures.status().ToString().c_str());
+    return 1;
+  }
+  const testing::BunnySceneReport& scene = figures->scene;
+  std::printf("bunny scene: %d views %dx%d, foreground %.3f, seen by >= 3 views within 60 deg %.3f, "
+              "footprint %.3f mm; render %.1f s\n",
+              scene.views, options.project.scene.width, options.project.scene.height, scene.mean_foreground_fraction,
+              scene.visibility.seen_by_3_fraction, 1e3 * scene.pixel_footprint_at_center_m, figures->seconds_render);
+  PrintDense(figures->dense);
+  std::printf("dense wall %.1f s\n", figures->seconds_dense);
+  std::printf("POINTS  accuracy(90%%) %.3f mm  completeness(1.25 mm) %.3f  (%zu points)\n",
+              1e3 * figures->points.accuracy, figures->points.completeness, figures->points.points);
+  std::printf("POISSON depth %d trim %.1f: %zu vertices %zu triangles, %.1f s; accuracy(90%%) %.3f mm  "
+              "completeness %.3f\n",
+              args.depth, args.trim, figures->mesh_vertices, figures->mesh_triangles, figures->seconds_poisson,
+              1e3 * figures->mesh.accuracy, figures->mesh.completeness);
+  const testing::MeshComparison& c = figures->mesh_to_reference;
+  std::printf("MESH vs bun_zipper: mesh->ref mean %.3f median %.3f p90 %.3f max %.3f mm; ref->mesh mean %.3f "
+              "median %.3f p90 %.3f max %.3f mm\n",
+              1e3 * c.mean_mesh_to_reference, 1e3 * c.median_mesh_to_reference, 1e3 * c.p90_mesh_to_reference,
+              1e3 * c.max_mesh_to_reference, 1e3 * c.mean_reference_to_mesh, 1e3 * c.median_reference_to_mesh,
+              1e3 * c.p90_reference_to_mesh, 1e3 * c.max_reference_to_mesh);
+  std::printf("scoring %.1f s; project in %s\n", figures->seconds_scoring, project.c_str());
+  return 0;
+}
+
+int RunTempleRing(const Args& args, const std::string& project) {
+  testing::TempleRingDenseOptions options;
+  options.level = args.level == -2 ? 1 : args.level;
+  options.num_threads = args.threads;
+  options.import.view_stride = args.stride;
+  auto figures =
+      testing::RunTempleRingDense(args.data_dir + "/middlebury_templeRing/templeR_par.txt", project, options);
+  if (!figures.ok()) {
+    std::fprintf(stderr, "bench_dense_figures: %s\n", figures.status().ToString().c_str());
+    return 1;
+  }
+  std::printf("templeRing: %d views (stride %d)\n", figures->import.views, args.stride);
+  PrintDense(figures->dense);
+  std::printf("dense wall %.1f s\n", figures->seconds_dense);
+  std::printf("POINTS %zu, in the README box (+%.1f mm) %zu = %.4f\n", figures->points, 1e3 * options.box_margin_m,
+              figures->points_in_box, figures->in_box_fraction);
+  std::printf("project in %s\n", project.c_str());
+  return 0;
+}
+
+}  // namespace
+}  // namespace reconar
+
+int main(int argc, char** argv) {
+  reconar::Args args;
+  std::string positional[2];
+  int positional_count = 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (arg == "--help" || arg == "-h") {
+      reconar::Usage("dense-accuracy figures of one scene");
+      return 0;
+    } else if (arg == "--level" && has_value) {
+      args.level = std::atoi(argv[++i]);
+    } else if (arg == "--threads" && has_value) {
+      args.threads = std::atoi(argv[++i]);
+    } else if (arg == "--depth" && has_value) {
+      args.depth = std::atoi(argv[++i]);
+    } else if (arg == "--trim" && has_value) {
+      args.trim = std::atof(argv[++i]);
+    } else if (arg == "--stride" && has_value) {
+      args.stride = std::atoi(argv[++i]);
+    } else if (arg == "--project" && has_value) {
+      args.project = argv[++i];
+    } else if (arg.rfind("--", 0) == 0) {
+      return reconar::Usage(("unknown or incomplete option " + arg).c_str());
+    } else if (positional_count < 2) {
+      positional[positional_count++] = arg;
+    } else {
+      return reconar::Usage("too many arguments");
+    }
+  }
+  if (positional_count < 1) return reconar::Usage("expected a scene");
+  args.scene = positional[0];
+  if (positional_count == 2) args.data_dir = positional[1];
+  const std::string project =
+      args.project.empty() ? "/tmp/reconar_dense_" + args.scene + "_" + std::to_string(::getpid()) : args.project;
+  if (args.scene == "bunny") return reconar::RunBunny(args, project);
+  if (args.scene == "templering") return reconar::RunTempleRing(args, project);
+  return reconar::Usage("the scene must be bunny or templering");
+}

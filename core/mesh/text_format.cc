@@ -1,0 +1,52 @@
+#include "core/mesh/text_format.h"
+
+#include <charconv>
+#include <string>
+
+namespace reconar::mesh_internal {
+
+void AppendShortestText(std::string* out, float value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out->append(buffer, result.ptr);
+}
+
+void AppendShortestText(std::string* out, const Eigen::Vector3f& value) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (axis > 0) out->push_back(' ');
+    AppendShortestText(out, value[axis]);
+  }
+}
+
+float ColourChannel(uint8_t byte) { return static_cast<float>(byte) / 255.0f; }
+
+Status CheckFiniteVertices(const std::string& path, const Mesh& mesh) {
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    if (!mesh.positions[i].allFinite()) {
+      return FileError(StatusCode::kInvalidArgument, path, "vertex " + std::to_string(i) + " has a non-finite position");
+    }
+  }
+  for (size_t i = 0; i < mesh.normals.size(); ++i) {
+    if (!mesh.normals[i].allFinite()) {
+      return FileError(StatusCode::kInvalidArgument, path, "vertex " + std::to_string(i) + " has a non-finite normal");
+    }
+  }
+  return Status::Ok();
+}
+
+
+std::vector<std::string_view> SplitFields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  size_t i = 0;
+  while (i < line.size()) {
+    const size_t begin = line.find_first_not_of(" \t\r", i);
+    if (begin == std::string_view::npos) break;
+    size_t end = line.find_first_of(" \t\r", begin);
+    if (end == std::string_view::npos) end = line.size();
+    fields.push_back(line.substr(begin, end - begin));
+    i = end;
+  }
+  return fields;
+}
+
+}  // namespace reconar::mesh_internal

@@ -1,0 +1,307 @@
+#include "core/pipeline/dense_stage.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <chrono>
+#include <map>
+#include <memory>
+
+#include "core/base/atomic_file.h"
+#include "core/base/json_writer.h"
+#include "core/base/memory_usage.h"
+#include "core/base/progress.h"
+#include "core/base/thread_pool.h"
+#include "core/io/image_io.h"
+#include "core/mesh/mesh.h"
+#include "core/mesh/mesh_io.h"
+#include "core/mvs/dense_memory.h"
+#include "core/mvs/merge_points.h"
+#include "core/mvs/undistort.h"
+#include "core/sfm/model_io.h"
+
+namespace reconar {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Times one phase segment and folds its peak RSS into the phase; a phase may have many segments
+// (undistortion and PMVS alternate over the clusters).
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(DensePhase* phase) : phase_(phase), start_(Clock::now()) { ResetPeakResidentBytes(); }
+  ~PhaseTimer() {
+    phase_->seconds += std::chrono::duration<double>(Clock::now() - start_).count();
+    phase_->peak_rss_bytes = std::max(phase_->peak_rss_bytes, PeakResidentBytes());
+  }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+
+ private:
+  DensePhase* phase_;
+  Clock::time_point start_;
+};
+
+void AddReports(const PatchMvsReport& part, PatchMvsReport* sum) {
+  sum->features += part.features;
+  sum->initial_patches += part.initial_patches;
+  sum->expanded_patches += part.expanded_patches;
+  sum->final_patches += part.final_patches;
+  sum->seconds_features += part.seconds_features;
+  sum->seconds_matching += part.seconds_matching;
+  sum->seconds_expansion += part.seconds_expansion;
+  sum->seconds_filtering += part.seconds_filtering;
+}
+
+// Decodes and undistorts the views of `cluster` that `cache` lacks, and drops the ones it no
+// longer needs, so that at most one cluster's views are held.
+Status LoadClusterViews(const std::vector<int>& cluster, const Reconstruction& model,
+                        const std::vector<std::string>& paths, int level, ThreadPool* pool, Progress* progress,
+                        std::map<int, std::unique_ptr<DenseView>>* cache, size_t* loaded) {
+  for (auto it = cache->begin(); it != cache->end();) {
+    it = std::binary_search(cluster.begin(), cluster.end(), it->first) ? std::next(it) : cache->erase(it);
+  }
+  std::vector<int> missing;
+  for (int id : cluster) {
+    if (cache->count(id) == 0) missing.push_back(id);
+  }
+  std::vector<std::unique_ptr<DenseView>> views(missing.size());
+  std::vector<Status> errors(missing.size());
+  pool->ParallelFor(0, missing.size(), [&](size_t k, int) {
+    const int id = missing[k];
+    const SfmImage& image = model.images[static_cast<size_t>(id)];
+    const std::string& path = paths[static_cast<size_t>(id)];
+    auto decoded = ReadImage(path);
+    if (!decoded.ok()) {
+      errors[k] = decoded.status();
+    } else {
+      auto view = UndistortView(decoded->rgb, model.cameras[static_cast<size_t>(image.camera_id)], image.pose, level);
+      if (!view.ok()) {
+        errors[k] = view.status().WithContext(path);
+      } else {
+        view->name = image.name;
+        view->image_id = id;
+        views[k] = std::make_unique<DenseView>(std::move(*view));
+      }
+    }
+    if (progress != nullptr) progress->Advance();
+  });
+  for (const Status& status : errors) RECONAR_RETURN_IF_ERROR(status);
+  for (size_t k = 0; k < missing.size(); ++k) (*cache)[missing[k]] = std::move(views[k]);
+  *loaded += missing.size();
+  return Status::Ok();
+}
+
+Mesh ToPointCloud(const OrientedPoints& points) {
+  Mesh mesh;
+  mesh.positions = points.positions;
+  mesh.normals = points.normals;
+  mesh.colors.reserve(points.size());
+  for (const std::array<uint8_t, 3>& c : points.colors) mesh.colors.push_back({c[0], c[1], c[2], 255});
+  return mesh;
+}
+
+void PhaseJson(const char* name, const DensePhase& phase, JsonWriter* json) {
+  json->Key(name).BeginObject();
+  json->Key("seconds").Double(phase.seconds);
+  json->Key("peak_rss_mib").Double(static_cast<double>(phase.peak_rss_bytes) / (1 << 20));
+  json->EndObject();
+}
+
+}  // namespace
+
+Status DenseStageOptions::Check() const {
+  if (level < -1 || level > kMaxDenseLevel) {
+    return InvalidArgument("dense: level must be -1 (auto), 0, 1 or 2, got " + std::to_string(level));
+  }
+  if (memory_budget_bytes == 0) return InvalidArgument("dense: the memory budget must be positive");
+  RECONAR_RETURN_IF_ERROR(clustering.Check());
+  return mvs.Check();
+}
+
+Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageOptions& options) {
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  DenseStageReport report;
+  report.peak_rss_resettable = ResetPeakResidentBytes();
+
+  // Load: the sparse model and the photo of every registered image.
+  Reconstruction model;
+  std::vector<std::string> paths;
+  {
+    PhaseTimer timer(&report.load);
+    RECONAR_ASSIGN_OR_RETURN(model, ReadColmapTextModel(project.SparseDir()));
+    RECONAR_ASSIGN_OR_RETURN(const std::vector<ProjectImage> list, project.ReadImageList());
+    std::map<std::string, std::string> path_of;
+    for (const ProjectImage& image : list) path_of[image.name] = image.path;
+    paths.resize(model.images.size());
+    for (size_t i = 0; i < model.images.size(); ++i) {
+      const SfmImage& image = model.images[i];
+      if (!image.registered) continue;
+      const auto it = path_of.find(image.name);
+      if (it == path_of.end()) {
+        return FileError(StatusCode::kNotFound, project.ImageListPath(),
+                         "image " + image.name + " of " + project.SparseDir() + "/images.txt is not listed");
+      }
+      paths[i] = it->second;
+    }
+    report.images = model.NumRegisteredImages();
+  }
+  if (report.images == 0) return FailedPrecondition(project.SparseDir() + ": the model has no registered image");
+
+  // Level and cluster size from the memory budget.
+  const int num_threads = ThreadPool::ResolveThreadCount(options.num_threads);
+  DenseMemoryInput memory;
+  for (const SfmImage& image : model.images) {
+    if (!image.registered) continue;
+    const SfmCamera& camera = model.cameras[static_cast<size_t>(image.camera_id)];
+    memory.image_sizes.emplace_back(camera.width, camera.height);
+  }
+  memory.max_cluster_size = options.clustering.max_cluster_size;
+  memory.cell_size = options.mvs.cell_size;
+  memory.num_threads = num_threads;
+  memory.baseline_bytes = CurrentMemoryUsage().resident_bytes;
+  const int min_cluster = std::max(options.clustering.min_views_per_point, options.mvs.min_visible_views);
+  RECONAR_ASSIGN_OR_RETURN(const DenseLevelChoice choice,
+                           ChooseDenseLevel(memory, options.level, options.memory_budget_bytes, min_cluster));
+  report.level = choice.level;
+  report.level_auto = options.level < 0;
+  report.estimated_bytes = choice.estimated_bytes;
+  report.max_cluster_size = std::max(choice.max_cluster_size, options.clustering.min_views_per_point);
+  report.cluster_size_reduced = choice.reduced_cluster_size;
+
+  ViewClustering clustering;
+  {
+    PhaseTimer timer(&report.clustering);
+    ViewClusteringOptions clustering_options = options.clustering;
+    clustering_options.max_cluster_size = report.max_cluster_size;
+    RECONAR_ASSIGN_OR_RETURN(clustering, ClusterViews(model, clustering_options));
+  }
+  report.kept_images = static_cast<int>(clustering.kept_images.size());
+  report.removed_images = static_cast<int>(clustering.removed_images.size());
+  report.clusters = static_cast<int>(clustering.clusters.size());
+  report.clusters_from_cameras = clustering.from_camera_geometry;
+  report.sparse_points_covered = clustering.covered_fraction;
+
+  // Per cluster: undistort its views (reusing the previous cluster's), run PMVS, keep the points.
+  PatchMvsOptions mvs_options = options.mvs;
+  if (mvs_options.num_threads == 0) mvs_options.num_threads = num_threads;
+  mvs_options.show_progress = options.show_progress;
+  ThreadPool pool(num_threads);
+  size_t loads = 0;  // views the undistortion will produce, for the progress bar
+  {
+    std::vector<int> previous;
+    for (const std::vector<int>& cluster : clustering.clusters) {
+      if (static_cast<int>(cluster.size()) < mvs_options.min_visible_views) continue;
+      for (int id : cluster) loads += std::binary_search(previous.begin(), previous.end(), id) ? 0 : 1;
+      previous = cluster;
+    }
+  }
+  std::unique_ptr<Progress> progress;
+  if (options.show_progress) progress = std::make_unique<Progress>("undistort", loads);
+  std::map<int, std::unique_ptr<DenseView>> cache;
+  std::vector<MergeInput> parts;
+  for (size_t c = 0; c < clustering.clusters.size(); ++c) {
+    const std::vector<int>& cluster = clustering.clusters[c];
+    if (static_cast<int>(cluster.size()) < mvs_options.min_visible_views) {
+      ++report.clusters_without_points;
+      continue;
+    }
+    {
+      PhaseTimer timer(&report.undistort);
+      RECONAR_RETURN_IF_ERROR(LoadClusterViews(cluster, model, paths, report.level, &pool, progress.get(), &cache,
+                                               &report.views_undistorted));
+      if (progress && report.views_undistorted == loads) progress->Finish();
+    }
+    std::vector<const DenseView*> views;
+    for (int id : cluster) views.push_back(cache.at(id).get());
+    if (options.show_progress) {
+      std::fprintf(stderr, "dense: cluster %zu of %zu, %zu views\n", c + 1, clustering.clusters.size(), cluster.size());
+    }
+    PhaseTimer timer(&report.mvs);
+    PatchMvsReport cluster_report;
+    auto points = RunPatchMvs(views, mvs_options, &cluster_report);
+    if (!points.ok()) {
+      if (points.status().code() != StatusCode::kFailedPrecondition) {
+        return points.status().WithContext("dense: cluster " + std::to_string(c + 1) + " of " +
+                                           std::to_string(clustering.clusters.size()));
+      }
+      ++report.clusters_without_points;
+      continue;
+    }
+    AddReports(cluster_report, &report.pmvs);
+    MergeInput part;
+    part.footprints.reserve(points->size());
+    for (const Eigen::Vector3f& position : points->positions) part.footprints.push_back(PixelFootprint(views, position));
+    part.points = std::move(*points);
+    report.points_before_merge += part.points.size();
+    parts.push_back(std::move(part));
+  }
+  if (progress) progress->Finish();
+  cache.clear();
+  if (report.points_before_merge == 0) {
+    return FailedPrecondition("dense: no cluster of " + project.SparseDir() +
+                              " yielded a point (too few views per cluster, or images without texture)");
+  }
+
+  OrientedPoints merged;
+  {
+    PhaseTimer timer(&report.merge);
+    merged = MergeOrientedPoints(parts, nullptr);
+    parts.clear();
+  }
+  report.points = merged.size();
+
+  const std::string dense_dir = project.root() + "/dense";
+  report.points_path = dense_dir + "/points.ply";
+  report.report_path = dense_dir + "/report.json";
+  {
+    PhaseTimer timer(&report.write);
+    RECONAR_RETURN_IF_ERROR(CreateDirectories(dense_dir));
+    RECONAR_RETURN_IF_ERROR(WritePly(report.points_path, ToPointCloud(merged)));
+  }
+  // report.json last: its presence marks a finished dense stage. Its own write is not timed.
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, DenseReportJson(report)));
+  return report;
+}
+
+std::string DenseReportJson(const DenseStageReport& report) {
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("level").Int(report.level);
+  json.Key("level_chosen_from_memory_budget").Bool(report.level_auto);
+  json.Key("estimated_cluster_mib").Double(static_cast<double>(report.estimated_bytes) / (1 << 20));
+  json.Key("max_cluster_size").Int(report.max_cluster_size);
+  json.Key("cluster_size_reduced_for_budget").Bool(report.cluster_size_reduced);
+  json.Key("images").Int(report.images);
+  json.Key("kept_images").Int(report.kept_images);
+  json.Key("removed_images").Int(report.removed_images);
+  json.Key("clusters").Int(report.clusters);
+  json.Key("clusters_without_points").Int(report.clusters_without_points);
+  json.Key("clusters_from_camera_geometry").Bool(report.clusters_from_cameras);
+  json.Key("sparse_points_covered").Double(report.sparse_points_covered);
+  json.Key("views_undistorted").Int(static_cast<long long>(report.views_undistorted));
+  json.Key("points_before_merge").Int(static_cast<long long>(report.points_before_merge));
+  json.Key("points").Int(static_cast<long long>(report.points));
+  json.Key("pmvs").BeginObject();
+  json.Key("features").Int(static_cast<long long>(report.pmvs.features));
+  json.Key("initial_patches").Int(static_cast<long long>(report.pmvs.initial_patches));
+  json.Key("expanded_patches").Int(static_cast<long long>(report.pmvs.expanded_patches));
+  json.Key("final_patches").Int(static_cast<long long>(report.pmvs.final_patches));
+  json.Key("seconds_features").Double(report.pmvs.seconds_features);
+  json.Key("seconds_matching").Double(report.pmvs.seconds_matching);
+  json.Key("seconds_expansion").Double(report.pmvs.seconds_expansion);
+  json.Key("seconds_filtering").Double(report.pmvs.seconds_filtering);
+  json.EndObject();
+  json.Key("peak_rss_resettable").Bool(report.peak_rss_resettable);
+  json.Key("phases").BeginObject();
+  PhaseJson("load", report.load, &json);
+  PhaseJson("clustering", report.clustering, &json);
+  PhaseJson("undistort", report.undistort, &json);
+  PhaseJson("mvs", report.mvs, &json);
+  PhaseJson("merge", report.merge, &json);
+  PhaseJson("write", report.write, &json);
+  json.EndObject();
+  json.EndObject();
+  return json.str() + "\n";
+}
+
+}  // namespace reconar

@@ -1,0 +1,66 @@
+#pragma once
+// Dense stage: reads a project's sparse model (<project>/sparse, COLMAP text) and image list
+// (features/images.txt), groups the registered images into view clusters (core/mvs/view_clustering.h),
+// undistorts the views of each cluster (core/mvs/undistort.h) and runs PMVS on it
+// (core/mvs/pmvs/patch_mvs.h), merges the clusters' points (core/mvs/merge_points.h) and writes
+//   <project>/dense/points.ply     binary PLY: x y z, nx ny nz (float), red green blue alpha (uchar)
+//   <project>/dense/report.json    DenseReportJson below
+// atomically. Views stay in memory only while a cluster that holds them runs, so memory follows the
+// cluster size and the level (core/mvs/dense_memory.h), not the number of images.
+#include <cstddef>
+#include <string>
+
+#include "core/base/status.h"
+#include "core/mvs/pmvs/patch_mvs.h"
+#include "core/mvs/view_clustering.h"
+#include "core/pipeline/project.h"
+
+namespace reconar {
+
+struct DenseStageOptions {
+  int level = -1;  // -1: the finest level 0..2 whose memory estimate fits the budget; else 0, 1 or 2
+  size_t memory_budget_bytes = 3ull << 30;
+  ViewClusteringOptions clustering;
+  PatchMvsOptions mvs;  // its num_threads 0 takes the stage's
+  int num_threads = 0;  // 0: one per core
+  bool show_progress = true;
+
+  Status Check() const;
+};
+
+struct DensePhase {
+  double seconds = 0.0;
+  size_t peak_rss_bytes = 0;  // VmHWM over the phase (since process start when resets are refused)
+};
+
+struct DenseStageReport {
+  int level = 0;
+  bool level_auto = false;
+  size_t estimated_bytes = 0;     // the memory model's figure for one cluster at that level
+  int max_cluster_size = 0;       // as used (below the requested one when the budget demanded it)
+  bool cluster_size_reduced = false;
+  int images = 0;                 // registered images in the model
+  int kept_images = 0, removed_images = 0;
+  int clusters = 0;
+  int clusters_without_points = 0;  // too small for PMVS, or no patch survived
+  bool clusters_from_cameras = false;
+  double sparse_points_covered = 0.0;  // fraction, see ViewClustering::covered_fraction
+  size_t views_undistorted = 0;   // counting views reused by consecutive clusters once
+  size_t points_before_merge = 0;
+  size_t points = 0;
+  DensePhase load, clustering, undistort, mvs, merge, write;
+  bool peak_rss_resettable = false;
+  PatchMvsReport pmvs;            // summed over clusters
+  std::string points_path, report_path;
+};
+
+// Errors name the file: a missing or corrupt sparse model or image list, an image missing from the
+// list or unreadable, a photo whose size differs from its camera. FailedPrecondition when no
+// cluster yields a point; ResourceExhausted when even the smallest useful cluster at the coarsest
+// allowed level exceeds the budget.
+Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageOptions& options);
+
+// The report as JSON (what dense/report.json holds).
+std::string DenseReportJson(const DenseStageReport& report);
+
+}  // namespace reconar

@@ -1,0 +1,82 @@
+#include "core/mvs/merge_points.h"
+
+#include <gtest/gtest.h>
+
+#include "core/mvs/dense_memory.h"
+
+namespace reconar {
+namespace {
+
+void Add(MergeInput* part, const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float score,
+         float footprint) {
+  part->points.positions.push_back(position);
+  part->points.normals.push_back(normal);
+  part->points.colors.push_back({static_cast<uint8_t>(100 * score), 0, 0});
+  part->points.scores.push_back(score);
+  part->footprints.push_back(footprint);
+}
+
+TEST(MergePoints, DropsDuplicatesWithinOneFootprintAndKeepsTheBetter) {
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  std::vector<MergeInput> parts(2);
+  for (int i = 0; i < 10; ++i) {
+    // A row of points 3 footprints apart; the second cluster saw the same surface 0.3 footprint off.
+    Add(&parts[0], Eigen::Vector3f(0.03f * i, 0, 0), up, 0.8f, 0.01f);
+    Add(&parts[1], Eigen::Vector3f(0.03f * i + 0.003f, 0, 0), up, 0.9f, 0.01f);
+  }
+  Add(&parts[1], Eigen::Vector3f(0, 0, 0.002f), -up, 0.95f, 0.01f);  // the other side of a thin sheet
+  MergeReport report;
+  const OrientedPoints merged = MergeOrientedPoints(parts, &report);
+  EXPECT_EQ(report.input_points, 21u);
+  EXPECT_EQ(report.duplicates_dropped, 10u);
+  ASSERT_EQ(merged.size(), 11u);
+  for (size_t i = 0; i < merged.size(); ++i) {
+    EXPECT_GE(merged.scores[i], 0.9f);  // the better-scored copy survived
+    EXPECT_EQ(merged.colors[i][0], static_cast<uint8_t>(100 * merged.scores[i]));
+  }
+}
+
+TEST(MergePoints, PixelFootprintIsDepthOverFocalInTheClosestView) {
+  DenseView near, far;
+  for (DenseView* view : {&near, &far}) {
+    view->gray = Image<uint8_t>(100, 100, 1);
+    view->fx = view->fy = 200.0;
+    view->cx = view->cy = 49.5;
+  }
+  near.pose.cam_from_world_translation = Eigen::Vector3d(0, 0, 2);
+  far.pose.cam_from_world_translation = Eigen::Vector3d(0, 0, 8);
+  EXPECT_FLOAT_EQ(PixelFootprint({&far, &near}, Eigen::Vector3f::Zero()), 2.0f / 200.0f);
+  EXPECT_EQ(PixelFootprint({&far, &near}, Eigen::Vector3f(0, 0, -10)), 0.0f);  // behind both
+}
+
+TEST(DenseMemory, FinestLevelThatFitsThenSmallerClusters) {
+  DenseMemoryInput input;
+  input.image_sizes.assign(30, {3072, 2048});
+  input.max_cluster_size = 20;
+  input.num_threads = 2;
+  const size_t level0 = EstimateDenseBytes(input, 0, 20);
+  const size_t level1 = EstimateDenseBytes(input, 1, 20);
+  const size_t level2 = EstimateDenseBytes(input, 2, 20);
+  EXPECT_GT(level0, 3 * level1);
+  EXPECT_GT(level1, 2 * level2);
+  auto choice = ChooseDenseLevel(input, -1, level0, 3);
+  ASSERT_TRUE(choice.ok());
+  EXPECT_EQ(choice->level, 0);
+  choice = ChooseDenseLevel(input, -1, level0 - 1, 3);
+  ASSERT_TRUE(choice.ok());
+  EXPECT_EQ(choice->level, 1);
+  choice = ChooseDenseLevel(input, -1, level2 - 1, 3);
+  ASSERT_TRUE(choice.ok());
+  EXPECT_EQ(choice->level, 2);
+  EXPECT_TRUE(choice->reduced_cluster_size);
+  EXPECT_EQ(choice->max_cluster_size, 19);
+  choice = ChooseDenseLevel(input, 0, level1, 3);  // a fixed level keeps the level, shrinks clusters
+  ASSERT_TRUE(choice.ok());
+  EXPECT_EQ(choice->level, 0);
+  EXPECT_LT(choice->max_cluster_size, 20);
+  EXPECT_EQ(ChooseDenseLevel(input, -1, 1 << 20, 3).status().code(), StatusCode::kResourceExhausted);
+  EXPECT_EQ(ChooseDenseLevel(input, 3, level0, 3).status().code(), StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace reconar

@@ -1,0 +1,106 @@
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <string>
+
+#include "core/pipeline/dense_stage.h"
+#include "tools/args.h"
+#include "tools/commands.h"
+
+namespace reconar::tools {
+namespace {
+
+constexpr char kHelp[] =
+    "usage: reconar dense PROJECT_DIR [options]\n"
+    "\n"
+    "Dense multi-view stereo on a project made by `reconar sfm`: the registered images are grouped\n"
+    "into overlapping view clusters (CMVS; redundant images dropped), each cluster's photos are\n"
+    "undistorted at the chosen resolution level and PMVS grows oriented patches from them; the\n"
+    "clusters' points are merged. Reads PROJECT_DIR/sparse and PROJECT_DIR/features/images.txt,\n"
+    "writes:\n"
+    "  dense/points.ply      binary PLY: position, normal, RGBA colour per point\n"
+    "  dense/report.json     level, clusters, counts, seconds and peak memory per phase\n"
+    "  --level 0|1|2|auto     image resolution: full, half, quarter; auto (default) takes the finest\n"
+    "                         whose memory estimate fits --memory-budget\n"
+    "  --max-cluster-size N   images per PMVS run (default 20; smaller needs less memory)\n"
+    "  --memory-budget MiB    memory the run may use (default 3072)\n"
+    "  --threads N            worker threads (default: one per core)\n"
+    "  --json                 print the report as JSON instead of a summary\n";
+
+bool IsDirectory(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+double Mib(size_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
+
+void PrintSummary(const DenseStageReport& r) {
+  std::printf("dense: level %d (%s), %d of %d images kept (%d redundant), %d clusters of at most %d images%s\n",
+              r.level, r.level_auto ? "auto" : "given", r.kept_images, r.images, r.removed_images, r.clusters,
+              r.max_cluster_size, r.cluster_size_reduced ? " (reduced for the memory budget)" : "");
+  if (r.clusters_from_cameras) std::printf("dense: no sparse points; clusters from camera positions\n");
+  std::printf("dense: %zu points (%zu before merging clusters), %zu PMVS features, %zu initial + %zu expanded patches\n",
+              r.points, r.points_before_merge, r.pmvs.features, r.pmvs.initial_patches, r.pmvs.expanded_patches);
+  const struct {
+    const char* name;
+    const DensePhase& phase;
+  } phases[] = {{"load", r.load}, {"clustering", r.clustering}, {"undistort", r.undistort},
+                {"mvs", r.mvs},   {"merge", r.merge},           {"write", r.write}};
+  double total = 0.0;
+  for (const auto& p : phases) total += p.phase.seconds;
+  std::printf("dense: %.1fs:", total);
+  for (const auto& p : phases) std::printf(" %s %.1fs (peak %.0f MiB)", p.name, p.phase.seconds, Mib(p.phase.peak_rss_bytes));
+  std::printf("%s\n", r.peak_rss_resettable ? "" : " [peaks since process start]");
+  std::printf("dense: estimated %.0f MiB per cluster; written to %s and %s\n", Mib(r.estimated_bytes),
+              r.points_path.c_str(), r.report_path.c_str());
+}
+
+}  // namespace
+
+int RunDense(int argc, char** argv, int first) {
+  Args args({"level", "max-cluster-size", "threads", "memory-budget"}, {"json"});
+  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
+  if (args.Has("help")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  if (args.positionals().size() != 1) {
+    std::fputs(kHelp, stderr);
+    return 2;
+  }
+  const Project project(args.positionals()[0]);
+  if (!IsDirectory(project.root())) {
+    return Fail(NotFound(project.root() + ": no such project directory (make one with `reconar sfm`)"));
+  }
+  DenseStageOptions options;
+  const std::string level = args.Get("level", "auto");
+  if (level == "auto") {
+    options.level = -1;
+  } else if (level == "0" || level == "1" || level == "2") {
+    options.level = level[0] - '0';
+  } else {
+    return Fail(InvalidArgument("--level must be 0, 1, 2 or auto, got '" + level + "'"));
+  }
+  auto cluster_size = args.GetInt("max-cluster-size", options.clustering.max_cluster_size, 3, 10000);
+  if (!cluster_size.ok()) return Fail(cluster_size.status());
+  options.clustering.max_cluster_size = *cluster_size;
+  auto threads = args.GetInt("threads", 0, 0, 1024);
+  if (!threads.ok()) return Fail(threads.status());
+  options.num_threads = *threads;
+  auto budget = args.GetInt("memory-budget", static_cast<int>(options.memory_budget_bytes >> 20), 16, 1 << 24);
+  if (!budget.ok()) return Fail(budget.status());
+  options.memory_budget_bytes = static_cast<size_t>(*budget) << 20;
+  const bool json = args.Has("json");
+  options.show_progress = true;
+
+  auto report = RunDenseStage(project, options);
+  if (!report.ok()) return Fail(report.status());
+  if (json) {
+    std::fputs(DenseReportJson(*report).c_str(), stdout);
+  } else {
+    PrintSummary(*report);
+  }
+  return 0;
+}
+
+}  // namespace reconar::tools
