@@ -5,7 +5,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh --cross
 build=${RECONAR_CROSS_BUILD_DIR:-build-aarch64}
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON -DRECONAR_BUILD_E2E_TESTS=OFF \
+generator_args=()  # Ninja for a new build directory, as scripts/test.sh
+if [ ! -f "$build/CMakeCache.txt" ]; then generator_args=(-G Ninja); fi
+cmake -S . -B "$build" "${generator_args[@]}" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON -DRECONAR_BUILD_E2E_TESTS=OFF \
   -DCMAKE_TOOLCHAIN_FILE=toolchains/aarch64-linux-gnu.cmake > "$build.configure.log" 2>&1 \
   || { cat "$build.configure.log"; exit 1; }
 cmake --build "$build" -j"$(nproc)"

@@ -11,7 +11,11 @@ validator_args=()
 if [ -f "$gltf_validator_dir/node_modules/gltf-validator/package.json" ]; then
   validator_args=(-DRECONAR_GLTF_VALIDATOR_DIR="$gltf_validator_dir")
 fi
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON "${validator_args[@]}" "$@" \
+# Ninja schedules all targets in one job pool (the Makefile generator serialises per target); a
+# build directory configured earlier keeps its generator.
+generator_args=()
+if [ ! -f "$build/CMakeCache.txt" ]; then generator_args=(-G Ninja); fi
+cmake -S . -B "$build" "${generator_args[@]}" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON "${validator_args[@]}" "$@" \
   > "$build.configure.log" 2>&1 \
   || { cat "$build.configure.log"; exit 1; }
 cmake --build "$build" -j"$(nproc)"
