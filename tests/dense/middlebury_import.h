@@ -10,26 +10,13 @@
 // principal point in ours (centre of the top-left pixel at (0, 0)). If Middlebury meant the pixel's
 // corner, every projection is off by half a pixel (0.17 mm on the temple), below what the dense
 // checks here can see.
-#include <Eigen/Core>
 #include <string>
 #include <vector>
 
 #include "core/base/status.h"
-#include "core/sfm/reconstruction.h"
 
 namespace reconar {
 namespace testing {
-
-struct MiddleburyView {
-  std::string name;  // "templeR0001.png"
-  Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
-  SfmPose pose;      // cam_from_world
-};
-
-// Parses a *_par.txt file. CorruptData "path:line: reason" for a malformed line, a count that
-// disagrees with the lines, a K that is not upper triangular with k33 = 1, or an R that is not a
-// rotation (|R^T R - I| > 1e-6, det < 0); Unsupported for a skewed K (k12 != 0).
-Result<std::vector<MiddleburyView>> ReadMiddleburyParameters(const std::string& par_path);
 
 struct MiddleburyImportOptions {
   std::string image_dir;  // where the PNGs are; empty = the directory of the _par.txt file
@@ -44,7 +31,7 @@ struct MiddleburyImportReport {
 // Writes <project_dir>/features/images.txt (the PNGs' absolute paths, sizes read from the files,
 // focal source "ground-truth") and <project_dir>/sparse/ (cameras: focal = k11, aspect = k22 / k11,
 // principal point (k13, k23), no distortion; one camera per distinct K). NotFound for a missing
-// image; errors of ReadMiddleburyParameters.
+// image; errors of ReadMiddleburyParInOrder (tests/support/sfm_evaluation.h).
 Result<MiddleburyImportReport> ImportMiddleburyProject(const std::string& par_path, const std::string& project_dir,
                                                       const MiddleburyImportOptions& options = {});
 

@@ -12,6 +12,7 @@
 #include "core/pipeline/project.h"
 #include "core/sfm/model_io.h"
 #include "tests/support/run_command.h"
+#include "tests/support/sfm_evaluation.h"
 
 namespace reconar {
 namespace testing {
@@ -130,7 +131,7 @@ TEST(MiddleburyImportTest, MalformedFilesNameTheLine) {
   };
   for (const Case& c : cases) {
     ASSERT_TRUE(WriteFileAtomically(dir + "/bad_par.txt", c.text).ok());
-    auto views = ReadMiddleburyParameters(dir + "/bad_par.txt");
+    auto views = ReadMiddleburyParInOrder(dir + "/bad_par.txt");
     ASSERT_FALSE(views.ok()) << c.text;
     EXPECT_EQ(views.status().code(), c.code) << views.status().ToString();
     EXPECT_NE(views.status().ToString().find(c.needle), std::string::npos) << views.status().ToString();

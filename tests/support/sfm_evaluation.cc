@@ -124,27 +124,61 @@ Result<GroundTruthByName> ReadStrechaGroundTruth(const std::string& dir) {
   return cameras;
 }
 
-Result<GroundTruthByName> ReadMiddleburyPar(const std::string& path) {
+Result<std::vector<NamedGroundTruthCamera>> ReadMiddleburyParInOrder(const std::string& path) {
   RECONAR_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  const auto line_error = [&path](int line, const std::string& reason) {
+    return CorruptData(path + ":" + std::to_string(line) + ": " + reason);
+  };
   std::istringstream in(text);
-  int count = 0;
-  if (!(in >> count) || count <= 0) return FileError(StatusCode::kCorruptData, path, "line 1: expected the image count");
-  GroundTruthByName cameras;
-  for (int i = 0; i < count; ++i) {
-    std::string name;
-    double v[21];
-    in >> name;
-    for (double& x : v) in >> x;
-    if (!in) {
-      return FileError(StatusCode::kCorruptData, path,
-                       "line " + std::to_string(i + 2) + ": expected a name and 21 numbers (K, R, t)");
+  std::string line;
+  int line_number = 0;
+  int expected = -1;
+  std::vector<NamedGroundTruthCamera> cameras;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::istringstream fields(line);
+    if (expected < 0) {
+      if (!(fields >> expected) || expected <= 0) return line_error(line_number, "expected the image count");
+      continue;
     }
-    GroundTruthCamera camera;
+    NamedGroundTruthCamera named;
+    double v[21];
+    if (!(fields >> named.name)) return line_error(line_number, "expected an image name");
+    for (double& value : v) {
+      if (!(fields >> value) || !std::isfinite(value)) {
+        return line_error(line_number, "expected 21 numbers after the name (K, R, t)");
+      }
+    }
+    std::string extra;
+    if (fields >> extra) return line_error(line_number, "unexpected text after t: \"" + extra + "\"");
+    GroundTruthCamera& camera = named.camera;
     camera.K << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
     camera.cam_from_world_rotation << v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16], v[17];
     camera.cam_from_world_translation << v[18], v[19], v[20];
-    cameras.emplace(name, camera);
+    const Eigen::Matrix3d& k = camera.K;
+    if (k(1, 0) != 0.0 || k(2, 0) != 0.0 || k(2, 1) != 0.0 || k(2, 2) != 1.0 || !(k(0, 0) > 0.0) || !(k(1, 1) > 0.0)) {
+      return line_error(line_number, "K must be upper triangular with positive focal lengths and k33 = 1");
+    }
+    if (k(0, 1) != 0.0) return Unsupported(path + ":" + std::to_string(line_number) + ": skewed K");
+    const Eigen::Matrix3d& r = camera.cam_from_world_rotation;
+    if ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || r.determinant() < 0.0) {
+      return line_error(line_number, "R is not a rotation");
+    }
+    cameras.push_back(std::move(named));
   }
+  if (expected < 0) return CorruptData(path + ": empty file");
+  if (static_cast<int>(cameras.size()) != expected) {
+    return CorruptData(path + ": the header announces " + std::to_string(expected) + " images, the file has " +
+                       std::to_string(cameras.size()));
+  }
+  return cameras;
+}
+
+Result<GroundTruthByName> ReadMiddleburyPar(const std::string& path) {
+  RECONAR_ASSIGN_OR_RETURN(std::vector<NamedGroundTruthCamera> in_order, ReadMiddleburyParInOrder(path));
+  GroundTruthByName cameras;
+  for (NamedGroundTruthCamera& named : in_order) cameras.emplace(std::move(named.name), named.camera);
   return cameras;
 }
 

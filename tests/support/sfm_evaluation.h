@@ -61,6 +61,15 @@ Result<GroundTruthByName> ReadStrechaGroundTruth(const std::string& dir);
 
 // Middlebury "*_par.txt": a count, then "name k11..k33 r11..r33 t1 t2 t3" per image, with
 // x ~ K [R | t] X. The file has no image size: width and height stay 0.
+// In file order. CorruptData "path:line: reason" for a malformed line, a count that disagrees with
+// the lines, a K that is not upper triangular with positive focal lengths and k33 = 1, or an R
+// that is not a rotation (|R^T R - I| > 1e-6, det < 0); Unsupported for a skewed K (k12 != 0).
+struct NamedGroundTruthCamera {
+  std::string name;  // "templeR0001.png"
+  GroundTruthCamera camera;
+};
+Result<std::vector<NamedGroundTruthCamera>> ReadMiddleburyParInOrder(const std::string& path);
+// The same, keyed by name.
 Result<GroundTruthByName> ReadMiddleburyPar(const std::string& path);
 
 }  // namespace reconar::testing

@@ -10,10 +10,9 @@
 #include <filesystem>
 #include <string>
 
-#include "core/base/atomic_file.h"
 #include "core/mesh/mesh_io.h"
-#include "core/pipeline/project.h"
 #include "core/sfm/model_io.h"
+#include "tests/dense/middlebury_import.h"
 #include "tests/support/ground_truth.h"
 #include "tests/support/run_command.h"
 #include "tests/support/sfm_evaluation.h"
@@ -79,33 +78,9 @@ TEST(DenseCli, BadUsageExitsTwoWithAReason) {
 }
 
 TEST(DenseCli, TempleWithGroundTruthCamerasLiesInTheObjectBox) {
-  auto truth = testing::ReadMiddleburyPar(Temple() + "/templeSR_par.txt");
-  ASSERT_TRUE(truth.ok()) << truth.status().ToString();
-  Reconstruction model;
-  std::vector<ProjectImage> list;
-  for (const auto& [name, camera] : *truth) {
-    SfmCamera sfm_camera;
-    sfm_camera.width = 640;
-    sfm_camera.height = 480;
-    sfm_camera.focal = camera.K(0, 0);
-    sfm_camera.aspect = camera.K(1, 1) / camera.K(0, 0);
-    sfm_camera.cx = camera.K(0, 2);
-    sfm_camera.cy = camera.K(1, 2);
-    SfmImage image;
-    image.name = name;
-    image.camera_id = static_cast<int>(model.cameras.size());
-    image.registered = true;
-    image.pose.cam_from_world_rotation = camera.cam_from_world_rotation;
-    image.pose.cam_from_world_translation = camera.cam_from_world_translation;
-    model.cameras.push_back(sfm_camera);
-    model.images.push_back(image);
-    list.push_back({name, Temple() + "/" + name, 640, 480, sfm_camera.focal, "default"});
-  }
   const std::string dir = testing::MakeTestDirectory("dense_cli_temple_gt");
-  const Project project(dir);
-  ASSERT_TRUE(WriteColmapTextModel(model, project.SparseDir()).ok());
-  ASSERT_TRUE(CreateDirectories(project.FeaturesDir()).ok());
-  ASSERT_TRUE(project.WriteImageList(list).ok());
+  auto imported = testing::ImportMiddleburyProject(Temple() + "/templeSR_par.txt", dir);
+  ASSERT_TRUE(imported.ok()) << imported.status().ToString();
 
   const CommandRun run = RunReconar("dense " + dir + " --level 1 --threads 2");
   ASSERT_EQ(run.exit_code, 0) << run.output;
