@@ -24,6 +24,7 @@ constexpr char kHelp[] =
     "                         whose memory estimate fits --memory-budget\n"
     "  --max-cluster-size N   images per PMVS run (default 20; smaller needs less memory)\n"
     "  --memory-budget MiB    memory the run may use (default 3072)\n"
+    "  --keep-outliers        keep isolated points and small floating pieces (removed by default)\n"
     "  --threads N            worker threads (default: one per core)\n"
     "  --json                 print the report as JSON instead of a summary\n";
 
@@ -41,11 +42,17 @@ void PrintSummary(const DenseStageReport& r) {
   if (r.clusters_from_cameras) std::printf("dense: no sparse points; clusters from camera positions\n");
   std::printf("dense: %zu points (%zu before merging clusters), %zu PMVS features, %zu initial + %zu expanded patches\n",
               r.points, r.points_before_merge, r.pmvs.features, r.pmvs.initial_patches, r.pmvs.expanded_patches);
+  if (r.outliers.input_points > 0) {
+    std::printf("dense: outliers removed: %zu isolated, %zu in %d small pieces (median spacing %.4g)\n",
+                r.outliers.isolated_removed, r.outliers.small_piece_removed, r.outliers.pieces - r.outliers.pieces_kept,
+                r.outliers.median_spacing);
+  }
   const struct {
     const char* name;
     const DensePhase& phase;
   } phases[] = {{"load", r.load}, {"clustering", r.clustering}, {"undistort", r.undistort},
-                {"mvs", r.mvs},   {"merge", r.merge},           {"write", r.write}};
+                {"mvs", r.mvs},   {"merge", r.merge},           {"outliers", r.outlier_filter},
+                {"write", r.write}};
   double total = 0.0;
   for (const auto& p : phases) total += p.phase.seconds;
   std::printf("dense: %.1fs:", total);
@@ -58,7 +65,7 @@ void PrintSummary(const DenseStageReport& r) {
 }  // namespace
 
 int RunDense(int argc, char** argv, int first) {
-  Args args({"level", "max-cluster-size", "threads", "memory-budget"}, {"json"});
+  Args args({"level", "max-cluster-size", "threads", "memory-budget"}, {"json", "keep-outliers"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
     std::fputs(kHelp, stdout);
@@ -91,6 +98,7 @@ int RunDense(int argc, char** argv, int first) {
   if (!budget.ok()) return Fail(budget.status());
   options.memory_budget_bytes = static_cast<size_t>(*budget) << 20;
   const bool json = args.Has("json");
+  options.remove_outliers = !args.Has("keep-outliers");
   options.show_progress = true;
 
   auto report = RunDenseStage(project, options);

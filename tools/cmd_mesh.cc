@@ -6,11 +6,11 @@
 #include <thread>
 
 #include "core/base/json_writer.h"
+#include "core/base/keep_masked.h"
 #include "core/mesh/mesh_file.h"
-#include "core/mesh/poisson/poisson.h"
-#ifdef RECONAR_HAVE_NORMAL_ESTIMATION
 #include "core/mesh/poisson/point_normals.h"
-#endif
+#include "core/mesh/poisson/point_outliers.h"
+#include "core/mesh/poisson/poisson.h"
 #include "tools/args.h"
 #include "tools/commands.h"
 
@@ -28,6 +28,8 @@ constexpr char kHelp[] =
     "  --trim T             drop surface whose sample density depth is below T, e.g. where Poisson\n"
     "                       closed holes in the data (default 0: keep everything; try depth - 1)\n"
     "  --point-weight W     screening weight: how closely the surface follows the points (default 1, as COLMAP)\n"
+    "  --remove-outliers    drop isolated points and small floating pieces first (core/mesh/poisson/\n"
+    "                       point_outliers.h; `reconar dense` already does this to its output)\n"
     "  --estimate-normals   estimate normals from the nearest neighbours (replaces normals in INPUT)\n"
     "  --threads N          worker threads (default: one per core)\n"
     "  --ascii              write .ply as ASCII\n"
@@ -41,6 +43,7 @@ struct MeshRun {
   std::string input, output;
   size_t points = 0;
   bool normals_estimated = false;
+  OutlierFilterReport outliers;
   PoissonOptions options;
   PoissonReport report;
   double seconds_read = 0.0, seconds_normals = 0.0, seconds_poisson = 0.0, seconds_write = 0.0;
@@ -52,6 +55,7 @@ std::string ReportJson(const MeshRun& run) {
   json.BeginObject();
   json.Key("input").String(run.input).Key("output").String(run.output);
   json.Key("points").Int(static_cast<long long>(run.points)).Key("normals_estimated").Bool(run.normals_estimated);
+  json.Key("outliers_removed").Int(static_cast<long long>(run.outliers.input_points - run.outliers.kept_points()));
   json.Key("depth").Int(run.options.depth).Key("point_weight").Double(run.options.point_weight);
   json.Key("trim").Double(run.options.trim).Key("threads").Int(run.options.num_threads);
   json.Key("vertices").Int(static_cast<long long>(r.vertices)).Key("triangles").Int(static_cast<long long>(r.triangles));
@@ -71,7 +75,7 @@ std::string ReportJson(const MeshRun& run) {
 }  // namespace
 
 int RunMesh(int argc, char** argv, int first) {
-  Args args({"depth", "trim", "point-weight", "threads"}, {"estimate-normals", "ascii", "json"});
+  Args args({"depth", "trim", "point-weight", "threads"}, {"estimate-normals", "remove-outliers", "ascii", "json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
     std::fputs(kHelp, stdout);
@@ -99,11 +103,6 @@ int RunMesh(int argc, char** argv, int first) {
   options.num_threads = *threads;
   options.show_progress = true;
   if (Status s = options.Check(); !s.ok()) return Fail(s);
-#ifndef RECONAR_HAVE_NORMAL_ESTIMATION
-  if (args.Has("estimate-normals")) {
-    return Fail(Unsupported("--estimate-normals: this build has no normal estimation (core/mesh/poisson/point_normals.h)"));
-  }
-#endif
   // Both extensions are checked before the (long) reconstruction.
   if (auto format = ReadableMeshFileFormatOf(run.input); !format.ok()) return Fail(format.status());
   auto output_format = MeshFileFormatOf(run.output);
@@ -121,12 +120,23 @@ int RunMesh(int argc, char** argv, int first) {
   auto t1 = std::chrono::steady_clock::now();
   run.seconds_read = Seconds(t0, t1);
   if (!args.Has("json")) PrintMeshSummary("read", run.input, *points);
+  if (args.Has("remove-outliers")) {
+    points->triangles.clear();
+    OutlierFilterOptions outlier_options;
+    outlier_options.num_threads = options.num_threads;
+    auto keep = FindInlierPoints(points->positions, outlier_options, &run.outliers);
+    if (!keep.ok()) return Fail(keep.status().WithContext(run.input));
+    KeepMasked(*keep, &points->positions);
+    KeepMasked(*keep, &points->normals);
+    KeepMasked(*keep, &points->colors);
+    std::fprintf(stderr, "outliers: %zu isolated and %zu in %d small pieces removed, %zu points kept\n",
+                 run.outliers.isolated_removed, run.outliers.small_piece_removed,
+                 run.outliers.pieces - run.outliers.pieces_kept, points->positions.size());
+  }
   if (args.Has("estimate-normals")) {
-#ifdef RECONAR_HAVE_NORMAL_ESTIMATION
     points->triangles.clear();
     if (Status s = EstimateNormals(&*points, NormalEstimationOptions()); !s.ok()) return Fail(s.WithContext(run.input));
     run.normals_estimated = true;
-#endif
     t0 = t1;
     t1 = std::chrono::steady_clock::now();
     run.seconds_normals = Seconds(t0, t1);

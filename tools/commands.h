@@ -12,8 +12,8 @@ int RunTrack(int argc, char** argv, int first);
 int RunCalibrate(int argc, char** argv, int first);
 int RunView(int argc, char** argv, int first);  // defined only with RECONAR_HAVE_VIEW
 int RunExport(int argc, char** argv, int first);
-int RunMesh(int argc, char** argv, int first);   // defined only with RECONAR_HAVE_POISSON
-int RunDense(int argc, char** argv, int first);  // defined only with RECONAR_HAVE_DENSE
+int RunMesh(int argc, char** argv, int first);
+int RunDense(int argc, char** argv, int first);
 
 }  // namespace reconar::tools
 

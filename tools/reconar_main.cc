@@ -42,23 +42,8 @@ int main(int argc, char** argv) {
   if (command == "track") return reconar::tools::RunTrack(argc, argv, 2);
   if (command == "calibrate") return reconar::tools::RunCalibrate(argc, argv, 2);
   if (command == "export") return reconar::tools::RunExport(argc, argv, 2);
-  if (command == "mesh") {
-#ifdef RECONAR_HAVE_POISSON
-    return reconar::tools::RunMesh(argc, argv, 2);
-#else
-    std::fputs("reconar: mesh needs Poisson reconstruction (core/mesh/poisson), which this build lacks\n", stderr);
-    return 2;
-#endif
-  }
-  if (command == "dense") {
-#ifdef RECONAR_HAVE_DENSE
-    return reconar::tools::RunDense(argc, argv, 2);
-#else
-    std::fputs("reconar: dense needs multi-view stereo (core/mvs, tools/cmd_dense.cc), which this build lacks\n",
-               stderr);
-    return 2;
-#endif
-  }
+  if (command == "mesh") return reconar::tools::RunMesh(argc, argv, 2);
+  if (command == "dense") return reconar::tools::RunDense(argc, argv, 2);
   if (command == "view") {
 #ifdef RECONAR_HAVE_VIEW
     return reconar::tools::RunView(argc, argv, 2);

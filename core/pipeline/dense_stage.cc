@@ -8,6 +8,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/json_writer.h"
+#include "core/base/keep_masked.h"
 #include "core/base/memory_usage.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
@@ -115,6 +116,7 @@ Status DenseStageOptions::Check() const {
   }
   if (memory_budget_bytes == 0) return InvalidArgument("dense: the memory budget must be positive");
   RECONAR_RETURN_IF_ERROR(clustering.Check());
+  RECONAR_RETURN_IF_ERROR(outliers.Check());
   return mvs.Check();
 }
 
@@ -248,6 +250,22 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
     merged = MergeOrientedPoints(parts, nullptr);
     parts.clear();
   }
+  if (options.remove_outliers) {
+    PhaseTimer timer(&report.outlier_filter);
+    OutlierFilterOptions outlier_options = options.outliers;
+    if (outlier_options.num_threads == 0) outlier_options.num_threads = num_threads;
+    RECONAR_ASSIGN_OR_RETURN(const std::vector<uint8_t> keep,
+                             FindInlierPoints(merged.positions, outlier_options, &report.outliers));
+    KeepMasked(keep, &merged.positions);
+    KeepMasked(keep, &merged.normals);
+    KeepMasked(keep, &merged.colors);
+    KeepMasked(keep, &merged.scores);
+    if (options.show_progress) {
+      std::fprintf(stderr, "dense: %zu isolated points and %zu in %d small pieces removed, %zu kept\n",
+                   report.outliers.isolated_removed, report.outliers.small_piece_removed,
+                   report.outliers.pieces - report.outliers.pieces_kept, merged.size());
+    }
+  }
   report.points = merged.size();
 
   const std::string dense_dir = project.root() + "/dense";
@@ -280,6 +298,12 @@ std::string DenseReportJson(const DenseStageReport& report) {
   json.Key("sparse_points_covered").Double(report.sparse_points_covered);
   json.Key("views_undistorted").Int(static_cast<long long>(report.views_undistorted));
   json.Key("points_before_merge").Int(static_cast<long long>(report.points_before_merge));
+  json.Key("outliers").BeginObject();
+  json.Key("isolated_removed").Int(static_cast<long long>(report.outliers.isolated_removed));
+  json.Key("small_piece_removed").Int(static_cast<long long>(report.outliers.small_piece_removed));
+  json.Key("pieces").Int(report.outliers.pieces).Key("pieces_kept").Int(report.outliers.pieces_kept);
+  json.Key("median_spacing").Double(report.outliers.median_spacing);
+  json.EndObject();
   json.Key("points").Int(static_cast<long long>(report.points));
   json.Key("pmvs").BeginObject();
   json.Key("features").Int(static_cast<long long>(report.pmvs.features));
@@ -298,6 +322,7 @@ std::string DenseReportJson(const DenseStageReport& report) {
   PhaseJson("undistort", report.undistort, &json);
   PhaseJson("mvs", report.mvs, &json);
   PhaseJson("merge", report.merge, &json);
+  PhaseJson("outlier_filter", report.outlier_filter, &json);
   PhaseJson("write", report.write, &json);
   json.EndObject();
   json.EndObject();

@@ -2,7 +2,8 @@
 // Dense stage: reads a project's sparse model (<project>/sparse, COLMAP text) and image list
 // (features/images.txt), groups the registered images into view clusters (core/mvs/view_clustering.h),
 // undistorts the views of each cluster (core/mvs/undistort.h) and runs PMVS on it
-// (core/mvs/pmvs/patch_mvs.h), merges the clusters' points (core/mvs/merge_points.h) and writes
+// (core/mvs/pmvs/patch_mvs.h), merges the clusters' points (core/mvs/merge_points.h), drops isolated
+// points and small floating pieces (core/mesh/poisson/point_outliers.h) and writes
 //   <project>/dense/points.ply     binary PLY: x y z, nx ny nz (float), red green blue alpha (uchar)
 //   <project>/dense/report.json    DenseReportJson below
 // atomically. Views stay in memory only while a cluster that holds them runs, so memory follows the
@@ -11,6 +12,7 @@
 #include <string>
 
 #include "core/base/status.h"
+#include "core/mesh/poisson/point_outliers.h"
 #include "core/mvs/pmvs/patch_mvs.h"
 #include "core/mvs/view_clustering.h"
 #include "core/pipeline/project.h"
@@ -22,6 +24,8 @@ struct DenseStageOptions {
   size_t memory_budget_bytes = 3ull << 30;
   ViewClusteringOptions clustering;
   PatchMvsOptions mvs;  // its num_threads 0 takes the stage's
+  bool remove_outliers = true;
+  OutlierFilterOptions outliers;  // its num_threads 0 takes the stage's
   int num_threads = 0;  // 0: one per core
   bool show_progress = true;
 
@@ -47,8 +51,9 @@ struct DenseStageReport {
   double sparse_points_covered = 0.0;  // fraction, see ViewClustering::covered_fraction
   size_t views_undistorted = 0;   // counting views reused by consecutive clusters once
   size_t points_before_merge = 0;
+  OutlierFilterReport outliers;   // all zero when the filter is off
   size_t points = 0;
-  DensePhase load, clustering, undistort, mvs, merge, write;
+  DensePhase load, clustering, undistort, mvs, merge, outlier_filter, write;
   bool peak_rss_resettable = false;
   PatchMvsReport pmvs;            // summed over clusters
   std::string points_path, report_path;

@@ -1,32 +1,10 @@
 #include "core/sfm/tracks.h"
 
 #include <algorithm>
-#include <numeric>
+
+#include "core/base/union_find.h"
 
 namespace reconar {
-namespace {
-
-class UnionFind {
- public:
-  explicit UnionFind(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  size_t Find(size_t x) {
-    while (parent_[x] != x) {
-      parent_[x] = parent_[parent_[x]];  // path halving
-      x = parent_[x];
-    }
-    return x;
-  }
-  void Union(size_t a, size_t b) {
-    a = Find(a);
-    b = Find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<size_t> parent_;
-};
-
-}  // namespace
 
 TrackSet BuildTracks(const std::vector<int>& num_keypoints, const std::vector<PairMatches>& pairs) {
   std::vector<size_t> first_node(num_keypoints.size() + 1, 0);
@@ -41,7 +19,7 @@ TrackSet BuildTracks(const std::vector<int>& num_keypoints, const std::vector<Pa
   for (const PairMatches& pair : pairs) {
     for (const FeatureMatch& m : pair.matches) {
       const size_t a = node(pair.image_a, m.index_a), b = node(pair.image_b, m.index_b);
-      sets.Union(a, b);
+      sets.Union(static_cast<uint32_t>(a), static_cast<uint32_t>(b));
       matched[a] = matched[b] = 1;
     }
   }
@@ -54,7 +32,7 @@ TrackSet BuildTracks(const std::vector<int>& num_keypoints, const std::vector<Pa
     for (int k = 0; k < num_keypoints[image]; ++k) {
       const size_t n = node(static_cast<int>(image), k);
       if (!matched[n]) continue;
-      const size_t root = sets.Find(n);
+      const size_t root = sets.Find(static_cast<uint32_t>(n));
       if (component_of_root[root] < 0) {
         component_of_root[root] = static_cast<int>(components.size());
         components.emplace_back();

@@ -129,7 +129,6 @@ TEST_F(MeshCliTest, BadUsageAndInputsExitTwoNamingTheFile) {
   EXPECT_NE(help.output.find(".wrl"), std::string::npos);
 }
 
-#ifdef RECONAR_HAVE_POISSON
 
 // Nearest-vertex distances from every 4th of `from` to all of `to`, sorted (brute force, a few
 // 10^8 operations).
@@ -218,16 +217,12 @@ TEST_F(MeshCliTest, MeshesOrientedBunnyPointsCloseToTheReferenceSurface) {
   EXPECT_NE(bad_output.output.find("mesh.stl"), std::string::npos) << bad_output.output;
   const auto bad_depth = RunReconar("mesh " + points + " " + dir_ + "/mesh.ply --depth 40");
   EXPECT_EQ(bad_depth.exit_code, 2) << bad_depth.output;
-#ifdef RECONAR_HAVE_NORMAL_ESTIMATION
   const auto estimated = RunReconar("mesh " + bare_path + " " + dir_ + "/estimated.wrl --depth 7 --estimate-normals");
   ASSERT_EQ(estimated.exit_code, 0) << estimated.output;
   const Result<std::string> vrml = ReadFileToString(dir_ + "/estimated.wrl");
   ASSERT_TRUE(vrml.ok());
   EXPECT_EQ(vrml->rfind("#VRML V2.0 utf8\n", 0), 0u);
-#endif
 }
-
-#endif  // RECONAR_HAVE_POISSON
 
 }  // namespace
 }  // namespace reconar

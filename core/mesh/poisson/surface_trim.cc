@@ -5,32 +5,22 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
 #include <unordered_map>
+
+#include "core/base/union_find.h"
 
 namespace reconar::poisson {
 namespace {
 
-uint32_t FindRoot(std::vector<uint32_t>* parent, uint32_t v) {
-  while ((*parent)[v] != v) {
-    (*parent)[v] = (*parent)[(*parent)[v]];
-    v = (*parent)[v];
-  }
-  return v;
-}
-
 // Component id (root vertex) of every triangle of `triangles`, by shared vertices.
 std::vector<uint32_t> TriangleComponents(const std::vector<std::array<uint32_t, 3>>& triangles, size_t vertices) {
-  std::vector<uint32_t> parent(vertices);
-  std::iota(parent.begin(), parent.end(), 0u);
+  UnionFind sets(vertices);
   for (const auto& t : triangles) {
-    for (int k = 1; k < 3; ++k) {
-      const uint32_t a = FindRoot(&parent, t[0]), b = FindRoot(&parent, t[k]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+    sets.Union(t[0], t[1]);
+    sets.Union(t[0], t[2]);
   }
   std::vector<uint32_t> component(triangles.size());
-  for (size_t i = 0; i < triangles.size(); ++i) component[i] = FindRoot(&parent, triangles[i][0]);
+  for (size_t i = 0; i < triangles.size(); ++i) component[i] = sets.Find(triangles[i][0]);
   return component;
 }
 

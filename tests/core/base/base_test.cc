@@ -13,11 +13,13 @@
 
 #include "core/base/arena.h"
 #include "core/base/json_writer.h"
+#include "core/base/keep_masked.h"
 #include "core/base/atomic_file.h"
 #include "core/base/image.h"
 #include "core/base/progress.h"
 #include "core/base/status.h"
 #include "core/base/thread_pool.h"
+#include "core/base/union_find.h"
 
 namespace reconar {
 namespace {
@@ -207,6 +209,29 @@ TEST(JsonWriter, PrettyPrintsWithIndent) {
   JsonWriter json(2);
   json.BeginObject().Key("a").Int(1).Key("b").BeginArray().Int(2).EndArray().EndObject();
   EXPECT_EQ(json.str(), "{\n  \"a\": 1,\n  \"b\": [\n    2\n  ]\n}");
+}
+
+TEST(KeepMasked, KeepsMarkedValuesInOrderAndLeavesEmptyAttributes) {
+  const std::vector<uint8_t> keep = {1, 0, 0, 1, 1};
+  std::vector<int> values = {10, 11, 12, 13, 14};
+  KeepMasked(keep, &values);
+  EXPECT_EQ(values, (std::vector<int>{10, 13, 14}));
+  std::vector<float> absent;
+  KeepMasked(keep, &absent);
+  EXPECT_TRUE(absent.empty());
+}
+
+TEST(UnionFind, RootIsTheSmallestMemberWhateverTheOrder) {
+  UnionFind sets(6);
+  sets.Union(5, 3);
+  sets.Union(3, 4);
+  sets.Union(1, 2);
+  EXPECT_EQ(sets.Find(4), 3u);
+  EXPECT_EQ(sets.Find(5), 3u);
+  EXPECT_EQ(sets.Find(2), 1u);
+  EXPECT_EQ(sets.Find(0), 0u);
+  sets.Union(4, 2);
+  for (uint32_t x : {1u, 2u, 3u, 4u, 5u}) EXPECT_EQ(sets.Find(x), 1u);
 }
 
 }  // namespace
