@@ -12,6 +12,7 @@
 #include "core/pipeline/feature_stage.h"
 #include "core/pipeline/match_stage.h"
 #include "core/pipeline/sfm_stage.h"
+#include "core/pipeline/stage_record.h"
 #include "tools/commands.h"
 
 namespace reconar::tools {
@@ -46,59 +47,6 @@ bool Exists(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0;
 }
 
-// Features are up to date when the image list names exactly these files and every feature file
-// is present.
-bool FeaturesUpToDate(const Project& project, const std::vector<std::string>& paths) {
-  auto list = project.ReadImageList();
-  if (!list.ok() || list->size() != paths.size()) return false;
-  for (size_t i = 0; i < paths.size(); ++i) {
-    if ((*list)[i].path != paths[i] || !Exists(project.FeaturePath((*list)[i].name))) return false;
-  }
-  return true;
-}
-
-// PROJECT/stages.txt: one "STAGE SETTINGS" line per finished stage, so that a re-run reuses a
-// stage only when it was made with the same settings.
-std::string StagesPath(const Project& project) { return project.root() + "/stages.txt"; }
-
-std::map<std::string, std::string> ReadStages(const Project& project) {
-  std::map<std::string, std::string> stages;
-  auto text = ReadFileToString(StagesPath(project));
-  if (!text.ok()) return stages;
-  std::istringstream in(*text);
-  std::string line;
-  while (std::getline(in, line)) {
-    const size_t space = line.find(' ');
-    if (space != std::string::npos) stages[line.substr(0, space)] = line.substr(space + 1);
-  }
-  return stages;
-}
-
-Status RecordStage(const Project& project, const std::string& stage, const std::string& settings) {
-  std::map<std::string, std::string> stages = ReadStages(project);
-  stages[stage] = settings;
-  // A redone stage invalidates the ones after it.
-  const std::vector<std::string> order = {"features", "matching", "mapping"};
-  bool after = false;
-  for (const std::string& name : order) {
-    if (after) stages.erase(name);
-    after |= name == stage;
-  }
-  std::string text;
-  for (const auto& [name, value] : stages) text += name + " " + value + "\n";
-  return WriteFileAtomically(StagesPath(project), text);
-}
-
-std::string Settings(std::initializer_list<std::pair<const char*, double>> values) {
-  std::string text;
-  char buffer[64];
-  for (const auto& [name, value] : values) {
-    std::snprintf(buffer, sizeof(buffer), "%s%s=%.12g", text.empty() ? "" : " ", name, value);
-    text += buffer;
-  }
-  return text;
-}
-
 struct StageTiming {
   std::string name;
   bool reused = false;
@@ -109,25 +57,7 @@ std::string ReportJson(const SfmStageReport& sfm, const std::vector<StageTiming>
   const MapperReport& m = sfm.mapper;
   JsonWriter json(2);
   json.BeginObject();
-  json.Key("images").Int(m.num_images);
-  json.Key("registered").Int(m.num_registered);
-  json.Key("points").Int(m.num_points);
-  json.Key("mean_track_length").Double(m.mean_track_length);
-  json.Key("mean_reprojection_error_px").Double(m.mean_reprojection_error_px);
-  json.Key("mean_focal_ratio").Double(sfm.mean_focal_ratio);
-  json.Key("rmse_focal_ratio").Double(sfm.rmse_focal_ratio);
-  json.Key("focal_35mm_equivalent_mm").Double(sfm.focal_35mm_equivalent);
-  json.Key("initial_pair").String(m.initial_pair);
-  json.Key("principal_point_refined").Bool(m.principal_point_refined);
-  json.Key("distortion_refined").Bool(m.distortion_refined);
-  json.Key("aspect_refined").Bool(m.aspect_refined);
-  json.Key("tracks").Int(m.num_tracks);
-  json.Key("inconsistent_tracks_dropped").Int(m.num_inconsistent_tracks);
-  json.Key("unregistered").BeginArray();
-  for (const MapperReport::Unregistered& u : m.unregistered) {
-    json.BeginObject().Key("image").String(u.name).Key("reason").String(u.reason).EndObject();
-  }
-  json.EndArray();
+  WriteSfmReportFields(sfm, &json);
   json.Key("stages").BeginObject();
   for (const StageTiming& stage : stages) {
     json.Key(stage.name).BeginObject().Key("reused").Bool(stage.reused).Key("seconds").Double(stage.seconds);
@@ -200,11 +130,11 @@ int RunSfm(int argc, char** argv, int first) {
   std::vector<StageTiming> stages;
 
 
-  const std::map<std::string, std::string> done = ReadStages(project);
+  StageRecord record(project);
   const auto finished = [&](const std::string& stage, const std::string& settings) {
-    const auto it = done.find(stage);
-    return !force && it != done.end() && it->second == settings;
+    return !force && record.Finished(stage, settings);
   };
+  const auto Settings = StageRecord::Settings;
   const SiftOptions& sift_used = feature_options.sift;
   const std::string feature_settings =
       Settings({{"first_octave", sift_used.first_octave}, {"max_features", sift_used.max_features},
@@ -227,7 +157,7 @@ int RunSfm(int argc, char** argv, int first) {
     std::printf("features: %zu images, %zu skipped, %.1fs\n", features->extracted.size(), features->skipped.size(),
                 features->seconds);
     stages.push_back({"features", false, features->seconds});
-    if (Status s = RecordStage(project, "features", feature_settings); !s.ok()) return Fail(s);
+    if (Status s = record.Record("features", feature_settings); !s.ok()) return Fail(s);
   } else {
     std::printf("features: up to date, reused\n");
     stages.push_back({"features", true, 0.0});
@@ -240,7 +170,7 @@ int RunSfm(int argc, char** argv, int first) {
     std::printf("matching: %d pairs: %d verified, %d planar or rotation-only; %.1fs\n", matches->num_pairs,
                 matches->num_verified, matches->num_planar, matches->seconds);
     stages.push_back({"matching", false, matches->seconds});
-    if (Status s = RecordStage(project, "matching", match_settings); !s.ok()) return Fail(s);
+    if (Status s = record.Record("matching", match_settings); !s.ok()) return Fail(s);
   } else {
     std::printf("matching: up to date, reused\n");
     stages.push_back({"matching", true, 0.0});
@@ -267,7 +197,7 @@ int RunSfm(int argc, char** argv, int first) {
     std::fprintf(stderr, "warning: %s not registered: %s\n", u.name.c_str(), u.reason.c_str());
   }
   if (Status s = WriteFileAtomically(project.ReportPath(), ReportJson(*sfm, stages)); !s.ok()) return Fail(s);
-  if (Status s = RecordStage(project, "mapping", mapping_settings); !s.ok()) return Fail(s);
+  if (Status s = record.Record("mapping", mapping_settings); !s.ok()) return Fail(s);
   std::printf("written to %s and %s\n", project.SparseDir().c_str(), project.ReportPath().c_str());
   return 0;
 }

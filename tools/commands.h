@@ -14,6 +14,7 @@ int RunView(int argc, char** argv, int first);  // defined only with RECONAR_HAV
 int RunExport(int argc, char** argv, int first);
 int RunMesh(int argc, char** argv, int first);
 int RunDense(int argc, char** argv, int first);
+int RunReconstruct(int argc, char** argv, int first);
 
 }  // namespace reconar::tools
 

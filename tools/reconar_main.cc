@@ -11,6 +11,7 @@ constexpr char kUsage[] =
     "usage: reconar COMMAND [ARGS] [--help]\n"
     "\n"
     "commands:\n"
+    "  reconstruct IMAGES_DIR PROJECT_DIR [--tag-size M]   the whole job: photos to a metric mesh (+ preview)\n"
     "  features IMAGE|DIR... [--project DIR] [--key OUT]   SIFT keypoints and descriptors\n"
     "  match IMAGE_A IMAGE_B [--pairs OUT.txt]             verified matches between two photos\n"
     "  match --project DIR                                 verified matches between all pairs of a project\n"
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
   if (command == "export") return reconar::tools::RunExport(argc, argv, 2);
   if (command == "mesh") return reconar::tools::RunMesh(argc, argv, 2);
   if (command == "dense") return reconar::tools::RunDense(argc, argv, 2);
+  if (command == "reconstruct") return reconar::tools::RunReconstruct(argc, argv, 2);
   if (command == "view") {
 #ifdef RECONAR_HAVE_VIEW
     return reconar::tools::RunView(argc, argv, 2);

@@ -83,6 +83,12 @@ JsonWriter& JsonWriter::Key(const std::string& key) {
   return *this;
 }
 
+JsonWriter& JsonWriter::Raw(const std::string& json_value) {
+  BeforeValue();
+  out_.append(json_value, 0, json_value.find_last_not_of(" \t\r\n") + 1);
+  return *this;
+}
+
 JsonWriter& JsonWriter::String(const std::string& value) {
   BeforeValue();
   out_ += JsonQuote(value);

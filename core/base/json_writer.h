@@ -24,6 +24,9 @@ class JsonWriter {
   JsonWriter& Double(double value);
   JsonWriter& Bool(bool value);
   JsonWriter& Null();
+  // A value that is already JSON (e.g. a stage's own report file), inserted as it is; trailing
+  // white space is dropped.
+  JsonWriter& Raw(const std::string& json_value);
 
   const std::string& str() const { return out_; }
 

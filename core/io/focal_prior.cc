@@ -61,8 +61,8 @@ FocalPrior EstimateFocalPrior(const ExifInfo& exif, int width, int height) {
 
 const char* FocalPriorSourceName(FocalPrior::Source source) {
   switch (source) {
-    case FocalPrior::Source::kExif35mm: return "EXIF 35mm-equivalent";
-    case FocalPrior::Source::kExifSensorTable: return "EXIF focal length + sensor table";
+    case FocalPrior::Source::kExif35mm: return "exif-35mm";
+    case FocalPrior::Source::kExifSensorTable: return "exif-sensor-table";
     case FocalPrior::Source::kDefault: return "default";
   }
   return "unknown";

@@ -20,6 +20,8 @@ struct FocalPrior {
 // `width`/`height` are the image size after orientation (max(w, h) is what matters).
 FocalPrior EstimateFocalPrior(const ExifInfo& exif, int width, int height);
 
+// One token (no white space): it is a field of PROJECT/features/images.txt, and the mapper trusts
+// priors whose name starts with "exif". "exif-35mm", "exif-sensor-table" or "default".
 const char* FocalPriorSourceName(FocalPrior::Source source);
 
 }  // namespace reconar

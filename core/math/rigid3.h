@@ -29,6 +29,22 @@ struct Rigid3 {
   }
 };
 
+// cam_from_world of a camera at `center` looking at `target` (+z), its image y axis pointing down
+// along -up (x = z cross up; any x orthogonal to z when up is parallel to the view).
+inline Rigid3 CamFromWorldLookingAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
+                                    const Eigen::Vector3d& up) {
+  const Eigen::Vector3d z = (target - center).normalized();
+  Eigen::Vector3d x = z.cross(up);
+  x = x.norm() < 1e-9 ? Eigen::Vector3d(z.unitOrthogonal()) : Eigen::Vector3d(x.normalized());
+  const Eigen::Vector3d y = z.cross(x);
+  Rigid3 cam_from_world;
+  cam_from_world.rotation.row(0) = x.transpose();
+  cam_from_world.rotation.row(1) = y.transpose();
+  cam_from_world.rotation.row(2) = z.transpose();
+  cam_from_world.translation = -(cam_from_world.rotation * center);
+  return cam_from_world;
+}
+
 // Angle of the rotation between a and b, in radians; accurate for small angles too.
 inline double RotationAngle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(Eigen::Quaterniond(a.transpose() * b).normalized()).angle();

@@ -131,4 +131,14 @@ Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image
   return report;
 }
 
+bool FeaturesUpToDate(const Project& project, const std::vector<std::string>& paths) {
+  auto list = project.ReadImageList();
+  if (!list.ok() || list->size() != paths.size()) return false;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    std::error_code error;
+    if ((*list)[i].path != paths[i] || !std::filesystem::exists(project.FeaturePath((*list)[i].name), error)) return false;
+  }
+  return true;
+}
+
 }  // namespace reconar

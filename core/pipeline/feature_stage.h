@@ -39,4 +39,7 @@ Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image
                                            const FeatureStageOptions& options,
                                            std::vector<SiftFeatures>* features_out = nullptr);
 
+// The project's image list names exactly these paths, in this order, and every feature file exists.
+bool FeaturesUpToDate(const Project& project, const std::vector<std::string>& paths);
+
 }  // namespace reconar

@@ -30,6 +30,10 @@ class Project {
   std::string MatchesPath() const { return MatchesDir() + "/matches.txt"; }
   std::string SparseDir() const { return root_ + "/sparse"; }
   std::string ReportPath() const { return root_ + "/report.json"; }
+  std::string TagDetectionsPath() const { return root_ + "/tags/detections.txt"; }  // core/sfm/tag_observations.h
+  std::string TagsJsonPath() const { return root_ + "/tags.json"; }  // core/sfm/tag_registration.h
+  std::string DensePointsPath() const { return root_ + "/dense/points.ply"; }
+  std::string MeshDir() const { return root_ + "/mesh"; }
 
   Status WriteImageList(const std::vector<ProjectImage>& images) const;
   Result<std::vector<ProjectImage>> ReadImageList() const;

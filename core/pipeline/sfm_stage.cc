@@ -116,6 +116,27 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     pair.planar = m.config == "planar";
     pairs.push_back(std::move(pair));
   }
+  std::vector<std::vector<TagObservation>> tag_observations;
+  std::vector<TagCornerKeypoint> corner_keypoints;
+  std::string tag_family;
+  if (options.tags.enabled) {
+    RECONAR_RETURN_IF_ERROR(options.tags.registration.Check());
+    RECONAR_ASSIGN_OR_RETURN(const TagDetectionsFile detections, ReadTagDetections(project.TagDetectionsPath()));
+    tag_family = detections.family;
+    tag_observations.resize(images.size());
+    for (const ImageTagObservations& image : detections.images) {
+      const auto it = index_of.find(image.image_name);
+      if (it == index_of.end()) {
+        return FileError(StatusCode::kCorruptData, project.TagDetectionsPath(),
+                         "image " + image.image_name + " is missing from " + project.ImageListPath());
+      }
+      tag_observations[static_cast<size_t>(it->second)] = image.tags;
+    }
+    if (options.tags.in_adjustment) {
+      corner_keypoints = AddTagCorrespondences(tag_observations, options.mapper.base_scale_px, kTagCornerWeight,
+                                               &images, &pairs);
+    }
+  }
   report.seconds_load = SecondsSince(start);
 
   start = Clock::now();
@@ -131,6 +152,11 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   auto reconstruction = RunIncrementalMapper(images, pairs, options.mapper, &report.mapper, on_progress);
   if (progress) progress->Finish();
   if (!reconstruction.ok()) return reconstruction.status();
+  if (options.tags.enabled) {
+    report.tags_used = true;
+    RECONAR_ASSIGN_OR_RETURN(report.tags, RegisterToTags(tag_observations, corner_keypoints,
+                                                         options.tags.registration, &*reconstruction));
+  }
   report.seconds_mapping = SecondsSince(start);
   FocalStatistics(*reconstruction, &report);
 
@@ -145,11 +171,48 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   for (const ProjectImage& image : list) paths.push_back(image.path);
   RECONAR_RETURN_IF_ERROR(WriteBundlerModel(*reconstruction, sparse + "/bundle.out", sparse + "/list.txt", paths));
   RECONAR_RETURN_IF_ERROR(WritePointsPly(*reconstruction, sparse + "/points.ply"));
+  if (report.tags_used) {
+    RECONAR_RETURN_IF_ERROR(WriteFileAtomically(
+        project.TagsJsonPath(), TagRegistrationJson(report.tags, tag_family, options.tags.registration.tag_size_m)));
+  }
   // points3D.txt last: its presence marks a finished model (see the sfm command's reuse check).
   RECONAR_RETURN_IF_ERROR(WriteColmapTextModel(*reconstruction, sparse));
   report.seconds_write = SecondsSince(start);
   if (reconstruction_out != nullptr) *reconstruction_out = std::move(*reconstruction);
   return report;
+}
+
+void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
+  const MapperReport& m = sfm.mapper;
+  json->Key("images").Int(m.num_images);
+  json->Key("registered").Int(m.num_registered);
+  json->Key("points").Int(m.num_points);
+  json->Key("mean_track_length").Double(m.mean_track_length);
+  json->Key("mean_reprojection_error_px").Double(m.mean_reprojection_error_px);
+  json->Key("mean_focal_ratio").Double(sfm.mean_focal_ratio);
+  json->Key("rmse_focal_ratio").Double(sfm.rmse_focal_ratio);
+  json->Key("focal_35mm_equivalent_mm").Double(sfm.focal_35mm_equivalent);
+  json->Key("initial_pair").String(m.initial_pair);
+  json->Key("initial_pair_relaxations").Int(m.init_relaxations);
+  json->Key("principal_point_refined").Bool(m.principal_point_refined);
+  json->Key("distortion_refined").Bool(m.distortion_refined);
+  json->Key("aspect_refined").Bool(m.aspect_refined);
+  json->Key("tracks").Int(m.num_tracks);
+  json->Key("inconsistent_tracks_dropped").Int(m.num_inconsistent_tracks);
+  json->Key("unregistered").BeginArray();
+  for (const MapperReport::Unregistered& u : m.unregistered) {
+    json->BeginObject().Key("image").String(u.name).Key("reason").String(u.reason).EndObject();
+  }
+  json->EndArray();
+  if (sfm.tags_used) {
+    json->Key("tags").BeginObject();
+    json->Key("metric").Bool(sfm.tags.metric);
+    if (!sfm.tags.metric) json->Key("reason").String(sfm.tags.reason);
+    json->Key("world_tag").Int(sfm.tags.world_tag).Key("tags_seen").Int(sfm.tags.tags_seen);
+    json->Key("tags_registered").Int(static_cast<long long>(sfm.tags.tags.size()));
+    json->Key("edge_mean_m").Double(sfm.tags.edge_mean_m).Key("edge_std_m").Double(sfm.tags.edge_std_m);
+    json->EndObject();
+  }
 }
 
 }  // namespace reconar

@@ -4,17 +4,31 @@
 //   cameras.txt images.txt points3D.txt   COLMAP text model (RADIAL cameras)
 //   bundle.out list.txt                   Bundler v0.3 (PMVS, MeshLab)
 //   points.ply                            coloured sparse points
+// With tags enabled the model is in metres in the world tag's frame, and PROJECT/tags.json says
+// where each tag is (TagRegistrationJson); without a complete tag it stays in arbitrary scale.
 #include <string>
 
+#include "core/base/json_writer.h"
 #include "core/base/status.h"
 #include "core/pipeline/project.h"
 #include "core/sfm/mapper.h"
 #include "core/sfm/reconstruction.h"
+#include "core/sfm/tag_registration.h"
 
 namespace reconar {
 
+// Metric registration by AprilTags (core/sfm/tag_registration.h) from PROJECT/tags/detections.txt.
+struct SfmTagOptions {
+  bool enabled = false;
+  // The corners join the mapper's tracks and bundle adjustment; false: they are only triangulated
+  // from the final cameras (to measure what the constraints bring).
+  bool in_adjustment = true;
+  TagRegistrationOptions registration;
+};
+
 struct SfmStageOptions {
   MapperOptions mapper;
+  SfmTagOptions tags;
   bool show_progress = true;
 };
 
@@ -29,7 +43,14 @@ struct SfmStageReport {
   double seconds_mapping = 0.0;
   double seconds_colour = 0.0;
   double seconds_write = 0.0;
+  bool tags_used = false;             // options.tags.enabled
+  TagRegistrationReport tags;         // also written to PROJECT/tags.json
 };
+
+// The report's members as JSON keys of the object `json` has open: images, registered, points,
+// focal statistics (paper Table 1), initial pair, refinement choices, unregistered images with
+// reasons, and with tags their registration summary.
+void WriteSfmReportFields(const SfmStageReport& report, JsonWriter* json);
 
 // FailedPrecondition when the mapper finds no initial pair (its message says why); errors of
 // the project files name the file.

@@ -162,19 +162,33 @@ class Mapper {
           "no image pair has enough verified matches with parallax to start a reconstruction "
           "(the photos may be unrelated, too few, or taken from one spot)");
     }
+    // Texture-poor scenes may have no pair that meets the bounds: like COLMAP's mapper, retry with
+    // the point count and the angle halved, down to init_min_points_floor / init_min_angle_floor.
     std::string last_reason;
     const int tries = std::min(static_cast<int>(order.size()), opt_.init_max_pairs_tried);
-    for (int k = 0; k < tries; ++k) {
-      const MapperPair& pair = pairs_[static_cast<size_t>(order[static_cast<size_t>(k)])];
-      last_reason = TryInitialPair(pair);
-      if (last_reason.empty()) {
-        report_->initial_pair = images_[static_cast<size_t>(pair.matches.image_a)].name + " + " +
-                                images_[static_cast<size_t>(pair.matches.image_b)].name;
-        return Status::Ok();
+    init_min_points_ = opt_.init_min_points;
+    init_min_angle_deg_ = opt_.init_min_median_angle_deg;
+    for (int round = 0;; ++round) {
+      for (int k = 0; k < tries; ++k) {
+        const MapperPair& pair = pairs_[static_cast<size_t>(order[static_cast<size_t>(k)])];
+        last_reason = TryInitialPair(pair);
+        if (last_reason.empty()) {
+          report_->initial_pair = images_[static_cast<size_t>(pair.matches.image_a)].name + " + " +
+                                  images_[static_cast<size_t>(pair.matches.image_b)].name;
+          report_->init_relaxations = round;
+          return Status::Ok();
+        }
       }
+      const int next_points = std::max(opt_.init_min_points_floor, init_min_points_ / 2);
+      const double next_angle = std::max(opt_.init_min_angle_floor_deg, init_min_angle_deg_ / 2.0);
+      if (next_points == init_min_points_ && next_angle == init_min_angle_deg_) break;
+      init_min_points_ = next_points;
+      init_min_angle_deg_ = next_angle;
     }
     return FailedPrecondition("no initial pair found among the " + std::to_string(tries) +
-                              " best-matched pairs; last: " + last_reason);
+                              " best-matched pairs, even with the bounds relaxed to " +
+                              std::to_string(init_min_points_) + " points and " +
+                              std::to_string(init_min_angle_deg_) + " deg; last: " + last_reason);
   }
 
   // Empty on success; otherwise the reason, with the model reset.
@@ -229,15 +243,15 @@ class Mapper {
     for (size_t p = 0; p < rec_.points.size(); ++p) {
       if (!rec_.points[p].deleted) angles.push_back(MaxTriangulationAngle(rec_.points[p]));
     }
-    if (static_cast<int>(angles.size()) < opt_.init_min_points) {
+    if (static_cast<int>(angles.size()) < init_min_points_) {
       return pair_name + ": only " + std::to_string(angles.size()) + " points triangulated (need " +
-             std::to_string(opt_.init_min_points) + ")";
+             std::to_string(init_min_points_) + ")";
     }
     std::nth_element(angles.begin(), angles.begin() + static_cast<std::ptrdiff_t>(angles.size() / 2), angles.end());
     const double median = angles[angles.size() / 2];
-    if (median < opt_.init_min_median_angle_deg * kDegree) {
+    if (median < init_min_angle_deg_ * kDegree) {
       return pair_name + ": median triangulation angle " + std::to_string(median / kDegree) +
-             " deg is below " + std::to_string(opt_.init_min_median_angle_deg) + " deg";
+             " deg is below " + std::to_string(init_min_angle_deg_) + " deg";
     }
     return "";
   }
@@ -639,6 +653,10 @@ class Mapper {
   // ---- bundle adjustment ---------------------------------------------------------------------
 
   double ObservationWeight(const TrackElement& e) const {
+    const std::vector<float>& weights = images_[static_cast<size_t>(e.image_id)].keypoint_weights;
+    if (!weights.empty() && weights[static_cast<size_t>(e.keypoint_id)] > 0.0f) {
+      return weights[static_cast<size_t>(e.keypoint_id)];
+    }
     const std::vector<float>& scales = images_[static_cast<size_t>(e.image_id)].keypoint_scales;
     if (!opt_.weight_by_scale || scales.empty()) return 1.0;
     const double scale = scales[static_cast<size_t>(e.keypoint_id)];
@@ -888,6 +906,8 @@ class Mapper {
   const std::vector<MapperImage>& images_;
   const std::vector<MapperPair>& pairs_;
   const MapperOptions& opt_;
+  int init_min_points_ = 0;          // the initial-pair bounds in force (relaxed by Initialize)
+  double init_min_angle_deg_ = 0.0;
   MapperReport* report_;
   Reconstruction rec_;
   TrackSet tracks_;
@@ -908,6 +928,12 @@ Status MapperOptions::Check() const {
   if (init_min_points < 8) return InvalidArgument("MapperOptions: init_min_points < 8");
   if (!(init_min_median_angle_deg >= 0.0)) return InvalidArgument("MapperOptions: init_min_median_angle_deg < 0");
   if (init_max_pairs_tried < 1) return InvalidArgument("MapperOptions: init_max_pairs_tried < 1");
+  if (init_min_points_floor < 8 || init_min_points_floor > init_min_points) {
+    return InvalidArgument("MapperOptions: init_min_points_floor must be in [8, init_min_points]");
+  }
+  if (!(init_min_angle_floor_deg >= 0.0 && init_min_angle_floor_deg <= init_min_median_angle_deg)) {
+    return InvalidArgument("MapperOptions: init_min_angle_floor_deg must be in [0, init_min_median_angle_deg]");
+  }
   if (!(registration_max_error_px > 0.0)) return InvalidArgument("MapperOptions: registration_max_error_px <= 0");
   if (registration_min_inliers < 6) return InvalidArgument("MapperOptions: registration_min_inliers < 6");
   if (!(max_reprojection_error_px > 0.0)) return InvalidArgument("MapperOptions: max_reprojection_error_px <= 0");

@@ -22,6 +22,9 @@ struct MapperImage {
   bool focal_from_exif = false; // the prior came from EXIF (trusted by the 0.7-1.4 rule)
   std::vector<Eigen::Vector2d> keypoints;  // pixels
   std::vector<float> keypoint_scales;      // optional: detection scale (sigma, pixels) per keypoint
+  // Optional: a bundle-adjustment weight (1 / relative standard deviation) per keypoint; 0 or an
+  // empty vector leaves the keypoint to the scale rule (MapperOptions::weight_by_scale).
+  std::vector<float> keypoint_weights;
 };
 
 struct MapperPair {
@@ -35,6 +38,10 @@ struct MapperOptions {
   int init_min_points = 100;
   double init_min_median_angle_deg = 4.0;
   int init_max_pairs_tried = 20;
+  // When no pair meets those bounds, both are halved and the pairs tried again, down to these
+  // floors (COLMAP's mapper relaxes the same way): texture-poor rooms have few matches per pair.
+  int init_min_points_floor = 25;
+  double init_min_angle_floor_deg = 1.0;
   // Registration: P3P LO-RANSAC with this pixel threshold; a pose needs this many inliers.
   double registration_max_error_px = 4.0;
   int registration_min_inliers = 30;
@@ -94,6 +101,7 @@ struct MapperReport {
   int num_tracks = 0;
   int num_inconsistent_tracks = 0;
   std::string initial_pair;  // "a.jpg + b.jpg"
+  int init_relaxations = 0;  // how often the initial-pair bounds were halved before one was found
   std::vector<Unregistered> unregistered;
   int num_local_ba = 0;
   int num_global_ba = 0;

@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "core/math/rigid3.h"
 #include "core/base/atomic_file.h"
 #include "core/io/image_write.h"
 #include "core/pipeline/project.h"
@@ -117,14 +118,10 @@ Eigen::Matrix4d CamFromWorld(const SfmPose& pose) {
 
 // A camera at `center` looking at `target`, image y pointing down the world's -y (world y is up).
 SfmPose LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - center).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitY()).normalized();
-  const Eigen::Vector3d y = z.cross(x);
+  const Rigid3 cam_from_world = CamFromWorldLookingAt(center, target, Eigen::Vector3d::UnitY());
   SfmPose pose;
-  pose.cam_from_world_rotation.row(0) = x.transpose();
-  pose.cam_from_world_rotation.row(1) = y.transpose();
-  pose.cam_from_world_rotation.row(2) = z.transpose();
-  pose.cam_from_world_translation = -pose.cam_from_world_rotation * center;
+  pose.cam_from_world_rotation = cam_from_world.rotation;
+  pose.cam_from_world_translation = cam_from_world.translation;
   return pose;
 }
 

@@ -39,35 +39,6 @@ double RotationAngleDeg(const Eigen::Matrix3d& rotation) {
 
 }  // namespace
 
-Result<Similarity3> AlignSimilarity(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to) {
-  if (from.size() != to.size()) return InvalidArgument("AlignSimilarity: point sets differ in size");
-  if (from.size() < 3) return InvalidArgument("AlignSimilarity: needs at least 3 point pairs");
-  const double n = static_cast<double>(from.size());
-  Eigen::Vector3d mean_from = Eigen::Vector3d::Zero();
-  Eigen::Vector3d mean_to = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < from.size(); ++i) {
-    mean_from += from[i] / n;
-    mean_to += to[i] / n;
-  }
-  // Covariance Sigma = 1/n sum (to - mean_to)(from - mean_from)^T and variance of `from` (eq. 36-38).
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  double variance_from = 0.0;
-  for (size_t i = 0; i < from.size(); ++i) {
-    covariance += (to[i] - mean_to) * (from[i] - mean_from).transpose() / n;
-    variance_from += (from[i] - mean_from).squaredNorm() / n;
-  }
-  if (!(variance_from > 0.0)) return InvalidArgument("AlignSimilarity: all source points coincide");
-
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Vector3d s = Eigen::Vector3d::Ones();
-  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) s.z() = -1.0;  // a reflection otherwise
-  Similarity3 similarity;
-  similarity.rotation = svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
-  similarity.scale = svd.singularValues().dot(s) / variance_from;
-  similarity.translation = mean_to - similarity.scale * similarity.rotation * mean_from;
-  return similarity;
-}
-
 CameraPose PoseOf(const GroundTruthCamera& camera) { return {camera.cam_from_world_rotation, camera.Centre()}; }
 
 Result<CameraPoseErrors> CameraCenterErrors(const std::vector<CameraPose>& estimated,

@@ -9,23 +9,14 @@
 #include <Eigen/Core>
 
 #include "core/base/status.h"
+#include "core/math/sim3.h"
 #include "tests/support/ground_truth.h"
 
 namespace reconar::testing {
 
-// to = scale * rotation * from + translation.
-struct Similarity3 {
-  double scale = 1.0;
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
-
-  Eigen::Vector3d Apply(const Eigen::Vector3d& from) const { return scale * rotation * from + translation; }
-};
-
-// Least-squares similarity with to_i ~ Apply(from_i) (Umeyama, "Least-squares estimation of
-// transformation parameters between two point patterns", PAMI 1991). Needs at least 3 pairs and
-// a `from` set that is not a single point.
-Result<Similarity3> AlignSimilarity(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to);
+// to = scale * rotation * from + translation; AlignSimilarity (Umeyama) is core/math/sim3.h's.
+using Similarity3 = Sim3;
+using reconar::AlignSimilarity;
 
 // A camera's orientation and position: X_cam = cam_from_world_rotation * (X_world - centre).
 struct CameraPose {

@@ -211,6 +211,12 @@ TEST(JsonWriter, PrettyPrintsWithIndent) {
   EXPECT_EQ(json.str(), "{\n  \"a\": 1,\n  \"b\": [\n    2\n  ]\n}");
 }
 
+TEST(JsonWriter, RawValuesAreInsertedAsTheyAre) {
+  JsonWriter json;
+  json.BeginObject().Key("a").Raw("{\"b\": [1, 2]}\n").Key("c").BeginArray().Raw("3").Raw("4").EndArray().EndObject();
+  EXPECT_EQ(json.str(), "{\"a\":{\"b\": [1, 2]},\"c\":[3,4]}");
+}
+
 TEST(KeepMasked, KeepsMarkedValuesInOrderAndLeavesEmptyAttributes) {
   const std::vector<uint8_t> keep = {1, 0, 0, 1, 1};
   std::vector<int> values = {10, 11, 12, 13, 14};

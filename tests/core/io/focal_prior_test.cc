@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "tests/core/io/test_matchers.h"
 
 namespace reconar {
@@ -78,6 +80,15 @@ TEST(FocalPriorTest, NoExifUsesDefault) {
   EXPECT_DOUBLE_EQ(prior.focal_px, 1.2 * 3072);
   EXPECT_TRUE(testing::HasSubstring(prior.explanation, "no EXIF focal length; using 1.2·max(width,height)"));
   EXPECT_STREQ(FocalPriorSourceName(prior.source), "default");
+}
+
+// The names are fields of features/images.txt (one token each) and the mapper trusts "exif*".
+TEST(FocalPriorTest, SourceNamesAreSingleTokensAndExifOnesSayExif) {
+  EXPECT_STREQ(FocalPriorSourceName(FocalPrior::Source::kExif35mm), "exif-35mm");
+  EXPECT_STREQ(FocalPriorSourceName(FocalPrior::Source::kExifSensorTable), "exif-sensor-table");
+  for (auto source : {FocalPrior::Source::kExif35mm, FocalPrior::Source::kExifSensorTable, FocalPrior::Source::kDefault}) {
+    EXPECT_EQ(std::string(FocalPriorSourceName(source)).find_first_of(" \t"), std::string::npos);
+  }
 }
 
 }  // namespace

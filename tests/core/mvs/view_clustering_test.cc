@@ -1,6 +1,7 @@
 // View clustering on synthetic scenes: rings of cameras around cylinders of sparse points, where
 // visibility follows from geometry (a point is seen when it faces the camera within 60 degrees
 // and projects inside the image).
+#include "core/math/rigid3.h"
 #include "core/mvs/view_clustering.h"
 
 #include <gtest/gtest.h>
@@ -22,14 +23,10 @@ struct SceneOptions {
 
 // Camera looking at `target` from `centre`, y down (world z up).
 SfmPose LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - centre).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d y = z.cross(x);
+  const Rigid3 cam_from_world = CamFromWorldLookingAt(centre, target, Eigen::Vector3d::UnitZ());
   SfmPose pose;
-  pose.cam_from_world_rotation.row(0) = x.transpose();
-  pose.cam_from_world_rotation.row(1) = y.transpose();
-  pose.cam_from_world_rotation.row(2) = z.transpose();
-  pose.cam_from_world_translation = -pose.cam_from_world_rotation * centre;
+  pose.cam_from_world_rotation = cam_from_world.rotation;
+  pose.cam_from_world_translation = cam_from_world.translation;
   return pose;
 }
 

@@ -1,0 +1,51 @@
+#pragma once
+// Mesh stage: PROJECT/dense/points.ply -> screened Poisson (core/mesh/poisson) -> PROJECT/mesh/
+// mesh.{ply,obj,glb,wrl} and mesh/report.json, every file atomically, report.json last.
+//
+// Depth: at most the requested one, and no finer than the points: the depth whose cells are as
+// small as the median distance between neighbouring points (finer cells only add unknowns that
+// no sample constrains).
+// Memory: Poisson's grids grow about fourfold per depth on a surface. When a budget is given, a
+// pilot solve at depth - 2 measures its own peak (VmHWM, reset before it) and the depth used is the
+// finest, at most the requested one, whose extrapolated peak (pilot x 4^(depth - pilot depth),
+// plus what the process already holds) fits the budget; the report says when it was lowered.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/mesh/poisson/poisson.h"
+#include "core/pipeline/project.h"
+
+namespace reconar {
+
+struct MeshStageOptions {
+  PoissonOptions poisson;                 // depth is the finest allowed
+  size_t memory_budget_bytes = 0;         // 0: no limit, no pilot
+  std::vector<std::string> formats = {"ply", "obj", "glb", "wrl"};  // mesh/mesh.<format>
+
+  Status Check() const;
+};
+
+struct MeshStageReport {
+  int requested_depth = 0;
+  double median_spacing = 0.0;      // of the points (mean distance to 8 nearest, median over a sample)
+  int spacing_depth = 0;            // the depth whose cell matches that spacing
+  int depth = 0;                    // used
+  bool depth_lowered_for_budget = false;
+  size_t pilot_peak_bytes = 0;      // above the baseline, at the pilot depth
+  size_t estimated_peak_bytes = 0;  // for the depth used
+  size_t points = 0;
+  PoissonReport poisson;
+  double seconds = 0.0;
+  size_t peak_rss_bytes = 0;
+  std::vector<std::string> paths;   // written meshes
+  std::string report_path;
+};
+
+// FailedPrecondition without dense points; ResourceExhausted when even depth 5 does not fit.
+Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOptions& options);
+
+std::string MeshReportJson(const MeshStageReport& report);
+
+}  // namespace reconar

@@ -1,0 +1,337 @@
+#include "core/pipeline/reconstruct.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+#include "core/base/atomic_file.h"
+#include "core/base/json_reader.h"
+#include "core/base/json_writer.h"
+#include "core/base/memory_usage.h"
+#include "core/base/thread_pool.h"
+#include "core/io/image_io.h"
+#include "core/pipeline/stage_record.h"
+
+namespace reconar {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Mib(size_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
+
+bool Exists(const std::string& path) {
+  std::error_code error;
+  return std::filesystem::exists(path, error);
+}
+
+// The decoded photo, its grey copy and SIFT's first doubled octave are what one feature worker
+// holds beyond its arena: about 8 bytes per pixel of the largest photo (measured by the arena's own
+// sizing, RequiredArenaBytes, for the pyramid itself).
+constexpr size_t kFeatureBytesPerPixel = 8;
+
+// Pixels of the first readable photo: a project's photos usually come from one camera.
+size_t TypicalPixelCount(const std::vector<std::string>& paths) {
+  for (const std::string& path : paths) {
+    auto image = ReadImage(path);
+    if (image.ok()) return static_cast<size_t>(image->rgb.width()) * static_cast<size_t>(image->rgb.height());
+  }
+  return 0;
+}
+
+double NumberAt(const JsonValue* object, const char* key) {
+  if (object == nullptr) return 0.0;
+  const JsonValue* value = object->Find(key);
+  return value != nullptr && value->is_number() ? value->number() : 0.0;
+}
+
+class StageRunner {
+ public:
+  StageRunner(const Project& project, const ReconstructOptions& options, ReconstructReport* report)
+      : project_(project), options_(options), report_(report), record_(project) {
+    // What an earlier run measured for the stages this one reuses.
+    if (auto previous = ReadJsonFile(project.ReportPath()); previous.ok()) {
+      const JsonValue* stages = previous->Find("stages");
+      for (size_t i = 0; stages != nullptr && i < stages->size(); ++i) {
+        const JsonValue& stage = (*stages)[i];
+        const JsonValue* name = stage.Find("name");
+        if (name == nullptr || !name->is_string()) continue;
+        StageSummary& summary = previous_[name->string()];
+        summary.seconds = NumberAt(&stage, "seconds");
+        summary.peak_rss_bytes = static_cast<size_t>(NumberAt(&stage, "peak_rss_mib") * (1 << 20));
+        const JsonValue* note = stage.Find("note");
+        if (note != nullptr && note->is_string()) summary.note = note->string();
+      }
+    }
+  }
+
+  // Runs `body` unless the stage finished with these settings (and `outputs_present`); records it.
+  Status Run(const std::string& name, const std::string& settings, bool outputs_present, bool force_redo,
+             const std::function<Status(StageSummary*)>& body) {
+    StageSummary summary;
+    summary.name = name;
+    const bool reuse = !options_.force && !force_redo && outputs_present && record_.Finished(name, settings);
+    ++index_;
+    if (reuse) {
+      if (const auto it = previous_.find(name); it != previous_.end()) summary = it->second;
+      summary.name = name;
+      summary.reused = true;
+      if (options_.show_progress) std::fprintf(stderr, "reconstruct: [%d] %s: finished earlier, reused\n", index_, name.c_str());
+      report_->stages.push_back(summary);
+      return Status::Ok();
+    }
+    redone_ = true;
+    if (options_.show_progress) std::fprintf(stderr, "reconstruct: [%d] %s\n", index_, name.c_str());
+    ResetPeakResidentBytes();
+    const auto start = Clock::now();
+    RECONAR_RETURN_IF_ERROR(body(&summary).WithContext(name));
+    summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    // A stage that resets the peak itself (per phase) reports its own maximum in the summary.
+    summary.peak_rss_bytes = std::max(summary.peak_rss_bytes, PeakResidentBytes());
+    RECONAR_RETURN_IF_ERROR(record_.Record(name, settings));
+    report_->stages.push_back(summary);
+    return Status::Ok();
+  }
+  // A stage redone in this run: the ones after it must be redone too.
+  bool redone() const { return redone_; }
+
+ private:
+  const Project& project_;
+  const ReconstructOptions& options_;
+  ReconstructReport* report_;
+  StageRecord record_;
+  std::map<std::string, StageSummary> previous_;
+  int index_ = 0;
+  bool redone_ = false;
+};
+
+std::string ReadOr(const std::string& path, const std::string& fallback) {
+  auto text = ReadFileToString(path);
+  return text.ok() ? *text : fallback;
+}
+
+
+std::string ReportJson(const Project& project, const ReconstructOptions& options, const ReconstructReport& report) {
+  const std::string sparse_text = ReadOr(project.SparseDir() + "/report.json", "null");
+  const std::string tags_text = ReadOr(project.TagsJsonPath(), "null");
+  const std::string dense_text = ReadOr(project.root() + "/dense/report.json", "null");
+  const std::string mesh_text = ReadOr(project.MeshDir() + "/report.json", "null");
+  const auto sparse = ParseJson(sparse_text, "sparse/report.json");
+  const auto dense = ParseJson(dense_text, "dense/report.json");
+  const auto mesh = ParseJson(mesh_text, "mesh/report.json");
+  const JsonValue* s = sparse.ok() ? &*sparse : nullptr;
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("table1").BeginObject();  // the paper's Table 1 columns
+  json.Key("images").Int(static_cast<long long>(NumberAt(s, "images")));
+  json.Key("registered").Int(static_cast<long long>(NumberAt(s, "registered")));
+  json.Key("sparse_points").Int(static_cast<long long>(NumberAt(s, "points")));
+  json.Key("mean_focal_ratio").Double(NumberAt(s, "mean_focal_ratio"));
+  json.Key("rmse_focal_ratio").Double(NumberAt(s, "rmse_focal_ratio"));
+  json.Key("focal_35mm_equivalent_mm").Double(NumberAt(s, "focal_35mm_equivalent_mm"));
+  json.Key("dense_points").Int(static_cast<long long>(NumberAt(dense.ok() ? &*dense : nullptr, "points")));
+  json.Key("mesh_vertices").Int(static_cast<long long>(NumberAt(mesh.ok() ? &*mesh : nullptr, "vertices")));
+  json.Key("mesh_faces").Int(static_cast<long long>(NumberAt(mesh.ok() ? &*mesh : nullptr, "triangles")));
+  json.EndObject();
+  json.Key("metric").Bool(report.metric);
+  json.Key("scale").String(report.metric ? "metres, world frame of the reference tag (tags.json)" : report.scale_note);
+  json.Key("memory_budget_mib").Double(Mib(options.memory_budget_bytes));
+  size_t peak = 0;
+  double seconds = 0.0;
+  json.Key("stages").BeginArray();
+  for (const StageSummary& stage : report.stages) {
+    json.BeginObject().Key("name").String(stage.name).Key("reused").Bool(stage.reused);
+    json.Key("seconds").Double(stage.seconds).Key("peak_rss_mib").Double(Mib(stage.peak_rss_bytes));
+    if (!stage.note.empty()) json.Key("note").String(stage.note);
+    json.EndObject();
+    peak = std::max(peak, stage.peak_rss_bytes);
+    seconds += stage.seconds;
+  }
+  json.EndArray();
+  json.Key("seconds").Double(seconds).Key("peak_rss_mib").Double(Mib(peak));
+  json.Key("sparse").Raw(sparse.ok() ? sparse_text : "null");
+  json.Key("tags").Raw(ParseJson(tags_text, "tags.json").ok() ? tags_text : "null");
+  json.Key("dense").Raw(dense.ok() ? dense_text : "null");
+  json.Key("mesh").Raw(mesh.ok() ? mesh_text : "null");
+  json.EndObject();
+  return json.str() + "\n";
+}
+
+}  // namespace
+
+Status ReconstructOptions::Check() const {
+  if (tag_size_m < 0.0 || !std::isfinite(tag_size_m)) return InvalidArgument("the tag size must be positive");
+  if (tag_size_m > 0.0 && !detect_tags) return InvalidArgument("reconstruct: tags requested without a tag detector");
+  if (memory_budget_bytes < (64u << 20)) return InvalidArgument("the memory budget must be at least 64 MiB");
+  RECONAR_RETURN_IF_ERROR(dense.Check());
+  return mesh.Check();
+}
+
+Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_paths, const Project& project,
+                                         const ReconstructOptions& options) {
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root()));
+  ReconstructReport report;
+  StageRunner runner(project, options, &report);
+  const int threads = ThreadPool::ResolveThreadCount(options.num_threads);
+  const auto Settings = StageRecord::Settings;
+  const size_t budget = options.memory_budget_bytes;
+
+  if (options.run_sparse) {
+    // Features: as many photos at once as the budget holds, each worker with its SIFT arena.
+    FeatureStageOptions features = options.features;
+    const size_t pixels = TypicalPixelCount(image_paths);
+    const size_t per_photo = kFeatureBytesPerPixel * pixels;
+    std::string feature_note;
+    size_t arena = features.sift.arena_bytes;
+    if (per_photo + arena > budget) {
+      arena = budget > per_photo + (64u << 20) ? budget - per_photo : (64u << 20);
+      feature_note = "SIFT arena lowered to " + std::to_string(static_cast<int>(Mib(arena))) +
+                     " MiB for the memory budget (large photos start at octave 0)";
+    }
+    features.sift.arena_bytes = arena;
+    const int fitting = static_cast<int>(std::max<size_t>(1, budget / (arena + per_photo)));
+    features.num_threads = std::min(threads, fitting);
+    if (features.num_threads < threads) {
+      feature_note += std::string(feature_note.empty() ? "" : "; ") + std::to_string(features.num_threads) +
+                      " photo(s) at a time for the memory budget";
+    }
+    features.show_progress = options.show_progress;
+    const SiftOptions& sift = features.sift;
+    if (Status s = runner.Run(
+        "features",
+        Settings({{"first_octave", sift.first_octave}, {"max_features", sift.max_features},
+                  {"contrast_threshold", sift.contrast_threshold}, {"arena_mib", Mib(sift.arena_bytes)}}),
+        FeaturesUpToDate(project, image_paths), false, [&](StageSummary* summary) -> Status {
+          summary->note = feature_note;
+          RECONAR_ASSIGN_OR_RETURN(const FeatureStageReport r, RunFeatureStage(image_paths, &project, features));
+          for (const std::string& skipped : r.skipped) std::fprintf(stderr, "warning: skipped %s\n", skipped.c_str());
+          return Status::Ok();
+        });
+        !s.ok()) {
+      return s;
+    }
+
+    MatchStageOptions matching = options.matching;
+    matching.num_threads = threads;
+    if (Status s = runner.Run(
+        "matching",
+        Settings({{"ratio", matching.match.max_ratio}, {"checks", matching.match.max_leaf_checks},
+                  {"min_inliers", matching.two_view.min_inliers},
+                  {"f_threshold", matching.two_view.f_threshold_fraction}}),
+        Exists(project.MatchesPath()), runner.redone(), [&](StageSummary*) -> Status {
+          return RunMatchStage(project, matching).status();
+        });
+        !s.ok()) {
+      return s;
+    }
+
+    const bool with_tags = options.tag_size_m > 0.0;
+    if (with_tags) {
+      if (Status s = runner.Run(
+          "tags", options.tag_family, Exists(project.TagDetectionsPath()), false, [&](StageSummary* summary) -> Status {
+            RECONAR_ASSIGN_OR_RETURN(const TagDetectionsFile detections, options.detect_tags(image_paths));
+            int with = 0;
+            for (const ImageTagObservations& image : detections.images) with += image.tags.empty() ? 0 : 1;
+            summary->note = std::to_string(with) + " of " + std::to_string(detections.images.size()) +
+                            " photos show a tag";
+            RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root() + "/tags"));
+            return WriteTagDetections(project.TagDetectionsPath(), detections);
+          });
+        !s.ok()) {
+      return s;
+    }
+    }
+
+    SfmStageOptions sfm = options.sfm;
+    sfm.mapper.num_threads = threads;
+    sfm.show_progress = options.show_progress;
+    sfm.tags.enabled = with_tags;
+    sfm.tags.registration.tag_size_m = with_tags ? options.tag_size_m : 1.0;
+    const MapperOptions& mapper = sfm.mapper;
+    if (Status s = runner.Run(
+        "mapping",
+        Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
+                  {"max_error", mapper.max_reprojection_error_px},
+                  {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0}, {"tag_size", options.tag_size_m},
+                  {"world_tag", sfm.tags.registration.world_tag}, {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}}),
+        Exists(project.SparseDir() + "/report.json"), runner.redone(), [&](StageSummary* summary) -> Status {
+          RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
+          if (with_tags && !r.tags.metric) summary->note = "no metric registration: " + r.tags.reason;
+          if (!with_tags) std::filesystem::remove(project.TagsJsonPath());
+          JsonWriter json(2);
+          json.BeginObject();
+          WriteSfmReportFields(r, &json);
+          json.EndObject();
+          return WriteFileAtomically(project.SparseDir() + "/report.json", json.str() + "\n");
+        });
+        !s.ok()) {
+      return s;
+    }
+  }
+
+  if (options.run_dense) {
+    DenseStageOptions dense = options.dense;
+    dense.memory_budget_bytes = budget;
+    dense.num_threads = threads;
+    dense.show_progress = options.show_progress;
+    if (Status s = runner.Run(
+        "dense",
+        Settings({{"level", dense.level}, {"max_cluster_size", dense.clustering.max_cluster_size},
+                  {"budget_mib", Mib(budget)}, {"remove_outliers", dense.remove_outliers ? 1.0 : 0.0}}),
+        Exists(project.root() + "/dense/report.json"), runner.redone(), [&](StageSummary* summary) -> Status {
+          RECONAR_ASSIGN_OR_RETURN(const DenseStageReport r, RunDenseStage(project, dense));
+          for (const DensePhase* phase : {&r.load, &r.clustering, &r.undistort, &r.mvs, &r.merge, &r.outlier_filter, &r.write}) {
+            summary->peak_rss_bytes = std::max(summary->peak_rss_bytes, phase->peak_rss_bytes);
+          }
+          if (r.level_auto && r.level > 0) summary->note = "level " + std::to_string(r.level) + " for the memory budget";
+          if (r.cluster_size_reduced) {
+            summary->note += std::string(summary->note.empty() ? "" : "; ") + "clusters of at most " +
+                             std::to_string(r.max_cluster_size) + " images for the memory budget";
+          }
+          return Status::Ok();
+        });
+        !s.ok()) {
+      return s;
+    }
+  }
+
+  if (options.run_mesh) {
+    MeshStageOptions mesh = options.mesh;
+    mesh.memory_budget_bytes = budget;
+    mesh.poisson.num_threads = threads;
+    mesh.poisson.show_progress = options.show_progress;
+    std::string formats;
+    for (const std::string& f : mesh.formats) formats += f;
+    if (Status s = runner.Run(
+        "mesh",
+        Settings({{"version", 2}, {"depth", mesh.poisson.depth}, {"trim", mesh.poisson.trim}, {"point_weight", mesh.poisson.point_weight},
+                  {"budget_mib", Mib(budget)}, {"formats", static_cast<double>(std::hash<std::string>()(formats) % 1000000)}}),
+        Exists(project.MeshDir() + "/report.json"), runner.redone(), [&](StageSummary* summary) -> Status {
+          RECONAR_ASSIGN_OR_RETURN(const MeshStageReport r, RunMeshStage(project, mesh));
+          summary->peak_rss_bytes = std::max(r.peak_rss_bytes, r.pilot_peak_bytes);
+          if (r.depth_lowered_for_budget) summary->note = "Poisson depth " + std::to_string(r.depth) + " for the memory budget";
+          return Status::Ok();
+        });
+        !s.ok()) {
+      return s;
+    }
+  }
+
+  // Scale: what tags.json says.
+  if (auto tags = ReadJsonFile(project.TagsJsonPath()); tags.ok()) {
+    const JsonValue* metric = tags->Find("metric");
+    report.metric = metric != nullptr && metric->is_bool() && metric->bool_value();
+    const JsonValue* reason = tags->Find("reason");
+    if (!report.metric) report.scale_note = reason != nullptr && reason->is_string() ? reason->string() : "no tag registered";
+  } else {
+    report.scale_note = "arbitrary (no --tag-size given)";
+  }
+  report.report_path = project.ReportPath();
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, ReportJson(project, options, report)));
+  return report;
+}
+
+}  // namespace reconar

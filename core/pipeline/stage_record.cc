@@ -1,0 +1,48 @@
+#include "core/pipeline/stage_record.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "core/base/atomic_file.h"
+
+namespace reconar {
+
+StageRecord::StageRecord(const Project& project) : path_(project.root() + "/stages.txt") {
+  auto text = ReadFileToString(path_);
+  if (!text.ok()) return;
+  std::istringstream in(*text);
+  std::string line;
+  while (std::getline(in, line)) {
+    const size_t space = line.find(' ');
+    if (space != std::string::npos) stages_[line.substr(0, space)] = line.substr(space + 1);
+  }
+}
+
+bool StageRecord::Finished(const std::string& stage, const std::string& settings) const {
+  const auto it = stages_.find(stage);
+  return it != stages_.end() && it->second == settings;
+}
+
+Status StageRecord::Record(const std::string& stage, const std::string& settings) {
+  stages_[stage] = settings;
+  bool after = false;
+  for (const char* name : kStageOrder) {
+    if (after) stages_.erase(name);
+    after |= stage == name;
+  }
+  std::string text;
+  for (const auto& [name, value] : stages_) text += name + " " + value + "\n";
+  return WriteFileAtomically(path_, text);
+}
+
+std::string StageRecord::Settings(std::initializer_list<std::pair<const char*, double>> values) {
+  std::string text;
+  char buffer[64];
+  for (const auto& [name, value] : values) {
+    std::snprintf(buffer, sizeof(buffer), "%s%s=%.12g", text.empty() ? "" : " ", name, value);
+    text += buffer;
+  }
+  return text;
+}
+
+}  // namespace reconar

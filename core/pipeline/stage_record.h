@@ -1,0 +1,35 @@
+#pragma once
+// PROJECT/stages.txt: one "STAGE SETTINGS" line per finished stage, so that a re-run (of `reconar
+// sfm`, or of `reconar reconstruct` after an interruption) reuses a stage only when it finished
+// with the same settings. A stage is recorded after its outputs are written (atomically), so a
+// killed run never records a stage it did not finish; recording a stage drops the record of every
+// stage after it in kStageOrder, whose inputs it has just replaced.
+#include <initializer_list>
+#include <map>
+#include <string>
+#include <utility>
+
+#include "core/base/status.h"
+#include "core/pipeline/project.h"
+
+namespace reconar {
+
+inline constexpr const char* kStageOrder[] = {"features", "matching", "tags", "mapping", "dense", "mesh"};
+
+class StageRecord {
+ public:
+  // A missing or unreadable stages.txt reads as no finished stage.
+  explicit StageRecord(const Project& project);
+
+  bool Finished(const std::string& stage, const std::string& settings) const;
+  Status Record(const std::string& stage, const std::string& settings);
+
+  // "name=value name=value" with values printed to 12 significant digits.
+  static std::string Settings(std::initializer_list<std::pair<const char*, double>> values);
+
+ private:
+  std::string path_;
+  std::map<std::string, std::string> stages_;
+};
+
+}  // namespace reconar

@@ -1,0 +1,349 @@
+#include "core/sfm/tag_registration.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <set>
+#include <utility>
+
+#include "core/base/json_writer.h"
+
+namespace reconar {
+namespace {
+
+using Observation = std::pair<int, Eigen::Vector2d>;  // (image id, pixel)
+
+// Normalised, undistorted coordinates of a pixel (the inverse of SfmCamera::Project by fixed point).
+Eigen::Vector2d NormalisedCoordinates(const SfmCamera& camera, const Eigen::Vector2d& pixel) {
+  const Eigen::Vector2d distorted((pixel.x() - camera.cx) / camera.focal,
+                                  (pixel.y() - camera.cy) / (camera.aspect * camera.focal));
+  Eigen::Vector2d p = distorted;
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    const double r2 = p.squaredNorm();
+    p = distorted / (1.0 + r2 * (camera.k1 + camera.k2 * r2));
+  }
+  return p;
+}
+
+double ReprojectionError(const Reconstruction& rec, const Observation& obs, const Eigen::Vector3d& point) {
+  const SfmImage& image = rec.images[static_cast<size_t>(obs.first)];
+  const Eigen::Vector3d cam = image.pose.CamFromWorld(point);
+  if (!(cam.z() > 0.0)) return std::numeric_limits<double>::infinity();
+  return (rec.cameras[static_cast<size_t>(image.camera_id)].Project(cam) - obs.second).norm();
+}
+
+// Multi-view DLT on normalised coordinates (Hartley & Zisserman sec. 12.2), then Gauss-Newton on
+// the pixel reprojection error.
+std::optional<Eigen::Vector3d> TriangulateViews(const Reconstruction& rec, const std::vector<Observation>& views) {
+  Eigen::MatrixXd system(2 * views.size(), 4);
+  for (size_t v = 0; v < views.size(); ++v) {
+    const SfmImage& image = rec.images[static_cast<size_t>(views[v].first)];
+    Eigen::Matrix<double, 3, 4> P;
+    P << image.pose.cam_from_world_rotation, image.pose.cam_from_world_translation;
+    const Eigen::Vector2d x = NormalisedCoordinates(rec.cameras[static_cast<size_t>(image.camera_id)], views[v].second);
+    system.row(static_cast<Eigen::Index>(2 * v)) = x.x() * P.row(2) - P.row(0);
+    system.row(static_cast<Eigen::Index>(2 * v + 1)) = x.y() * P.row(2) - P.row(1);
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(system, Eigen::ComputeFullV);
+  const Eigen::Vector4d h = svd.matrixV().col(3);
+  if (!(std::abs(h.w()) > 1e-12)) return std::nullopt;
+  Eigen::Vector3d point = h.head<3>() / h.w();
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+    for (const Observation& view : views) {
+      const SfmImage& image = rec.images[static_cast<size_t>(view.first)];
+      const SfmCamera& camera = rec.cameras[static_cast<size_t>(image.camera_id)];
+      const Eigen::Vector3d cam = image.pose.CamFromWorld(point);
+      if (!(cam.z() > 0.0)) return std::nullopt;
+      const Eigen::Vector2d residual = camera.Project(cam) - view.second;
+      Eigen::Matrix<double, 2, 3> jacobian;
+      for (int axis = 0; axis < 3; ++axis) {
+        Eigen::Vector3d step = Eigen::Vector3d::Zero();
+        step[axis] = 1e-6 * std::max(1.0, point.norm());
+        jacobian.col(axis) = (camera.Project(image.pose.CamFromWorld(point + step)) - camera.Project(cam)) / step[axis];
+      }
+      normal += jacobian.transpose() * jacobian;
+      gradient += jacobian.transpose() * residual;
+    }
+    const Eigen::Vector3d delta = normal.ldlt().solve(-gradient);
+    if (!delta.allFinite()) return std::nullopt;
+    point += delta;
+    if (delta.norm() < 1e-12 * std::max(1.0, point.norm())) break;
+  }
+  if (!point.allFinite()) return std::nullopt;
+  return point;
+}
+
+// Triangulates from the views, dropping the worst view while any error exceeds the bound.
+std::optional<Eigen::Vector3d> TriangulateCorner(const Reconstruction& rec, std::vector<Observation> views,
+                                                 const TagRegistrationOptions& options) {
+  while (static_cast<int>(views.size()) >= options.min_views) {
+    const std::optional<Eigen::Vector3d> point = TriangulateViews(rec, views);
+    if (!point) return std::nullopt;
+    size_t worst = 0;
+    double worst_error = -1.0;
+    for (size_t v = 0; v < views.size(); ++v) {
+      const double error = ReprojectionError(rec, views[v], *point);
+      if (error > worst_error) {
+        worst_error = error;
+        worst = v;
+      }
+    }
+    if (worst_error <= options.max_reprojection_error_px) return point;
+    views.erase(views.begin() + static_cast<std::ptrdiff_t>(worst));
+  }
+  return std::nullopt;
+}
+
+std::array<Eigen::Vector3d, 4> IdealCorners(double size) {
+  std::array<Eigen::Vector3d, 4> corners;
+  for (int k = 0; k < 4; ++k) {
+    corners[static_cast<size_t>(k)] = Eigen::Vector3d(kTagCornerUnits[k][0], kTagCornerUnits[k][1], 0.0) * size / 2.0;
+  }
+  return corners;
+}
+
+std::vector<Eigen::Vector3d> AsVector(const std::array<Eigen::Vector3d, 4>& corners) {
+  return std::vector<Eigen::Vector3d>(corners.begin(), corners.end());
+}
+
+void ApplyToModel(const Sim3& world_from_model, Reconstruction* rec) {
+  for (SfmPoint& point : rec->points) point.position = world_from_model.Apply(point.position);
+  const Eigen::Matrix3d model_from_world_rotation = world_from_model.rotation.transpose();
+  for (SfmImage& image : rec->images) {
+    if (!image.registered) continue;
+    // X_cam' = s X_cam = s R_c X_model + s t_c with X_model = R^T (X_world - t) / s.
+    SfmPose& pose = image.pose;
+    pose.cam_from_world_rotation = pose.cam_from_world_rotation * model_from_world_rotation;
+    pose.cam_from_world_translation =
+        world_from_model.scale * pose.cam_from_world_translation - pose.cam_from_world_rotation * world_from_model.translation;
+  }
+}
+
+}  // namespace
+
+std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vector<TagObservation>>& observations,
+                                                     double keypoint_scale, double corner_weight,
+                                                     std::vector<MapperImage>* images, std::vector<MapperPair>* pairs) {
+  std::vector<TagCornerKeypoint> corners;
+  std::vector<std::map<int, int>> first_keypoint(images->size());  // per image: tag id -> its corner 0 keypoint
+  for (size_t i = 0; i < images->size() && i < observations.size(); ++i) {
+    std::map<int, int> count;
+    for (const TagObservation& tag : observations[i]) ++count[tag.tag_id];
+    MapperImage& image = (*images)[i];
+    if (!observations[i].empty()) image.keypoint_weights.resize(image.keypoints.size(), 0.0f);
+    for (const TagObservation& tag : observations[i]) {
+      if (count[tag.tag_id] != 1) continue;  // a printed id twice in one photo: which is which is unknown
+      first_keypoint[i][tag.tag_id] = static_cast<int>(image.keypoints.size());
+      for (int k = 0; k < 4; ++k) {
+        corners.push_back({static_cast<int>(i), static_cast<int>(image.keypoints.size()), tag.tag_id, k});
+        image.keypoints.push_back(tag.corners[static_cast<size_t>(k)]);
+        if (!image.keypoint_scales.empty()) image.keypoint_scales.push_back(static_cast<float>(keypoint_scale));
+        image.keypoint_weights.push_back(static_cast<float>(corner_weight));
+      }
+    }
+  }
+  std::map<std::pair<int, int>, size_t> pair_of;
+  for (size_t p = 0; p < pairs->size(); ++p) {
+    const PairMatches& m = (*pairs)[p].matches;
+    pair_of[{std::min(m.image_a, m.image_b), std::max(m.image_a, m.image_b)}] = p;
+  }
+  for (size_t a = 0; a < first_keypoint.size(); ++a) {
+    if (first_keypoint[a].empty()) continue;
+    for (size_t b = a + 1; b < first_keypoint.size(); ++b) {
+      std::vector<std::pair<int, int>> shared;  // (corner 0 keypoint in a, in b)
+      for (const auto& [id, keypoint] : first_keypoint[a]) {
+        const auto other = first_keypoint[b].find(id);
+        if (other != first_keypoint[b].end()) shared.emplace_back(keypoint, other->second);
+      }
+      if (shared.empty()) continue;
+      const std::pair<int, int> key(static_cast<int>(a), static_cast<int>(b));
+      auto it = pair_of.find(key);
+      if (it == pair_of.end()) {
+        MapperPair pair;
+        pair.matches.image_a = key.first;
+        pair.matches.image_b = key.second;
+        pair.planar = true;
+        pairs->push_back(std::move(pair));
+        it = pair_of.emplace(key, pairs->size() - 1).first;
+      }
+      PairMatches& matches = (*pairs)[it->second].matches;
+      const bool swapped = matches.image_a != key.first;
+      for (const auto& [in_a, in_b] : shared) {
+        for (int k = 0; k < 4; ++k) {
+          matches.matches.push_back(swapped ? FeatureMatch{in_b + k, in_a + k} : FeatureMatch{in_a + k, in_b + k});
+        }
+      }
+    }
+  }
+  return corners;
+}
+
+Status TagRegistrationOptions::Check() const {
+  if (!(tag_size_m > 0.0) || !std::isfinite(tag_size_m)) return InvalidArgument("tag registration: the tag size must be positive");
+  if (min_views < 2) return InvalidArgument("tag registration: min_views must be >= 2");
+  if (!(max_reprojection_error_px > 0.0)) return InvalidArgument("tag registration: max_reprojection_error_px must be > 0");
+  return Status::Ok();
+}
+
+Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagObservation>>& observations,
+                                             const std::vector<TagCornerKeypoint>& corner_keypoints,
+                                             const TagRegistrationOptions& options, Reconstruction* rec) {
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  TagRegistrationReport report;
+  // Observations of every corner in registered images, and the adjusted tracks that hold them.
+  std::map<int, std::array<std::vector<Observation>, 4>> seen;  // tag id -> per corner
+  for (size_t i = 0; i < rec->images.size() && i < observations.size(); ++i) {
+    if (!rec->images[i].registered) continue;
+    std::map<int, int> count;
+    for (const TagObservation& tag : observations[i]) ++count[tag.tag_id];
+    for (const TagObservation& tag : observations[i]) {
+      if (count[tag.tag_id] != 1) continue;
+      for (int k = 0; k < 4; ++k) seen[tag.tag_id][static_cast<size_t>(k)].emplace_back(static_cast<int>(i), tag.corners[static_cast<size_t>(k)]);
+    }
+  }
+  std::map<std::pair<int, int>, std::map<int, int>> track_votes;  // (tag, corner) -> point id -> observations
+  for (const TagCornerKeypoint& c : corner_keypoints) {
+    const SfmImage& image = rec->images[static_cast<size_t>(c.image_id)];
+    if (!image.registered) continue;
+    const int point = image.point3d_ids[static_cast<size_t>(c.keypoint_id)];
+    if (point >= 0 && !rec->points[static_cast<size_t>(point)].deleted) ++track_votes[{c.tag_id, c.corner}][point];
+  }
+  report.tags_seen = static_cast<int>(seen.size());
+
+  // Each tag's corners in the model frame.
+  struct ModelTag {
+    int id;
+    std::array<Eigen::Vector3d, 4> corners;
+    bool adjusted;
+    int views;
+  };
+  std::vector<ModelTag> complete;
+  for (const auto& [id, per_corner] : seen) {
+    ModelTag tag{id, {}, true, static_cast<int>(per_corner[0].size())};
+    bool ok = true;
+    for (int k = 0; k < 4 && ok; ++k) {
+      const auto votes = track_votes.find({id, k});
+      if (votes != track_votes.end()) {
+        const auto best = std::max_element(votes->second.begin(), votes->second.end(),
+                                           [](const auto& x, const auto& y) { return x.second < y.second; });
+        tag.corners[static_cast<size_t>(k)] = rec->points[static_cast<size_t>(best->first)].position;
+      } else {
+        tag.adjusted = false;
+        const std::optional<Eigen::Vector3d> point = TriangulateCorner(*rec, per_corner[static_cast<size_t>(k)], options);
+        ok = point.has_value();
+        if (ok) tag.corners[static_cast<size_t>(k)] = *point;
+      }
+    }
+    if (ok) complete.push_back(tag);
+  }
+  if (complete.empty()) {
+    report.reason = report.tags_seen == 0
+                        ? "no tag was detected in a registered image"
+                        : std::to_string(report.tags_seen) + " tag(s) seen, none with all four corners in " +
+                              std::to_string(options.min_views) + " registered views";
+    return report;
+  }
+
+  // Scale from every complete tag's mean edge; frame from the world tag.
+  double mean_edge = 0.0;
+  for (const ModelTag& tag : complete) {
+    for (int k = 0; k < 4; ++k) {
+      mean_edge += (tag.corners[static_cast<size_t>((k + 1) % 4)] - tag.corners[static_cast<size_t>(k)]).norm() / 4.0;
+    }
+  }
+  mean_edge /= static_cast<double>(complete.size());
+  if (!(mean_edge > 0.0)) return FailedPrecondition("tag registration: the tags' corners coincide");
+  const auto world = std::find_if(complete.begin(), complete.end(), [&](const ModelTag& tag) {
+    return options.world_tag < 0 || tag.id == options.world_tag;
+  });
+  if (world == complete.end()) {
+    std::string ids;
+    for (const ModelTag& tag : complete) ids += (ids.empty() ? "" : ", ") + std::to_string(tag.id);
+    return InvalidArgument("tag registration: world tag " + std::to_string(options.world_tag) +
+                           " was not reconstructed; complete tags: " + ids);
+  }
+  report.metres_per_model_unit = options.tag_size_m / mean_edge;
+  RECONAR_ASSIGN_OR_RETURN(report.world_from_model,
+                           AlignSimilarity(AsVector(world->corners), AsVector(IdealCorners(options.tag_size_m)),
+                                           report.metres_per_model_unit));
+  ApplyToModel(report.world_from_model, rec);
+  report.metric = true;
+  report.world_tag = world->id;
+
+  std::vector<double> edges;
+  for (const ModelTag& model_tag : complete) {
+    RegisteredTag tag;
+    tag.id = model_tag.id;
+    tag.views = model_tag.views;
+    tag.adjusted = model_tag.adjusted;
+    for (size_t k = 0; k < 4; ++k) tag.corners[k] = report.world_from_model.Apply(model_tag.corners[k]);
+    double squares = 0.0;
+    int count = 0;
+    for (size_t k = 0; k < 4; ++k) {
+      tag.edges_m[k] = (tag.corners[(k + 1) % 4] - tag.corners[k]).norm();
+      edges.push_back(tag.edges_m[k]);
+      for (const Observation& view : seen.at(tag.id)[k]) {
+        const double error = ReprojectionError(*rec, view, tag.corners[k]);
+        if (std::isfinite(error)) {
+          squares += error * error;
+          ++count;
+        }
+      }
+    }
+    tag.rms_reprojection_px = count > 0 ? std::sqrt(squares / count) : 0.0;
+    auto fit = AlignSimilarity(AsVector(IdealCorners(options.tag_size_m)), AsVector(tag.corners), 1.0);
+    if (fit.ok()) tag.world_from_tag = Rigid3{fit->rotation, fit->translation};
+    report.tags.push_back(tag);
+  }
+  for (double e : edges) report.edge_mean_m += e / static_cast<double>(edges.size());
+  for (double e : edges) {
+    report.edge_std_m += (e - report.edge_mean_m) * (e - report.edge_mean_m) / static_cast<double>(edges.size());
+    report.edge_max_abs_error_m = std::max(report.edge_max_abs_error_m, std::abs(e - options.tag_size_m));
+  }
+  report.edge_std_m = std::sqrt(report.edge_std_m);
+  return report;
+}
+
+std::string TagRegistrationJson(const TagRegistrationReport& report, const std::string& family, double tag_size_m) {
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("metric").Bool(report.metric);
+  if (!report.metric) json.Key("reason").String(report.reason);
+  json.Key("family").String(family);
+  json.Key("tag_size_m").Double(tag_size_m);
+  json.Key("world_tag").Int(report.world_tag);
+  json.Key("tags_seen").Int(report.tags_seen);
+  json.Key("metres_per_model_unit").Double(report.metres_per_model_unit);
+  json.Key("edge_mean_m").Double(report.edge_mean_m);
+  json.Key("edge_std_m").Double(report.edge_std_m);
+  json.Key("edge_max_abs_error_m").Double(report.edge_max_abs_error_m);
+  json.Key("tags").BeginArray();
+  for (const RegisteredTag& tag : report.tags) {
+    json.BeginObject();
+    json.Key("id").Int(tag.id).Key("views").Int(tag.views).Key("adjusted").Bool(tag.adjusted);
+    json.Key("corners").BeginArray();
+    for (const Eigen::Vector3d& c : tag.corners) json.BeginArray().Double(c.x()).Double(c.y()).Double(c.z()).EndArray();
+    json.EndArray();
+    json.Key("edges_m").BeginArray();
+    for (double e : tag.edges_m) json.Double(e);
+    json.EndArray();
+    json.Key("rms_reprojection_px").Double(tag.rms_reprojection_px);
+    json.Key("world_from_tag").BeginObject().Key("R").BeginArray();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) json.Double(tag.world_from_tag.rotation(r, c));
+    }
+    json.EndArray().Key("t").BeginArray();
+    for (int r = 0; r < 3; ++r) json.Double(tag.world_from_tag.translation[r]);
+    json.EndArray().EndObject();
+    json.EndObject();
+  }
+  json.EndArray();
+  json.EndObject();
+  return json.str() + "\n";
+}
+
+}  // namespace reconar

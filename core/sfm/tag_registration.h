@@ -1,0 +1,97 @@
+#pragma once
+// Metric registration of a reconstruction by AprilTags of known size (the paper's sections 2.4.3
+// and 3.4: the markers give the model absolute scale and the frame it is shown in).
+//
+// AddTagCorrespondences gives the mapper each tag corner as a keypoint and every pair of images
+// that see the same tag its four corner matches, so that the corners become tracks: they help
+// register images of texture-poor surfaces (the paper's Fig. 12) and bundle adjustment refines
+// them with every other point.
+//
+// RegisterToTags then finds each tag's four corners in the model (the adjusted track, or a
+// triangulation from the registered views when the mapper kept none), takes the scale from the
+// mean edge of all complete tags, and moves the model into the frame of the world tag (tag frame:
+// origin at its centre, x right, y up, z out of the printed tag; metres): world_from_model is the
+// similarity with that scale whose rotation and translation fit the world tag's corners to their
+// ideal places (Umeyama with fixed scale).
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/base/status.h"
+#include "core/math/rigid3.h"
+#include "core/math/sim3.h"
+#include "core/sfm/mapper.h"
+#include "core/sfm/reconstruction.h"
+#include "core/sfm/tag_observations.h"
+
+namespace reconar {
+
+// Where AddTagCorrespondences put a corner.
+struct TagCornerKeypoint {
+  int image_id = -1;
+  int keypoint_id = -1;
+  int tag_id = -1;
+  int corner = -1;  // 0..3, kTagCornerUnits order
+};
+
+// Bundle-adjustment weight of a tag corner against a keypoint detected at the base scale: the
+// inverse ratio of their localisation errors, about 0.1 px for libapriltag's edge-fitted corners
+// (Wang & Olson 2016) against 0.2-0.3 px for SIFT (Lowe 2004's sub-pixel fit).
+inline constexpr double kTagCornerWeight = 2.0;
+
+// observations[i] are the tags seen in images[i]. Corners get `keypoint_scale` as detection scale
+// (when the images carry scales) and `corner_weight` as weight. A pair of images that share tags
+// but have no verified pair gets a new one, marked planar so that it never starts the reconstruction.
+std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vector<TagObservation>>& observations,
+                                                     double keypoint_scale, double corner_weight,
+                                                     std::vector<MapperImage>* images, std::vector<MapperPair>* pairs);
+
+struct TagRegistrationOptions {
+  double tag_size_m = 0.0;    // edge of the black square (libapriltag's width_at_border), > 0
+  int world_tag = -1;         // the tag whose frame becomes the world frame; -1: the lowest complete id
+  int min_views = 2;          // registered views a corner needs to be triangulated
+  double max_reprojection_error_px = 4.0;  // a triangulated corner's observations beyond this are dropped
+
+  Status Check() const;
+};
+
+struct RegisteredTag {
+  int id = -1;
+  std::array<Eigen::Vector3d, 4> corners;  // world frame, metres
+  int views = 0;                           // registered images that saw all four corners
+  bool adjusted = false;                   // all corners were bundle-adjusted tracks
+  std::array<double, 4> edges_m = {};      // |corner k+1 - corner k|
+  double rms_reprojection_px = 0.0;        // of the corners in the views that saw them
+  Rigid3 world_from_tag;                   // fitted to the corners (rotation, translation)
+};
+
+struct TagRegistrationReport {
+  // The model is in metres in the world tag's frame. False: no tag was seen with all four
+  // corners in `min_views` registered images (`reason` says what was seen); the model is unchanged.
+  bool metric = false;
+  std::string reason;
+  int world_tag = -1;
+  int tags_seen = 0;                 // distinct ids detected in registered images
+  double metres_per_model_unit = 0;  // the scale applied
+  Sim3 world_from_model;
+  std::vector<RegisteredTag> tags;   // complete tags, by id
+  double edge_mean_m = 0.0, edge_std_m = 0.0, edge_max_abs_error_m = 0.0;  // over all edges of all tags
+};
+
+// observations[i] are the tags seen in rec->images[i]; `corner_keypoints` (may be empty) says which
+// of their keypoints carry corners. On success with report.metric, *rec is moved into the world
+// frame (points, poses; intrinsics are unchanged). InvalidArgument for bad options or when the
+// requested world tag is not among the complete tags.
+Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagObservation>>& observations,
+                                             const std::vector<TagCornerKeypoint>& corner_keypoints,
+                                             const TagRegistrationOptions& options, Reconstruction* rec);
+
+// PROJECT/tags.json: {"metric", "reason", "family", "tag_size_m", "world_tag", "tags_seen",
+// "metres_per_model_unit", "edge_mean_m", "edge_std_m", "edge_max_abs_error_m", "tags": [{"id",
+// "views", "adjusted", "corners": [[x, y, z] x 4] (metres, world frame), "edges_m": [4],
+// "rms_reprojection_px", "world_from_tag": {"R": [9, row-major], "t": [3]}}]}.
+std::string TagRegistrationJson(const TagRegistrationReport& report, const std::string& family, double tag_size_m);
+
+}  // namespace reconar

@@ -1,0 +1,206 @@
+// Tag registration (core/sfm/tag_registration.h) on a synthetic scene whose metric truth is known:
+// three tags in a world frame, cameras looking at them, the model an arbitrary similarity of the
+// world. Also the tag corner correspondences handed to the mapper.
+#include "core/sfm/tag_registration.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "core/base/atomic_file.h"
+#include "core/math/rigid3.h"
+
+namespace reconar {
+namespace {
+
+constexpr double kTagSize = 0.16;
+
+struct Scene {
+  std::vector<Rigid3> world_from_tag;  // tag ids 0, 1, 2
+  Sim3 model_from_world;
+  Reconstruction model;                // cameras in the model frame
+  std::vector<std::vector<TagObservation>> observations;
+  std::vector<Eigen::Vector3d> camera_centres_world;
+};
+
+Eigen::Vector3d TagCorner(const Rigid3& world_from_tag, int k) {
+  return world_from_tag * (Eigen::Vector3d(kTagCornerUnits[k][0], kTagCornerUnits[k][1], 0.0) * kTagSize / 2.0);
+}
+
+Scene MakeScene() {
+  Scene scene;
+  scene.world_from_tag.push_back(Rigid3::Identity());
+  scene.world_from_tag.push_back(
+      Rigid3{Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY()).toRotationMatrix(), Eigen::Vector3d(0.6, 0.05, -0.1)});
+  scene.world_from_tag.push_back(
+      Rigid3{Eigen::AngleAxisd(-0.4, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix(), Eigen::Vector3d(-0.5, 0.4, 0.05)});
+  scene.model_from_world.scale = 3.7;
+  scene.model_from_world.rotation = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -1, 0.4).normalized()).toRotationMatrix();
+  scene.model_from_world.translation = Eigen::Vector3d(5, -2, 9);
+
+  SfmCamera camera;
+  camera.width = 800;
+  camera.height = 600;
+  camera.focal = 700;
+  camera.cx = 401;
+  camera.cy = 297;
+  camera.k1 = -0.04;
+  camera.k2 = 0.01;
+  scene.model.cameras.push_back(camera);
+  for (int c = 0; c < 6; ++c) {
+    const double angle = -0.6 + 0.24 * c;
+    const Eigen::Vector3d centre(2.0 * std::sin(angle), 0.3 * std::cos(3.0 * angle), 2.0 * std::cos(angle));
+    scene.camera_centres_world.push_back(centre);
+    const Rigid3 cam_from_world = CamFromWorldLookingAt(centre, Eigen::Vector3d(0, 0.1, 0), Eigen::Vector3d::UnitY());
+    // cam_from_model: X_cam = R_c X_world + t_c with X_world = R^T (X_model - t) / s, scaled by s.
+    const Sim3& m = scene.model_from_world;
+    SfmImage image;
+    image.name = "view" + std::to_string(c);
+    image.camera_id = 0;
+    image.registered = true;
+    image.pose.cam_from_world_rotation = cam_from_world.rotation * m.rotation.transpose();
+    image.pose.cam_from_world_translation = m.scale * cam_from_world.translation - image.pose.cam_from_world_rotation * m.translation;
+    std::vector<TagObservation> seen;
+    for (int id = 0; id < 3; ++id) {
+      TagObservation tag;
+      tag.tag_id = id;
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d model_point = m.Apply(TagCorner(scene.world_from_tag[static_cast<size_t>(id)], k));
+        tag.corners[static_cast<size_t>(k)] = camera.Project(image.pose.CamFromWorld(model_point));
+      }
+      seen.push_back(tag);
+    }
+    scene.model.images.push_back(image);
+    scene.observations.push_back(seen);
+  }
+  return scene;
+}
+
+TEST(TagRegistrationTest, RecoversMetresAndTheWorldTagFrame) {
+  Scene scene = MakeScene();
+  TagRegistrationOptions options;
+  options.tag_size_m = kTagSize;
+  auto report = RegisterToTags(scene.observations, {}, options, &scene.model);
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  ASSERT_TRUE(report->metric) << report->reason;
+  EXPECT_EQ(report->world_tag, 0);
+  EXPECT_EQ(report->tags_seen, 3);
+  ASSERT_EQ(report->tags.size(), 3u);
+  EXPECT_NEAR(report->metres_per_model_unit, 1.0 / 3.7, 1e-9);
+  for (const RegisteredTag& tag : report->tags) {
+    EXPECT_EQ(tag.views, 6);
+    EXPECT_FALSE(tag.adjusted);
+    EXPECT_LT(tag.rms_reprojection_px, 1e-6);
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_LT((tag.corners[static_cast<size_t>(k)] - TagCorner(scene.world_from_tag[static_cast<size_t>(tag.id)], k)).norm(), 1e-7);
+      EXPECT_NEAR(tag.edges_m[static_cast<size_t>(k)], kTagSize, 1e-7);
+    }
+    EXPECT_LT(RotationAngle(tag.world_from_tag.rotation, scene.world_from_tag[static_cast<size_t>(tag.id)].rotation), 1e-7);
+  }
+  EXPECT_LT(report->edge_max_abs_error_m, 1e-7);
+  // The cameras moved with the model.
+  for (size_t c = 0; c < scene.model.images.size(); ++c) {
+    EXPECT_LT((scene.model.images[c].pose.Center() - scene.camera_centres_world[c]).norm(), 1e-7);
+  }
+}
+
+TEST(TagRegistrationTest, AnyCompleteTagCanBeTheWorldAndOthersAreRefused) {
+  Scene scene = MakeScene();
+  TagRegistrationOptions options;
+  options.tag_size_m = kTagSize;
+  options.world_tag = 2;
+  auto report = RegisterToTags(scene.observations, {}, options, &scene.model);
+  ASSERT_TRUE(report.ok() && report->metric);
+  EXPECT_EQ(report->world_tag, 2);
+  const RegisteredTag& tag2 = report->tags[2];
+  EXPECT_LT(tag2.world_from_tag.translation.norm(), 1e-7);
+  EXPECT_LT(RotationAngle(tag2.world_from_tag.rotation, Eigen::Matrix3d::Identity()), 1e-7);
+
+  Scene other = MakeScene();
+  options.world_tag = 7;
+  EXPECT_EQ(RegisterToTags(other.observations, {}, options, &other.model).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(TagRegistrationTest, WithoutATagInTwoViewsTheModelStaysAsItWas) {
+  Scene scene = MakeScene();
+  const Eigen::Vector3d centre = scene.model.images[0].pose.Center();
+  for (size_t c = 1; c < scene.observations.size(); ++c) scene.observations[c].clear();
+  TagRegistrationOptions options;
+  options.tag_size_m = kTagSize;
+  auto report = RegisterToTags(scene.observations, {}, options, &scene.model);
+  ASSERT_TRUE(report.ok());
+  EXPECT_FALSE(report->metric);
+  EXPECT_NE(report->reason.find("3 tag(s) seen"), std::string::npos) << report->reason;
+  EXPECT_LT((scene.model.images[0].pose.Center() - centre).norm(), 1e-12);
+  options.tag_size_m = 0.0;
+  EXPECT_EQ(RegisterToTags(scene.observations, {}, options, &scene.model).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(TagRegistrationTest, CornersBecomeKeypointsAndMatchesOfEveryPairSharingATag) {
+  std::vector<MapperImage> images(3);
+  for (MapperImage& image : images) {
+    image.keypoints.assign(5, Eigen::Vector2d::Zero());
+    image.keypoint_scales.assign(5, 2.0f);
+  }
+  const auto tag = [](int id) {
+    TagObservation t;
+    t.tag_id = id;
+    for (size_t k = 0; k < 4; ++k) t.corners[k] = Eigen::Vector2d(10.0 * id + k, 1.0);
+    return t;
+  };
+  // Image 2 shows id 1 twice: both are dropped. Pair (0, 1) exists, stored as (1, 0).
+  std::vector<std::vector<TagObservation>> observations = {{tag(1), tag(2)}, {tag(2)}, {tag(1), tag(1)}};
+  std::vector<MapperPair> pairs(1);
+  pairs[0].matches.image_a = 1;
+  pairs[0].matches.image_b = 0;
+  pairs[0].matches.matches = {{0, 0}, {1, 1}};
+  const std::vector<TagCornerKeypoint> corners = AddTagCorrespondences(observations, 1.6, 2.0, &images, &pairs);
+  EXPECT_EQ(corners.size(), 12u);
+  EXPECT_EQ(images[0].keypoints.size(), 13u);
+  EXPECT_EQ(images[1].keypoints.size(), 9u);
+  EXPECT_EQ(images[2].keypoints.size(), 5u);
+  EXPECT_EQ(images[0].keypoint_scales.size(), 13u);
+  ASSERT_EQ(images[0].keypoint_weights.size(), 13u);
+  EXPECT_EQ(images[0].keypoint_weights[4], 0.0f);
+  EXPECT_EQ(images[0].keypoint_weights[5], 2.0f);
+  EXPECT_EQ(images[0].keypoints[9], Eigen::Vector2d(20, 1));  // tag 2, corner 0
+  ASSERT_EQ(pairs.size(), 1u);  // no new pair: image 2 keeps no tag
+  ASSERT_EQ(pairs[0].matches.matches.size(), 6u);
+  // Tag 2 is keypoints 9..12 of image 0 and 5..8 of image 1; the pair is (1, 0).
+  EXPECT_EQ(pairs[0].matches.matches[2].index_a, 5);
+  EXPECT_EQ(pairs[0].matches.matches[2].index_b, 9);
+  EXPECT_EQ(pairs[0].matches.matches[5].index_a, 8);
+  EXPECT_EQ(pairs[0].matches.matches[5].index_b, 12);
+}
+
+TEST(TagRegistrationTest, DetectionsFileRoundTripsAndNamesBadLines) {
+  const std::string dir = ::testing::TempDir();
+  TagDetectionsFile file;
+  file.family = "tag36h11";
+  ImageTagObservations image;
+  image.image_name = "a.jpg";
+  TagObservation tag;
+  tag.tag_id = 7;
+  for (size_t k = 0; k < 4; ++k) tag.corners[k] = Eigen::Vector2d(0.1 + k, 1.0 / 3.0 + k);
+  image.tags.push_back(tag);
+  file.images.push_back(image);
+  file.images.push_back({"b.jpg", {}});
+  const std::string path = dir + "/reconar_tag_detections.txt";
+  ASSERT_TRUE(WriteTagDetections(path, file).ok());
+  auto read = ReadTagDetections(path);
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  EXPECT_EQ(read->family, "tag36h11");
+  ASSERT_EQ(read->images.size(), 2u);
+  ASSERT_EQ(read->images[0].tags.size(), 1u);
+  EXPECT_EQ(read->images[0].tags[0].tag_id, 7);
+  EXPECT_EQ(read->images[0].tags[0].corners[3], tag.corners[3]);
+  EXPECT_TRUE(read->images[1].tags.empty());
+  ASSERT_TRUE(WriteFileAtomically(path, "# reconar tag detections v1\nimage a.jpg 1\n7 1 2 3\n").ok());
+  const Status bad = ReadTagDetections(path).status();
+  EXPECT_EQ(bad.code(), StatusCode::kCorruptData);
+  EXPECT_NE(bad.message().find("line 3"), std::string::npos) << bad.ToString();
+}
+
+}  // namespace
+}  // namespace reconar

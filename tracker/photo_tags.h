@@ -1,0 +1,39 @@
+#pragma once
+// AprilTags in a set of photographs (the `tags` stage of `reconar reconstruct`): each photo is
+// decoded upright (EXIF orientation, as the feature stage reads it), turned grey and searched
+// with TagDetector; the corners come out in the SfM pixel convention (core/sfm/tag_observations.h).
+// An id seen twice in one photo is dropped there (which print is which cannot be told).
+#include <string>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/sfm/tag_observations.h"
+#include "tracker/tag_detector.h"
+
+namespace reconar {
+
+struct PhotoTagOptions {
+  TagFamily family = TagFamily::kTag36h11;
+  // Quad decimation: photos up to this long side are searched at full resolution (libapriltag
+  // finds small tags there that decimation 2 misses); larger ones at decimation 2.
+  int full_resolution_max_side = 2048;
+  int num_threads = 0;  // 0: one per core
+  bool show_progress = true;
+
+  Status Check() const;
+};
+
+struct PhotoTagReport {
+  int photos = 0;
+  int photos_with_tags = 0;
+  int detections = 0;
+  int duplicates_dropped = 0;
+  double seconds = 0.0;
+};
+
+// One entry per path, named by the file name (as features/images.txt names the photos). Errors
+// name the photo that could not be read.
+Result<TagDetectionsFile> DetectTagsInPhotos(const std::vector<std::string>& paths, const PhotoTagOptions& options,
+                                             PhotoTagReport* report = nullptr);
+
+}  // namespace reconar
