@@ -40,17 +40,24 @@ Result<CameraIntrinsics> IntrinsicsFromArg(const std::string& value) {
   return intrinsics;
 }
 
-Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args) {
+Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args, const TrackerDefaults& defaults) {
   TagTrackerOptions options;
-  if (!args.Has("intrinsics")) return InvalidArgument("--intrinsics is required (fx,fy,cx,cy or a file)");
-  auto intrinsics = IntrinsicsFromArg(args.Get("intrinsics"));
-  if (!intrinsics.ok()) return intrinsics.status();
-  options.intrinsics = *intrinsics;
-  if (!args.Has("tag-size")) return InvalidArgument("--tag-size is required (metres, edge of the black square)");
-  auto tag_size = args.GetDouble("tag-size", 0.0, 1e-4, 100.0);
+  if (args.Has("intrinsics")) {
+    auto intrinsics = IntrinsicsFromArg(args.Get("intrinsics"));
+    if (!intrinsics.ok()) return intrinsics.status();
+    options.intrinsics = *intrinsics;
+  } else if (defaults.intrinsics) {
+    options.intrinsics = *defaults.intrinsics;
+  } else {
+    return InvalidArgument("--intrinsics is required (fx,fy,cx,cy or a file)");
+  }
+  if (!args.Has("tag-size") && !defaults.tag_size) {
+    return InvalidArgument("--tag-size is required (metres, edge of the black square)");
+  }
+  auto tag_size = args.GetDouble("tag-size", defaults.tag_size.value_or(0.0), 1e-4, 100.0);
   if (!tag_size.ok()) return tag_size.status();
   options.tag_size = *tag_size;
-  auto family = ParseTagFamily(args.Get("family", "tag36h11"));
+  auto family = ParseTagFamily(args.Get("family", defaults.family.value_or("tag36h11")));
   if (!family.ok()) return family.status();
   options.detector.family = *family;
   auto decimate = args.GetDouble("decimate", options.detector.quad_decimate, 1.0, 8.0);

@@ -1,5 +1,6 @@
 #pragma once
 // Command-line options shared by the AR subcommands (track, view, calibrate).
+#include <optional>
 #include <set>
 #include <string>
 
@@ -14,8 +15,16 @@ namespace reconar::tools {
 // the path of an intrinsics file written by `reconar calibrate`.
 Result<CameraIntrinsics> IntrinsicsFromArg(const std::string& value);
 
+// Values to use where the command line gives none (`reconar view --project` reads them from the
+// project); without them --intrinsics and --tag-size are required.
+struct TrackerDefaults {
+  std::optional<CameraIntrinsics> intrinsics;
+  std::optional<double> tag_size;
+  std::optional<std::string> family;
+};
+
 // --intrinsics, --tag-size, --family, --decimate, --threads, --full-frame-interval, --max-tags.
-Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args);
+Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args, const TrackerDefaults& defaults = {});
 inline const std::set<std::string> kTrackerValuedOptions = {"intrinsics", "tag-size", "family", "decimate",
                                                               "threads", "full-frame-interval", "max-tags"};
 inline constexpr char kTrackerOptionsHelp[] =

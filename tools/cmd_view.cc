@@ -7,10 +7,16 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/base/atomic_file.h"
+#include "core/base/json_reader.h"
+#include "core/mesh/mesh_file.h"
+#include "core/pipeline/project.h"
+#include "core/sfm/model_io.h"
 #include "core/io/image_write.h"
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_io.h"
@@ -21,6 +27,7 @@
 #include "render/overlay_renderer.h"
 #include "tools/ar_args.h"
 #include "tools/commands.h"
+#include "tracker/tag_layout.h"
 #include "tracker/tag_tracker.h"
 
 namespace reconar::tools {
@@ -29,12 +36,17 @@ namespace {
 constexpr char kHelp[] =
     "usage: reconar view --model MODEL (--camera DEVICE | --frames DIR|FILE.frames)\n"
     "                    --intrinsics K --tag-size METRES [options]\n"
+    "       reconar view --project DIR (--camera DEVICE | --frames DIR|FILE.frames) [options]\n"
     "\n"
     "Tracks an AprilTag in the video and draws MODEL (.ply or .glb mesh or point cloud) standing on\n"
     "it. Without --out the overlay is shown live: in an X11 window when DISPLAY is set, otherwise\n"
     "full screen through DRM/KMS ('q' or Escape quits the window). With --out, one PNG per frame\n"
     "is written to DIR instead (headless, no display needed).\n"
     "  --model FILE          mesh or point cloud to show (.ply, .glb)\n"
+    "  --project DIR         a project of `reconar reconstruct --tag-size`: its mesh (or dense, or\n"
+    "                        sparse points) at true size, posed from all of its tags in view at once\n"
+    "                        (tags.layout), with its tag size, family and camera (scaled to the frame\n"
+    "                        size; --intrinsics overrides); the --model-* options do not apply\n"
     "  --camera DEVICE       /dev/videoN, libcamera or libcamera:N\n"
     "  --frames PATH         a folder of JPEG/PNG frames or a .frames recording\n"
     "  --out DIR             write DIR/<frame>.png instead of showing a window\n"
@@ -115,11 +127,80 @@ Result<ModelPlacement> PlacementFromArgs(const Args& args, const Mesh& mesh, dou
   return placement;
 }
 
-// The tag the model stands on this frame: --tag-id if followed, else the lowest id followed.
+// What `--project DIR` brings: the model in metres in the world frame, where each tag sits in it,
+// the tags' size and family, and the photos' camera.
+struct ProjectScene {
+  std::string model_path;
+  TagLayout layout;  // world_from_tag of every registered tag (PROJECT/tags.layout)
+  TrackerDefaults tracker;
+};
+
+Result<ProjectScene> LoadProjectScene(const std::string& dir) {
+  const Project project(dir);
+  ProjectScene scene;
+  // The mesh, else the dense points, else the sparse points.
+  for (const std::string& path : {project.MeshDir() + "/mesh.ply", project.DensePointsPath(), project.SparseDir() + "/points.ply"}) {
+    scene.model_path = path;
+    if (ReadMeshFile(path).ok()) break;
+  }
+  RECONAR_ASSIGN_OR_RETURN(const JsonValue tags, ReadJsonFile(project.TagsJsonPath()));
+  const JsonValue* metric = tags.Find("metric");
+  if (metric == nullptr || !metric->is_bool() || !metric->bool_value()) {
+    const JsonValue* reason = tags.Find("reason");
+    return FailedPrecondition(project.TagsJsonPath() + ": the model is not in metres (" +
+                              (reason != nullptr && reason->is_string() ? reason->string() : "no tag registered") +
+                              "); show it with --model and --model-height");
+  }
+  const JsonValue* size = tags.Find("tag_size_m");
+  const JsonValue* family = tags.Find("family");
+  if (size == nullptr || !size->is_number() || family == nullptr || !family->is_string()) {
+    return FileError(StatusCode::kCorruptData, project.TagsJsonPath(), "no tag_size_m or family");
+  }
+  scene.tracker.tag_size = size->number();
+  scene.tracker.family = family->string();
+  RECONAR_ASSIGN_OR_RETURN(scene.layout, ReadTagLayout(project.TagLayoutPath()));
+  if (auto model = ReadColmapTextModel(project.SparseDir()); model.ok() && !model->cameras.empty()) {
+    const SfmCamera& camera = model->cameras.front();
+    CameraIntrinsics intrinsics;
+    intrinsics.width = camera.width;
+    intrinsics.height = camera.height;
+    intrinsics.fx = camera.focal;
+    intrinsics.fy = camera.aspect * camera.focal;
+    intrinsics.cx = camera.cx;
+    intrinsics.cy = camera.cy;
+    intrinsics.k1 = camera.k1;
+    intrinsics.k2 = camera.k2;
+    scene.tracker.intrinsics = intrinsics;
+  }
+  return scene;
+}
+
+// The photo camera for video of another size with the same aspect ratio (a phone's video mode).
+Result<CameraIntrinsics> ScaledTo(const CameraIntrinsics& photo, int width, int height) {
+  if (photo.width == width && photo.height == height) return photo;
+  if (photo.width <= 0 || std::abs(static_cast<double>(photo.width) * height - static_cast<double>(photo.height) * width) >
+                              0.01 * photo.width * height) {
+    return InvalidArgument("the project's photos are " + std::to_string(photo.width) + "x" + std::to_string(photo.height) +
+                           ", the video " + std::to_string(width) + "x" + std::to_string(height) +
+                           ": pass --intrinsics for this camera");
+  }
+  const double s = static_cast<double>(width) / photo.width;
+  CameraIntrinsics scaled = photo;
+  scaled.width = width;
+  scaled.height = height;
+  scaled.fx *= s;
+  scaled.fy *= s;
+  scaled.cx = (photo.cx + 0.5) * s - 0.5;  // pixel centres at integer coordinates
+  scaled.cy = (photo.cy + 0.5) * s - 0.5;
+  return scaled;
+}
+
+// The tag the model stands on this frame: --tag-id if measured, else the lowest id measured in this
+// frame. A tag the tracker still follows but did not find in this frame has only a stale pose.
 const TrackedTag* ChooseTag(const TagTrackerFrameReport& report, int wanted_id) {
   const TrackedTag* chosen = nullptr;
   for (const TrackedTag& tag : report.tags) {
-    if (tag.state == TagTrackState::kLost) continue;
+    if (tag.state == TagTrackState::kLost || !tag.measured) continue;
     if (wanted_id >= 0 && tag.id != wanted_id) continue;
     if (chosen == nullptr || tag.id < chosen->id) chosen = &tag;
   }
@@ -154,7 +235,7 @@ struct Latency {
 
 int RunView(int argc, char** argv, int first) {
   std::set<std::string> valued = kTrackerValuedOptions;
-  valued.insert({"model", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
+  valued.insert({"model", "project", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
                  "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames"});
   Args args(valued, {"no-axes", "smooth"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
@@ -163,12 +244,18 @@ int RunView(int argc, char** argv, int first) {
     std::fputs(kTrackerOptionsHelp, stdout);
     return 0;
   }
-  if (!args.positionals().empty() || !args.Has("model") || args.Has("camera") == args.Has("frames")) {
+  if (!args.positionals().empty() || args.Has("model") == args.Has("project") || args.Has("camera") == args.Has("frames")) {
     std::fputs(kHelp, stderr);
     std::fputs(kTrackerOptionsHelp, stderr);
     return 2;
   }
-  auto tracker_options = TrackerOptionsFromArgs(args);
+  std::optional<ProjectScene> scene;
+  if (args.Has("project")) {
+    auto loaded = LoadProjectScene(args.Get("project"));
+    if (!loaded.ok()) return Fail(loaded.status());
+    scene = std::move(*loaded);
+  }
+  auto tracker_options = TrackerOptionsFromArgs(args, scene ? scene->tracker : TrackerDefaults());
   if (!tracker_options.ok()) return Fail(tracker_options.status());
   auto tag_id = args.GetInt("tag-id", -1, -1, 1 << 20);
   if (!tag_id.ok()) return Fail(tag_id.status());
@@ -196,9 +283,11 @@ int RunView(int argc, char** argv, int first) {
     }
   }
 
-  auto mesh = ReadModel(args.Get("model"));
+  const std::string model_path = scene ? scene->model_path : args.Get("model");
+  auto mesh = ReadModel(model_path);
   if (!mesh.ok()) return Fail(mesh.status());
-  auto placement = PlacementFromArgs(args, *mesh, tracker_options->tag_size);
+  Result<ModelPlacement> placement = ModelPlacement();
+  if (!scene) placement = PlacementFromArgs(args, *mesh, tracker_options->tag_size);
   if (!placement.ok()) return Fail(placement.status());
   if (to_files) {
     if (Status s = CreateDirectories(out_dir); !s.ok()) return Fail(s);
@@ -209,13 +298,23 @@ int RunView(int argc, char** argv, int first) {
   const std::string source_spec = args.Has("camera") ? args.Get("camera") : args.Get("frames");
   auto source = OpenFrameSource(source_spec, source_options);
   if (!source.ok()) return Fail(source.status());
-  auto tracker = TagTracker::Create(*tracker_options);
-  if (!tracker.ok()) return Fail(tracker.status());
-
   auto first_frame = (*source)->Next();
   if (!first_frame.ok()) {
     if (IsEndOfStream(first_frame.status())) return Fail(FailedPrecondition(source_spec + ": no frames"));
     return Fail(first_frame.status());
+  }
+  if (scene && !args.Has("intrinsics")) {
+    auto scaled = ScaledTo(tracker_options->intrinsics, first_frame->width, first_frame->height);
+    if (!scaled.ok()) {
+      (*source)->Release(*first_frame);
+      return Fail(scaled.status());
+    }
+    tracker_options->intrinsics = *scaled;
+  }
+  auto tracker = TagTracker::Create(*tracker_options);
+  if (!tracker.ok()) {
+    (*source)->Release(*first_frame);
+    return Fail(tracker.status());
   }
   egl_options.width = first_frame->width;
   egl_options.height = first_frame->height;
@@ -244,10 +343,11 @@ int RunView(int argc, char** argv, int first) {
   style.point_size_px = static_cast<float>(*point_size);
   std::fprintf(stderr, "reconar view: %s; %s %s; model %s (%d vertices, %lld triangles)\n",
                (*source)->Describe().c_str(), EglContextKindName((*context)->kind()), (*context)->renderer().c_str(),
-               args.Get("model").c_str(), drawable->vertex_count(), static_cast<long long>(drawable->triangle_count()));
+               model_path.c_str(), drawable->vertex_count(), static_cast<long long>(drawable->triangle_count()));
 
   const CameraIntrinsics& intrinsics = tracker_options->intrinsics;
   TagTrackerFrameReport report;
+  TagDetectionList layout_detections(tracker_options->max_tags);
   Image<uint8_t> rgb;
   Latency latency;
   long frames = 0;
@@ -268,7 +368,24 @@ int RunView(int argc, char** argv, int first) {
     const auto render_start = std::chrono::steady_clock::now();
     Status drawn = (*renderer)->BeginFrame();
     if (drawn.ok()) drawn = (*renderer)->DrawBackground(frame->rgb, 3);
-    const TrackedTag* tag = ChooseTag(report, *tag_id);
+    if (scene && drawn.ok()) {
+      // The model is in the world frame: its pose from every project tag in view at once.
+      layout_detections.Clear();
+      for (const TrackedTag& t : report.tags) {
+        if (t.measured) layout_detections.Add(t.detection);
+      }
+      if (auto board = EstimateBoardPose(scene->layout, layout_detections, intrinsics); board.ok()) {
+        drawn = (*renderer)->DrawMesh(*drawable, intrinsics, board->cam_from_layout.Matrix(), style);
+        for (const LayoutTag& t : scene->layout.tags()) {
+          if (!drawn.ok() || args.Has("no-axes")) break;
+          const bool seen = std::any_of(layout_detections.begin(), layout_detections.end(),
+                                        [&](const TagDetection& d) { return d.id == t.id; });
+          if (seen) drawn = (*renderer)->DrawTagAxes(intrinsics, board->cam_from_layout * t.layout_from_tag, t.size);
+        }
+        ++frames_with_model;
+      }
+    }
+    const TrackedTag* tag = scene ? nullptr : ChooseTag(report, *tag_id);
     if (tag != nullptr && drawn.ok()) {
       const Rigid3& cam_from_tag = args.Has("smooth") ? tag->smoothed_cam_from_tag : tag->cam_from_tag;
       drawn = (*renderer)->DrawMesh(*drawable, intrinsics, CamFromModel(cam_from_tag, *placement), style);

@@ -32,6 +32,8 @@ class Project {
   std::string ReportPath() const { return root_ + "/report.json"; }
   std::string TagDetectionsPath() const { return root_ + "/tags/detections.txt"; }  // core/sfm/tag_observations.h
   std::string TagsJsonPath() const { return root_ + "/tags.json"; }  // core/sfm/tag_registration.h
+  // The registered tags as a tracker/tag_layout.h layout (world_from_tag per id), for `track --layout`.
+  std::string TagLayoutPath() const { return root_ + "/tags.layout"; }
   std::string DensePointsPath() const { return root_ + "/dense/points.ply"; }
   std::string MeshDir() const { return root_ + "/mesh"; }
 

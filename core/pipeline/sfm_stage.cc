@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <memory>
 
@@ -172,8 +173,13 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   RECONAR_RETURN_IF_ERROR(WriteBundlerModel(*reconstruction, sparse + "/bundle.out", sparse + "/list.txt", paths));
   RECONAR_RETURN_IF_ERROR(WritePointsPly(*reconstruction, sparse + "/points.ply"));
   if (report.tags_used) {
-    RECONAR_RETURN_IF_ERROR(WriteFileAtomically(
-        project.TagsJsonPath(), TagRegistrationJson(report.tags, tag_family, options.tags.registration.tag_size_m)));
+    const double size = options.tags.registration.tag_size_m;
+    if (report.tags.metric) {
+      RECONAR_RETURN_IF_ERROR(WriteFileAtomically(project.TagLayoutPath(), TagLayoutText(report.tags, size)));
+    } else {
+      std::filesystem::remove(project.TagLayoutPath());
+    }
+    RECONAR_RETURN_IF_ERROR(WriteFileAtomically(project.TagsJsonPath(), TagRegistrationJson(report.tags, tag_family, size)));
   }
   // points3D.txt last: its presence marks a finished model (see the sfm command's reuse check).
   RECONAR_RETURN_IF_ERROR(WriteColmapTextModel(*reconstruction, sparse));

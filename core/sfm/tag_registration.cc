@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -344,6 +345,19 @@ std::string TagRegistrationJson(const TagRegistrationReport& report, const std::
   json.EndArray();
   json.EndObject();
   return json.str() + "\n";
+}
+
+std::string TagLayoutText(const TagRegistrationReport& report, double tag_size_m) {
+  std::string text = "# reconar tag layout: id size x y z qw qx qy qz (world_from_tag, metres)\n";
+  char line[320];
+  for (const RegisteredTag& tag : report.tags) {
+    const Eigen::Quaterniond q(tag.world_from_tag.rotation);
+    const Eigen::Vector3d& t = tag.world_from_tag.translation;
+    std::snprintf(line, sizeof(line), "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", tag.id, tag_size_m, t.x(), t.y(),
+                  t.z(), q.w(), q.x(), q.y(), q.z());
+    text += line;
+  }
+  return text;
 }
 
 }  // namespace reconar
