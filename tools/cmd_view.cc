@@ -160,17 +160,7 @@ Result<ProjectScene> LoadProjectScene(const std::string& dir) {
   scene.tracker.family = family->string();
   RECONAR_ASSIGN_OR_RETURN(scene.layout, ReadTagLayout(project.TagLayoutPath()));
   if (auto model = ReadColmapTextModel(project.SparseDir()); model.ok() && !model->cameras.empty()) {
-    const SfmCamera& camera = model->cameras.front();
-    CameraIntrinsics intrinsics;
-    intrinsics.width = camera.width;
-    intrinsics.height = camera.height;
-    intrinsics.fx = camera.focal;
-    intrinsics.fy = camera.aspect * camera.focal;
-    intrinsics.cx = camera.cx;
-    intrinsics.cy = camera.cy;
-    intrinsics.k1 = camera.k1;
-    intrinsics.k2 = camera.k2;
-    scene.tracker.intrinsics = intrinsics;
+    scene.tracker.intrinsics = model->cameras.front().Intrinsics();
   }
   return scene;
 }

@@ -1,5 +1,9 @@
 #include "core/base/memory_usage.h"
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 #include <cstdio>
 #include <cstring>
 
@@ -34,6 +38,12 @@ bool ResetPeakResidentBytes() {
   const bool written = std::fputs("5", file) >= 0;
   const bool closed = std::fclose(file) == 0;  // the write reaches the kernel at close
   return written && closed;
+}
+
+void ReleaseFreeHeapMemory() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
 }
 
 }  // namespace reconar

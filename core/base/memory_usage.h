@@ -22,4 +22,9 @@ size_t PeakResidentBytes();
 // True when the kernel accepted the reset.
 bool ResetPeakResidentBytes();
 
+// Gives the heap's free pages back to the kernel (glibc malloc_trim), so that RSS shows what is in
+// use: a long run's earlier stages leave freed memory resident, which would hide what the next one
+// allocates. No-op elsewhere.
+void ReleaseFreeHeapMemory();
+
 }  // namespace reconar

@@ -81,6 +81,7 @@ Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOpti
     pilot.depth = std::max(kMinDepth, report.depth - 2);
     pilot.trim = 0.0;
     pilot.show_progress = false;
+    ReleaseFreeHeapMemory();
     const size_t baseline = CurrentMemoryUsage().resident_bytes;
     ResetPeakResidentBytes();
     RECONAR_RETURN_IF_ERROR(ReconstructPoissonSurface(*points, pilot, nullptr).status());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -84,6 +85,7 @@ class StageRunner {
     }
     redone_ = true;
     if (options_.show_progress) std::fprintf(stderr, "reconstruct: [%d] %s\n", index_, name.c_str());
+    ReleaseFreeHeapMemory();
     ResetPeakResidentBytes();
     const auto start = Clock::now();
     RECONAR_RETURN_IF_ERROR(body(&summary).WithContext(name));
@@ -231,7 +233,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     const bool with_tags = options.tag_size_m > 0.0;
     if (with_tags) {
       if (Status s = runner.Run(
-          "tags", options.tag_family, Exists(project.TagDetectionsPath()), false, [&](StageSummary* summary) -> Status {
+          "tags", options.tag_family, Exists(project.TagDetectionsPath()), runner.redone(),
+          [&](StageSummary* summary) -> Status {
             RECONAR_ASSIGN_OR_RETURN(const TagDetectionsFile detections, options.detect_tags(image_paths));
             int with = 0;
             for (const ImageTagObservations& image : detections.images) with += image.tags.empty() ? 0 : 1;
@@ -260,7 +263,10 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
         Exists(project.SparseDir() + "/report.json"), runner.redone(), [&](StageSummary* summary) -> Status {
           RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
           if (with_tags && !r.tags.metric) summary->note = "no metric registration: " + r.tags.reason;
-          if (!with_tags) std::filesystem::remove(project.TagsJsonPath());
+          if (!with_tags) {
+            std::filesystem::remove(project.TagsJsonPath());
+            std::filesystem::remove(project.TagLayoutPath());
+          }
           JsonWriter json(2);
           json.BeginObject();
           WriteSfmReportFields(r, &json);
@@ -304,11 +310,11 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     mesh.poisson.num_threads = threads;
     mesh.poisson.show_progress = options.show_progress;
     std::string formats;
-    for (const std::string& f : mesh.formats) formats += f;
+    for (const std::string& f : mesh.formats) formats += (formats.empty() ? "" : ",") + f;
     if (Status s = runner.Run(
         "mesh",
         Settings({{"version", 2}, {"depth", mesh.poisson.depth}, {"trim", mesh.poisson.trim}, {"point_weight", mesh.poisson.point_weight},
-                  {"budget_mib", Mib(budget)}, {"formats", static_cast<double>(std::hash<std::string>()(formats) % 1000000)}}),
+                  {"budget_mib", Mib(budget)}}) + " formats=" + formats,
         Exists(project.MeshDir() + "/report.json"), runner.redone(), [&](StageSummary* summary) -> Status {
           RECONAR_ASSIGN_OR_RETURN(const MeshStageReport r, RunMeshStage(project, mesh));
           summary->peak_rss_bytes = std::max(r.peak_rss_bytes, r.pilot_peak_bytes);

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "core/math/camera_intrinsics.h"
+
 namespace reconar {
 
 struct SfmCamera {
@@ -35,6 +37,20 @@ struct SfmCamera {
     const double r2 = p.squaredNorm();
     const double d = 1.0 + r2 * (k1 + k2 * r2);
     return Eigen::Vector2d(focal * d * p.x() + cx, aspect * focal * d * p.y() + cy);
+  }
+
+  // The same camera as the tracker and renderer take it (the models agree: fy = aspect * focal).
+  CameraIntrinsics Intrinsics() const {
+    CameraIntrinsics intrinsics;
+    intrinsics.width = width;
+    intrinsics.height = height;
+    intrinsics.fx = focal;
+    intrinsics.fy = aspect * focal;
+    intrinsics.cx = cx;
+    intrinsics.cy = cy;
+    intrinsics.k1 = k1;
+    intrinsics.k2 = k2;
+    return intrinsics;
   }
 };
 

@@ -98,17 +98,6 @@ void ToGl(const Eigen::Matrix4d& m, float out[16]) {
   std::copy(f.data(), f.data() + 16, out);  // column major, as GL wants
 }
 
-CameraIntrinsics IntrinsicsOf(const SfmCamera& camera) {
-  CameraIntrinsics intrinsics;
-  intrinsics.width = camera.width;
-  intrinsics.height = camera.height;
-  intrinsics.fx = camera.focal;
-  intrinsics.fy = camera.aspect * camera.focal;
-  intrinsics.cx = camera.cx;
-  intrinsics.cy = camera.cy;
-  return intrinsics;
-}
-
 Eigen::Matrix4d CamFromWorld(const SfmPose& pose) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
   m.topLeftCorner<3, 3>() = pose.cam_from_world_rotation;
@@ -206,7 +195,7 @@ struct BunnyRenderer::Gl {
   Image<uint8_t> readback;
 
   Status Draw(const SfmCamera& camera, const SfmPose& pose, OffscreenTarget* target, int mode_value) {
-    const CameraIntrinsics intrinsics = IntrinsicsForTarget(IntrinsicsOf(camera), target->width(), target->height());
+    const CameraIntrinsics intrinsics = IntrinsicsForTarget(camera.Intrinsics(), target->width(), target->height());
     DepthRange depth;
     depth.near_m = 0.02;
     depth.far_m = kDepthEncodingRangeM;
