@@ -1,5 +1,6 @@
 // `reconar reconstruct`: photos in, a metric 3D model out (core/pipeline/reconstruct.h).
 #include <cstdio>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -43,6 +44,7 @@ constexpr char kHelp[] =
     "  --trim T              Poisson density trim (default 7)\n"
     "  --formats LIST        mesh formats among ply,obj,glb,wrl (default all four)\n"
     "  --no-preview          do not render preview.png\n"
+    "  --contrast-threshold T, --max-features N, --first-octave O, --sift-memory-mib M   as `reconar features`\n"
     "  --force               redo every stage\n"
     "  --json                print report.json on stdout\n";
 
@@ -102,9 +104,10 @@ Status WritePreview(const Project& project, const std::string& model_path, const
 }  // namespace
 
 int RunReconstruct(int argc, char** argv, int first) {
-  Args args({"tag-size", "tag-family", "world-tag", "memory-budget", "threads", "stages", "level", "depth", "trim",
-             "formats"},
-            {"no-tags-in-ba", "no-preview", "force", "json"});
+  std::set<std::string> valued = kSiftValuedOptions;
+  valued.insert({"tag-size", "tag-family", "world-tag", "memory-budget", "threads", "stages", "level", "depth", "trim",
+                 "formats"});
+  Args args(valued, {"no-tags-in-ba", "no-preview", "force", "json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
     std::fputs(kHelp, stdout);
@@ -119,6 +122,9 @@ int RunReconstruct(int argc, char** argv, int first) {
   inputs.pop_back();
 
   ReconstructOptions options;
+  auto sift = SiftOptionsFromArgs(args);
+  if (!sift.ok()) return Fail(sift.status());
+  options.features.sift = *sift;
   auto tag_size = args.GetDouble("tag-size", 0.0, 0.0, 100.0);
   auto world_tag = args.GetInt("world-tag", -1, -1, 1 << 20);
   auto threads = args.GetInt("threads", 0, 0, 1024);
