@@ -20,7 +20,8 @@ std::vector<std::pair<double, double>> PreviewOptions::Ring(int views, double el
 }
 
 Status PreviewOptions::Check() const {
-  if (width < 16 || height < 16 || width > 4096 || height > 4096) return InvalidArgument("preview: views must be 16..4096 pixels a side");
+  if (width < 16 || height < 16 || width > 4096 || height > 4096)
+    return InvalidArgument("preview: views must be 16..4096 pixels a side");
   if (directions.empty()) return InvalidArgument("preview: no view direction");
   if (!(up.norm() > 0.0) || !up.allFinite()) return InvalidArgument("preview: the up direction must be non-zero");
   if (!(point_size_px > 0.0f)) return InvalidArgument("preview: the point size must be positive");
@@ -94,7 +95,8 @@ Image<uint8_t> TileImages(const std::vector<Image<uint8_t>>& views, int columns)
   for (size_t i = 0; i < views.size(); ++i) {
     const int x0 = static_cast<int>(i % static_cast<size_t>(columns)) * width;
     const int y0 = static_cast<int>(i / static_cast<size_t>(columns)) * height;
-    for (int y = 0; y < height; ++y) std::memcpy(tiled.row(y0 + y) + 3 * x0, views[i].row(y), 3 * static_cast<size_t>(width));
+    for (int y = 0; y < height; ++y)
+      std::memcpy(tiled.row(y0 + y) + 3 * x0, views[i].row(y), 3 * static_cast<size_t>(width));
   }
   return tiled;
 }

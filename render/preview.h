@@ -17,7 +17,7 @@
 namespace reconar {
 
 struct PreviewOptions {
-  int width = 640;   // per view
+  int width = 640;  // per view
   int height = 480;
   Eigen::Vector3d up = -Eigen::Vector3d::UnitY();  // model up (SfM frames: the first camera's -y)
   // (azimuth, elevation) of each view in radians, azimuth about `up`; elevation from the horizon.

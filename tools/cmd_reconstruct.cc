@@ -58,7 +58,8 @@ Result<size_t> ParseSize(const std::string& text) {
   } else if (!(unit.empty() || unit == "M" || unit == "m" || unit == "MiB" || unit == "MB")) {
     return InvalidArgument("--memory-budget: '" + text + "' is not a size (MiB, or a number with M or G)");
   }
-  if (!(mib >= 64.0) || mib > 1e7) return InvalidArgument("--memory-budget must be at least 64 MiB, got '" + text + "'");
+  if (!(mib >= 64.0) || mib > 1e7)
+    return InvalidArgument("--memory-budget must be at least 64 MiB, got '" + text + "'");
   return static_cast<size_t>(mib * (1 << 20));
 }
 
@@ -209,8 +210,7 @@ int RunReconstruct(int argc, char** argv, int first) {
                 stage.note.c_str());
   }
   std::printf("scale: %s\n", report->metric ? "metres (tags.json)" : report->scale_note.c_str());
-  std::printf("written to %s (report.json%s)\n", project.root().c_str(),
-              args.Has("no-preview") ? "" : ", preview.png");
+  std::printf("written to %s (report.json%s)\n", project.root().c_str(), args.Has("no-preview") ? "" : ", preview.png");
   return 0;
 }
 

@@ -90,7 +90,8 @@ Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOpti
     int depth = report.depth;
     for (; depth >= kMinDepth; --depth) {
       const double growth = depth >= pilot.depth ? static_cast<double>(1ull << (2 * (depth - pilot.depth))) : 1.0;
-      report.estimated_peak_bytes = baseline + static_cast<size_t>(growth * static_cast<double>(report.pilot_peak_bytes));
+      report.estimated_peak_bytes =
+          baseline + static_cast<size_t>(growth * static_cast<double>(report.pilot_peak_bytes));
       if (report.estimated_peak_bytes <= options.memory_budget_bytes) break;
     }
     if (depth < kMinDepth) {

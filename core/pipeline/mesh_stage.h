@@ -20,8 +20,8 @@
 namespace reconar {
 
 struct MeshStageOptions {
-  PoissonOptions poisson;                 // depth is the finest allowed
-  size_t memory_budget_bytes = 0;         // 0: no limit, no pilot
+  PoissonOptions poisson;                                           // depth is the finest allowed
+  size_t memory_budget_bytes = 0;                                   // 0: no limit, no pilot
   std::vector<std::string> formats = {"ply", "obj", "glb", "wrl"};  // mesh/mesh.<format>
 
   Status Check() const;
@@ -29,9 +29,9 @@ struct MeshStageOptions {
 
 struct MeshStageReport {
   int requested_depth = 0;
-  double median_spacing = 0.0;      // of the points (mean distance to 8 nearest, median over a sample)
-  int spacing_depth = 0;            // the depth whose cell matches that spacing
-  int depth = 0;                    // used
+  double median_spacing = 0.0;  // of the points (mean distance to 8 nearest, median over a sample)
+  int spacing_depth = 0;        // the depth whose cell matches that spacing
+  int depth = 0;                // used
   bool depth_lowered_for_budget = false;
   size_t pilot_peak_bytes = 0;      // above the baseline, at the pilot depth
   size_t estimated_peak_bytes = 0;  // for the depth used
@@ -39,7 +39,7 @@ struct MeshStageReport {
   PoissonReport poisson;
   double seconds = 0.0;
   size_t peak_rss_bytes = 0;
-  std::vector<std::string> paths;   // written meshes
+  std::vector<std::string> paths;  // written meshes
   std::string report_path;
 };
 

@@ -79,7 +79,8 @@ class StageRunner {
       if (const auto it = previous_.find(name); it != previous_.end()) summary = it->second;
       summary.name = name;
       summary.reused = true;
-      if (options_.show_progress) std::fprintf(stderr, "reconstruct: [%d] %s: finished earlier, reused\n", index_, name.c_str());
+      if (options_.show_progress)
+        std::fprintf(stderr, "reconstruct: [%d] %s: finished earlier, reused\n", index_, name.c_str());
       report_->stages.push_back(summary);
       return Status::Ok();
     }
@@ -113,7 +114,6 @@ std::string ReadOr(const std::string& path, const std::string& fallback) {
   auto text = ReadFileToString(path);
   return text.ok() ? *text : fallback;
 }
-
 
 std::string ReportJson(const Project& project, const ReconstructOptions& options, const ReconstructReport& report) {
   const std::string sparse_text = ReadOr(project.SparseDir() + "/report.json", "null");
@@ -202,50 +202,41 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     }
     features.show_progress = options.show_progress;
     const SiftOptions& sift = features.sift;
-    if (Status s = runner.Run(
-        "features",
-        Settings({{"first_octave", sift.first_octave}, {"max_features", sift.max_features},
-                  {"contrast_threshold", sift.contrast_threshold}, {"arena_mib", Mib(sift.arena_bytes)}}),
-        FeaturesUpToDate(project, image_paths), false, [&](StageSummary* summary) -> Status {
-          summary->note = feature_note;
-          RECONAR_ASSIGN_OR_RETURN(const FeatureStageReport r, RunFeatureStage(image_paths, &project, features));
-          for (const std::string& skipped : r.skipped) std::fprintf(stderr, "warning: skipped %s\n", skipped.c_str());
-          return Status::Ok();
-        });
-        !s.ok()) {
-      return s;
-    }
+    const auto run_features = [&](StageSummary* summary) -> Status {
+      summary->note = feature_note;
+      RECONAR_ASSIGN_OR_RETURN(const FeatureStageReport r, RunFeatureStage(image_paths, &project, features));
+      for (const std::string& skipped : r.skipped) std::fprintf(stderr, "warning: skipped %s\n", skipped.c_str());
+      return Status::Ok();
+    };
+    RECONAR_RETURN_IF_ERROR(runner.Run("features",
+                                       Settings({{"first_octave", sift.first_octave},
+                                                 {"max_features", sift.max_features},
+                                                 {"contrast_threshold", sift.contrast_threshold},
+                                                 {"arena_mib", Mib(sift.arena_bytes)}}),
+                                       FeaturesUpToDate(project, image_paths), false, run_features));
 
     MatchStageOptions matching = options.matching;
     matching.num_threads = threads;
-    if (Status s = runner.Run(
-        "matching",
-        Settings({{"ratio", matching.match.max_ratio}, {"checks", matching.match.max_leaf_checks},
-                  {"min_inliers", matching.two_view.min_inliers},
-                  {"f_threshold", matching.two_view.f_threshold_fraction}}),
-        Exists(project.MatchesPath()), runner.redone(), [&](StageSummary*) -> Status {
-          return RunMatchStage(project, matching).status();
-        });
-        !s.ok()) {
-      return s;
-    }
+    const auto run_matching = [&](StageSummary*) -> Status { return RunMatchStage(project, matching).status(); };
+    RECONAR_RETURN_IF_ERROR(runner.Run("matching",
+                                       Settings({{"ratio", matching.match.max_ratio},
+                                                 {"checks", matching.match.max_leaf_checks},
+                                                 {"min_inliers", matching.two_view.min_inliers},
+                                                 {"f_threshold", matching.two_view.f_threshold_fraction}}),
+                                       Exists(project.MatchesPath()), runner.redone(), run_matching));
 
     const bool with_tags = options.tag_size_m > 0.0;
     if (with_tags) {
-      if (Status s = runner.Run(
-          "tags", options.tag_family, Exists(project.TagDetectionsPath()), runner.redone(),
-          [&](StageSummary* summary) -> Status {
-            RECONAR_ASSIGN_OR_RETURN(const TagDetectionsFile detections, options.detect_tags(image_paths));
-            int with = 0;
-            for (const ImageTagObservations& image : detections.images) with += image.tags.empty() ? 0 : 1;
-            summary->note = std::to_string(with) + " of " + std::to_string(detections.images.size()) +
-                            " photos show a tag";
-            RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root() + "/tags"));
-            return WriteTagDetections(project.TagDetectionsPath(), detections);
-          });
-        !s.ok()) {
-      return s;
-    }
+      const auto run_tags = [&](StageSummary* summary) -> Status {
+        RECONAR_ASSIGN_OR_RETURN(const TagDetectionsFile detections, options.detect_tags(image_paths));
+        int with = 0;
+        for (const ImageTagObservations& image : detections.images) with += image.tags.empty() ? 0 : 1;
+        summary->note = std::to_string(with) + " of " + std::to_string(detections.images.size()) + " photos show a tag";
+        RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root() + "/tags"));
+        return WriteTagDetections(project.TagDetectionsPath(), detections);
+      };
+      RECONAR_RETURN_IF_ERROR(
+          runner.Run("tags", options.tag_family, Exists(project.TagDetectionsPath()), runner.redone(), run_tags));
     }
 
     SfmStageOptions sfm = options.sfm;
@@ -254,28 +245,27 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     sfm.tags.enabled = with_tags;
     sfm.tags.registration.tag_size_m = with_tags ? options.tag_size_m : 1.0;
     const MapperOptions& mapper = sfm.mapper;
-    if (Status s = runner.Run(
-        "mapping",
-        Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
-                  {"max_error", mapper.max_reprojection_error_px},
-                  {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0}, {"tag_size", options.tag_size_m},
-                  {"world_tag", sfm.tags.registration.world_tag}, {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}}),
-        Exists(project.SparseDir() + "/report.json"), runner.redone(), [&](StageSummary* summary) -> Status {
-          RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
-          if (with_tags && !r.tags.metric) summary->note = "no metric registration: " + r.tags.reason;
-          if (!with_tags) {
-            std::filesystem::remove(project.TagsJsonPath());
-            std::filesystem::remove(project.TagLayoutPath());
-          }
-          JsonWriter json(2);
-          json.BeginObject();
-          WriteSfmReportFields(r, &json);
-          json.EndObject();
-          return WriteFileAtomically(project.SparseDir() + "/report.json", json.str() + "\n");
-        });
-        !s.ok()) {
-      return s;
-    }
+    const auto run_mapping = [&](StageSummary* summary) -> Status {
+      RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
+      if (with_tags && !r.tags.metric) summary->note = "no metric registration: " + r.tags.reason;
+      if (!with_tags) {
+        std::filesystem::remove(project.TagsJsonPath());
+        std::filesystem::remove(project.TagLayoutPath());
+      }
+      JsonWriter json(2);
+      json.BeginObject();
+      WriteSfmReportFields(r, &json);
+      json.EndObject();
+      return WriteFileAtomically(project.SparseDir() + "/report.json", json.str() + "\n");
+    };
+    RECONAR_RETURN_IF_ERROR(runner.Run("mapping",
+                                       Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
+                                                 {"max_error", mapper.max_reprojection_error_px},
+                                                 {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
+                                                 {"tag_size", options.tag_size_m},
+                                                 {"world_tag", sfm.tags.registration.world_tag},
+                                                 {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}}),
+                                       Exists(project.SparseDir() + "/report.json"), runner.redone(), run_mapping));
   }
 
   if (options.run_dense) {
@@ -283,25 +273,25 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     dense.memory_budget_bytes = budget;
     dense.num_threads = threads;
     dense.show_progress = options.show_progress;
-    if (Status s = runner.Run(
-        "dense",
-        Settings({{"level", dense.level}, {"max_cluster_size", dense.clustering.max_cluster_size},
-                  {"budget_mib", Mib(budget)}, {"remove_outliers", dense.remove_outliers ? 1.0 : 0.0}}),
-        Exists(project.root() + "/dense/report.json"), runner.redone(), [&](StageSummary* summary) -> Status {
-          RECONAR_ASSIGN_OR_RETURN(const DenseStageReport r, RunDenseStage(project, dense));
-          for (const DensePhase* phase : {&r.load, &r.clustering, &r.undistort, &r.mvs, &r.merge, &r.outlier_filter, &r.write}) {
-            summary->peak_rss_bytes = std::max(summary->peak_rss_bytes, phase->peak_rss_bytes);
-          }
-          if (r.level_auto && r.level > 0) summary->note = "level " + std::to_string(r.level) + " for the memory budget";
-          if (r.cluster_size_reduced) {
-            summary->note += std::string(summary->note.empty() ? "" : "; ") + "clusters of at most " +
-                             std::to_string(r.max_cluster_size) + " images for the memory budget";
-          }
-          return Status::Ok();
-        });
-        !s.ok()) {
-      return s;
-    }
+    const auto run_dense = [&](StageSummary* summary) -> Status {
+      RECONAR_ASSIGN_OR_RETURN(const DenseStageReport r, RunDenseStage(project, dense));
+      for (const DensePhase* phase :
+           {&r.load, &r.clustering, &r.undistort, &r.mvs, &r.merge, &r.outlier_filter, &r.write}) {
+        summary->peak_rss_bytes = std::max(summary->peak_rss_bytes, phase->peak_rss_bytes);
+      }
+      if (r.level_auto && r.level > 0) summary->note = "level " + std::to_string(r.level) + " for the memory budget";
+      if (r.cluster_size_reduced) {
+        summary->note += std::string(summary->note.empty() ? "" : "; ") + "clusters of at most " +
+                         std::to_string(r.max_cluster_size) + " images for the memory budget";
+      }
+      return Status::Ok();
+    };
+    RECONAR_RETURN_IF_ERROR(runner.Run("dense",
+                                       Settings({{"level", dense.level},
+                                                 {"max_cluster_size", dense.clustering.max_cluster_size},
+                                                 {"budget_mib", Mib(budget)},
+                                                 {"remove_outliers", dense.remove_outliers ? 1.0 : 0.0}}),
+                                       Exists(project.root() + "/dense/report.json"), runner.redone(), run_dense));
   }
 
   if (options.run_mesh) {
@@ -311,19 +301,22 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     mesh.poisson.show_progress = options.show_progress;
     std::string formats;
     for (const std::string& f : mesh.formats) formats += (formats.empty() ? "" : ",") + f;
-    if (Status s = runner.Run(
-        "mesh",
-        Settings({{"version", 2}, {"depth", mesh.poisson.depth}, {"trim", mesh.poisson.trim}, {"point_weight", mesh.poisson.point_weight},
-                  {"budget_mib", Mib(budget)}}) + " formats=" + formats,
-        Exists(project.MeshDir() + "/report.json"), runner.redone(), [&](StageSummary* summary) -> Status {
-          RECONAR_ASSIGN_OR_RETURN(const MeshStageReport r, RunMeshStage(project, mesh));
-          summary->peak_rss_bytes = std::max(r.peak_rss_bytes, r.pilot_peak_bytes);
-          if (r.depth_lowered_for_budget) summary->note = "Poisson depth " + std::to_string(r.depth) + " for the memory budget";
-          return Status::Ok();
-        });
-        !s.ok()) {
-      return s;
-    }
+    const auto run_mesh = [&](StageSummary* summary) -> Status {
+      RECONAR_ASSIGN_OR_RETURN(const MeshStageReport r, RunMeshStage(project, mesh));
+      summary->peak_rss_bytes = std::max(r.peak_rss_bytes, r.pilot_peak_bytes);
+      if (r.depth_lowered_for_budget) {
+        summary->note = "Poisson depth " + std::to_string(r.depth) + " for the memory budget";
+      }
+      return Status::Ok();
+    };
+    RECONAR_RETURN_IF_ERROR(runner.Run("mesh",
+                                       Settings({{"version", 2},
+                                                 {"depth", mesh.poisson.depth},
+                                                 {"trim", mesh.poisson.trim},
+                                                 {"point_weight", mesh.poisson.point_weight},
+                                                 {"budget_mib", Mib(budget)}}) +
+                                           " formats=" + formats,
+                                       Exists(project.MeshDir() + "/report.json"), runner.redone(), run_mesh));
   }
 
   // Scale: what tags.json says.
@@ -331,7 +324,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     const JsonValue* metric = tags->Find("metric");
     report.metric = metric != nullptr && metric->is_bool() && metric->bool_value();
     const JsonValue* reason = tags->Find("reason");
-    if (!report.metric) report.scale_note = reason != nullptr && reason->is_string() ? reason->string() : "no tag registered";
+    if (!report.metric)
+      report.scale_note = reason != nullptr && reason->is_string() ? reason->string() : "no tag registered";
   } else {
     report.scale_note = "arbitrary (no --tag-size given)";
   }

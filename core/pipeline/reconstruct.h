@@ -40,15 +40,15 @@ struct ReconstructOptions {
   bool run_sparse = true, run_dense = true, run_mesh = true;  // --stages; a stage needs the ones before
   FeatureStageOptions features;
   MatchStageOptions matching;
-  SfmStageOptions sfm;             // sfm.tags.enabled follows tag_size_m > 0
+  SfmStageOptions sfm;  // sfm.tags.enabled follows tag_size_m > 0
   DenseStageOptions dense;
   MeshStageOptions mesh;
-  double tag_size_m = 0.0;         // 0: no tags, the model keeps an arbitrary scale
+  double tag_size_m = 0.0;  // 0: no tags, the model keeps an arbitrary scale
   std::string tag_family = "tag36h11";
   TagDetectorFunction detect_tags;  // required when tag_size_m > 0
   size_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
-  int num_threads = 0;             // 0: one per core
-  bool force = false;              // redo every stage
+  int num_threads = 0;  // 0: one per core
+  bool force = false;   // redo every stage
   bool show_progress = true;
 
   Status Check() const;
@@ -65,8 +65,8 @@ struct StageSummary {
 struct ReconstructReport {
   std::vector<StageSummary> stages;
   std::string report_path;
-  bool metric = false;             // tags.json says the model is in metres
-  std::string scale_note;          // why not, when not
+  bool metric = false;     // tags.json says the model is in metres
+  std::string scale_note;  // why not, when not
 };
 
 // image_paths as CollectImagePaths gives them. Errors name the stage and the file.

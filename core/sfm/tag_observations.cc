@@ -57,7 +57,8 @@ Result<TagDetectionsFile> ReadTagDetections(const std::string& path) {
         TagObservation tag;
         tag_fields >> tag.tag_id;
         for (Eigen::Vector2d& c : tag.corners) tag_fields >> c.x() >> c.y();
-        if (!tag_fields || tag.tag_id < 0 || !(tag_fields >> std::ws).eof()) return corrupt("expected 'ID x0 y0 ... x3 y3'");
+        if (!tag_fields || tag.tag_id < 0 || !(tag_fields >> std::ws).eof())
+          return corrupt("expected 'ID x0 y0 ... x3 y3'");
         image.tags.push_back(tag);
       }
       file.images.push_back(std::move(image));

@@ -2,8 +2,8 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
@@ -119,8 +119,8 @@ void ApplyToModel(const Sim3& world_from_model, Reconstruction* rec) {
     // X_cam' = s X_cam = s R_c X_model + s t_c with X_model = R^T (X_world - t) / s.
     SfmPose& pose = image.pose;
     pose.cam_from_world_rotation = pose.cam_from_world_rotation * model_from_world_rotation;
-    pose.cam_from_world_translation =
-        world_from_model.scale * pose.cam_from_world_translation - pose.cam_from_world_rotation * world_from_model.translation;
+    pose.cam_from_world_translation = world_from_model.scale * pose.cam_from_world_translation -
+                                      pose.cam_from_world_rotation * world_from_model.translation;
   }
 }
 
@@ -184,9 +184,11 @@ std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vect
 }
 
 Status TagRegistrationOptions::Check() const {
-  if (!(tag_size_m > 0.0) || !std::isfinite(tag_size_m)) return InvalidArgument("tag registration: the tag size must be positive");
+  if (!(tag_size_m > 0.0) || !std::isfinite(tag_size_m))
+    return InvalidArgument("tag registration: the tag size must be positive");
   if (min_views < 2) return InvalidArgument("tag registration: min_views must be >= 2");
-  if (!(max_reprojection_error_px > 0.0)) return InvalidArgument("tag registration: max_reprojection_error_px must be > 0");
+  if (!(max_reprojection_error_px > 0.0))
+    return InvalidArgument("tag registration: max_reprojection_error_px must be > 0");
   return Status::Ok();
 }
 
@@ -203,7 +205,8 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
     for (const TagObservation& tag : observations[i]) ++count[tag.tag_id];
     for (const TagObservation& tag : observations[i]) {
       if (count[tag.tag_id] != 1) continue;
-      for (int k = 0; k < 4; ++k) seen[tag.tag_id][static_cast<size_t>(k)].emplace_back(static_cast<int>(i), tag.corners[static_cast<size_t>(k)]);
+      for (int k = 0; k < 4; ++k)
+        seen[tag.tag_id][static_cast<size_t>(k)].emplace_back(static_cast<int>(i), tag.corners[static_cast<size_t>(k)]);
     }
   }
   std::map<std::pair<int, int>, std::map<int, int>> track_votes;  // (tag, corner) -> point id -> observations
@@ -234,7 +237,8 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
         tag.corners[static_cast<size_t>(k)] = rec->points[static_cast<size_t>(best->first)].position;
       } else {
         tag.adjusted = false;
-        const std::optional<Eigen::Vector3d> point = TriangulateCorner(*rec, per_corner[static_cast<size_t>(k)], options);
+        const std::optional<Eigen::Vector3d> point =
+            TriangulateCorner(*rec, per_corner[static_cast<size_t>(k)], options);
         ok = point.has_value();
         if (ok) tag.corners[static_cast<size_t>(k)] = *point;
       }
@@ -353,8 +357,8 @@ std::string TagLayoutText(const TagRegistrationReport& report, double tag_size_m
   for (const RegisteredTag& tag : report.tags) {
     const Eigen::Quaterniond q(tag.world_from_tag.rotation);
     const Eigen::Vector3d& t = tag.world_from_tag.translation;
-    std::snprintf(line, sizeof(line), "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", tag.id, tag_size_m, t.x(), t.y(),
-                  t.z(), q.w(), q.x(), q.y(), q.z());
+    std::snprintf(line, sizeof(line), "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", tag.id, tag_size_m, t.x(),
+                  t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
     text += line;
   }
   return text;

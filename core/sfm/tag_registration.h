@@ -49,9 +49,9 @@ std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vect
                                                      std::vector<MapperImage>* images, std::vector<MapperPair>* pairs);
 
 struct TagRegistrationOptions {
-  double tag_size_m = 0.0;    // edge of the black square (libapriltag's width_at_border), > 0
-  int world_tag = -1;         // the tag whose frame becomes the world frame; -1: the lowest complete id
-  int min_views = 2;          // registered views a corner needs to be triangulated
+  double tag_size_m = 0.0;                 // edge of the black square (libapriltag's width_at_border), > 0
+  int world_tag = -1;                      // the tag whose frame becomes the world frame; -1: the lowest complete id
+  int min_views = 2;                       // registered views a corner needs to be triangulated
   double max_reprojection_error_px = 4.0;  // a triangulated corner's observations beyond this are dropped
 
   Status Check() const;
@@ -76,7 +76,7 @@ struct TagRegistrationReport {
   int tags_seen = 0;                 // distinct ids detected in registered images
   double metres_per_model_unit = 0;  // the scale applied
   Sim3 world_from_model;
-  std::vector<RegisteredTag> tags;   // complete tags, by id
+  std::vector<RegisteredTag> tags;                                         // complete tags, by id
   double edge_mean_m = 0.0, edge_std_m = 0.0, edge_max_abs_error_m = 0.0;  // over all edges of all tags
 };
 

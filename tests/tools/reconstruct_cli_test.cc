@@ -67,8 +67,8 @@ TagFigures ReadTagFigures(const std::string& project) {
 TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
   const std::string data = testing::SharedDataPath("apriltag_swatbotics_mapping");
   const std::string project = testing::MakeTestDirectory("reconar_reconstruct_swat") + "/project";
-  const CommandRun run = RunReconar("reconstruct " + data + " " + project +
-                                    " --tag-size 0.127 --stages sparse --threads 2 --no-preview");
+  const CommandRun run =
+      RunReconar("reconstruct " + data + " " + project + " --tag-size 0.127 --stages sparse --threads 2 --no-preview");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   auto report = ReadJsonFile(project + "/report.json");
   ASSERT_TRUE(report.ok()) << report.status().ToString();
@@ -117,17 +117,19 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
   const std::string frames = testing::MakeTestDirectory("reconar_reconstruct_swat_frames");
   const std::vector<std::string> names = {"IMG_1375.JPG", "IMG_1390.JPG", "IMG_1410.JPG"};
   for (const std::string& name : names) fs::create_symlink(data + "/" + name, frames + "/" + name);
-  const CommandRun view = RunReconar("view --project " + project + " --frames " + frames + " --out " + frames + "/out --decimate 1");
+  const CommandRun view =
+      RunReconar("view --project " + project + " --frames " + frames + " --out " + frames + "/out --decimate 1");
   ASSERT_EQ(view.exit_code, 0) << view.output;
   EXPECT_NE(view.output.find("3 frames, model drawn on 3"), std::string::npos) << view.output;
   auto model = ReadColmapTextModel(project + "/sparse");
   ASSERT_TRUE(model.ok());
   const SfmCamera& camera = model->cameras.front();
   char intrinsics[256];
-  std::snprintf(intrinsics, sizeof(intrinsics), "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", camera.focal, camera.aspect * camera.focal,
-                camera.cx, camera.cy, camera.k1, camera.k2);
-  const CommandRun track = RunReconar("track " + frames + " --intrinsics " + intrinsics + " --tag-size 0.127 --decimate 1 --layout " +
-                                      project + "/tags.layout --json", testing::StderrMode::kSeparate);
+  std::snprintf(intrinsics, sizeof(intrinsics), "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", camera.focal,
+                camera.aspect * camera.focal, camera.cx, camera.cy, camera.k1, camera.k2);
+  const CommandRun track = RunReconar("track " + frames + " --intrinsics " + intrinsics +
+                                          " --tag-size 0.127 --decimate 1 --layout " + project + "/tags.layout --json",
+                                      testing::StderrMode::kSeparate);
   ASSERT_EQ(track.exit_code, 0) << track.error;
   std::istringstream lines(track.output);
   int compared = 0;
@@ -140,7 +142,8 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
     const JsonValue* pose = frame->Find("cam_from_layout");
     if (image == nullptr || pose == nullptr) continue;
     Rigid3 cam_from_world;
-    for (int e = 0; e < 9; ++e) cam_from_world.rotation(e / 3, e % 3) = (*pose->Find("R"))[static_cast<size_t>(e)].number();
+    for (int e = 0; e < 9; ++e)
+      cam_from_world.rotation(e / 3, e % 3) = (*pose->Find("R"))[static_cast<size_t>(e)].number();
     for (int e = 0; e < 3; ++e) cam_from_world.translation[e] = (*pose->Find("t"))[static_cast<size_t>(e)].number();
     const double distance = (cam_from_world.Inverse().translation - image->pose.Center()).norm();
     const double degrees = RotationAngle(cam_from_world.rotation, image->pose.cam_from_world_rotation) * 180.0 / M_PI;
@@ -198,7 +201,8 @@ TEST(ReconstructCli, KilledRunsResumeToTheSameFiles) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(reference.exit_code, 0) << reference.output;
   const auto expected = ProjectFiles(dir + "/reference");
-  ASSERT_TRUE(expected.count("mesh/mesh.glb") && expected.count("dense/points.ply") && expected.count("sparse/points3D.txt"));
+  ASSERT_TRUE(expected.count("mesh/mesh.glb") && expected.count("dense/points.ply") &&
+              expected.count("sparse/points3D.txt"));
 
   int interrupted = 0;
   for (const double fraction : {0.2, 0.5, 0.8}) {
@@ -228,9 +232,9 @@ TEST(ReconstructCli, FullDiskEndsWithAClearErrorAndNoHalfFile) {
   const std::string data = std::string(RECONAR_SOURCE_DIR) + "/data/templeSparseRing";
   const std::string project = testing::MakeTestDirectory("reconar_reconstruct_full_disk") + "/project";
   // Files may grow to 2 MB (ulimit -f counts 1024-byte blocks); SIGXFSZ ignored, so writes fail with EFBIG.
-  const CommandRun run = testing::RunCommand("bash -c \"trap '' XFSZ; ulimit -f 2048; exec " +
-                                             std::string(RECONAR_BINARY) + " reconstruct " + data + " " + project +
-                                             " --threads 2 --no-preview\"");
+  const CommandRun run =
+      testing::RunCommand("bash -c \"trap '' XFSZ; ulimit -f 2048; exec " + std::string(RECONAR_BINARY) +
+                          " reconstruct " + data + " " + project + " --threads 2 --no-preview\"");
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(run.output.find("reconar: error:"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find(project), std::string::npos) << "the error names the file: " << run.output;
@@ -247,12 +251,14 @@ TEST(ReconstructCli, FullDiskEndsWithAClearErrorAndNoHalfFile) {
 TEST(ReconstructCli, PhotosWithoutTagsKeepAnArbitraryScaleAndSaySo) {
   const std::string data = std::string(RECONAR_SOURCE_DIR) + "/data/templeSparseRing";
   const std::string project = testing::MakeTestDirectory("reconar_reconstruct_no_tags") + "/project";
-  const CommandRun run = RunReconar("reconstruct " + data + " " + project + " --tag-size 0.1 --stages sparse --no-preview");
+  const CommandRun run =
+      RunReconar("reconstruct " + data + " " + project + " --tag-size 0.1 --stages sparse --no-preview");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   auto report = ReadJsonFile(project + "/report.json");
   ASSERT_TRUE(report.ok());
   EXPECT_FALSE(report->Find("metric")->bool_value());
-  EXPECT_NE(report->Find("scale")->string().find("no tag was detected"), std::string::npos) << report->Find("scale")->string();
+  EXPECT_NE(report->Find("scale")->string().find("no tag was detected"), std::string::npos)
+      << report->Find("scale")->string();
   EXPECT_NE(run.output.find("scale: no tag was detected"), std::string::npos) << run.output;
 
   const CommandRun one = RunReconar("reconstruct " + data + "/templeSR0001.png " + project + "_one");

@@ -114,7 +114,8 @@ std::vector<uint8_t> ClassifyDistinctPoints(const std::vector<Eigen::Vector3f>& 
 }  // namespace
 
 Status OutlierFilterOptions::Check() const {
-  if (neighbors < 1) return InvalidArgument("OutlierFilterOptions.neighbors must be >= 1, got " + std::to_string(neighbors));
+  if (neighbors < 1)
+    return InvalidArgument("OutlierFilterOptions.neighbors must be >= 1, got " + std::to_string(neighbors));
   if (!(max_robust_sigmas > 0.0)) return InvalidArgument("OutlierFilterOptions.max_robust_sigmas must be > 0");
   if (!(min_isolation_ratio >= 1.0)) return InvalidArgument("OutlierFilterOptions.min_isolation_ratio must be >= 1");
   if (!(link_factor > 0.0)) return InvalidArgument("OutlierFilterOptions.link_factor must be > 0");

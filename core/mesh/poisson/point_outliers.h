@@ -36,7 +36,7 @@ struct OutlierFilterReport {
   size_t small_piece_removed = 0;  // second test
   int pieces = 0;                  // components among the points that passed the first test
   int pieces_kept = 0;
-  double median_spacing = 0.0;     // median of d_i, the cloud's units
+  double median_spacing = 0.0;  // median of d_i, the cloud's units
   size_t kept_points() const { return input_points - isolated_removed - small_piece_removed; }
 };
 

@@ -19,7 +19,7 @@ constexpr double kTagSize = 0.16;
 struct Scene {
   std::vector<Rigid3> world_from_tag;  // tag ids 0, 1, 2
   Sim3 model_from_world;
-  Reconstruction model;                // cameras in the model frame
+  Reconstruction model;  // cameras in the model frame
   std::vector<std::vector<TagObservation>> observations;
   std::vector<Eigen::Vector3d> camera_centres_world;
 };
@@ -34,9 +34,11 @@ Scene MakeScene() {
   scene.world_from_tag.push_back(
       Rigid3{Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY()).toRotationMatrix(), Eigen::Vector3d(0.6, 0.05, -0.1)});
   scene.world_from_tag.push_back(
-      Rigid3{Eigen::AngleAxisd(-0.4, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix(), Eigen::Vector3d(-0.5, 0.4, 0.05)});
+      Rigid3{Eigen::AngleAxisd(-0.4, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix(),
+             Eigen::Vector3d(-0.5, 0.4, 0.05)});
   scene.model_from_world.scale = 3.7;
-  scene.model_from_world.rotation = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -1, 0.4).normalized()).toRotationMatrix();
+  scene.model_from_world.rotation =
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -1, 0.4).normalized()).toRotationMatrix();
   scene.model_from_world.translation = Eigen::Vector3d(5, -2, 9);
 
   SfmCamera camera;
@@ -60,7 +62,8 @@ Scene MakeScene() {
     image.camera_id = 0;
     image.registered = true;
     image.pose.cam_from_world_rotation = cam_from_world.rotation * m.rotation.transpose();
-    image.pose.cam_from_world_translation = m.scale * cam_from_world.translation - image.pose.cam_from_world_rotation * m.translation;
+    image.pose.cam_from_world_translation =
+        m.scale * cam_from_world.translation - image.pose.cam_from_world_rotation * m.translation;
     std::vector<TagObservation> seen;
     for (int id = 0; id < 3; ++id) {
       TagObservation tag;
@@ -93,10 +96,13 @@ TEST(TagRegistrationTest, RecoversMetresAndTheWorldTagFrame) {
     EXPECT_FALSE(tag.adjusted);
     EXPECT_LT(tag.rms_reprojection_px, 1e-6);
     for (int k = 0; k < 4; ++k) {
-      EXPECT_LT((tag.corners[static_cast<size_t>(k)] - TagCorner(scene.world_from_tag[static_cast<size_t>(tag.id)], k)).norm(), 1e-7);
+      EXPECT_LT((tag.corners[static_cast<size_t>(k)] - TagCorner(scene.world_from_tag[static_cast<size_t>(tag.id)], k))
+                    .norm(),
+                1e-7);
       EXPECT_NEAR(tag.edges_m[static_cast<size_t>(k)], kTagSize, 1e-7);
     }
-    EXPECT_LT(RotationAngle(tag.world_from_tag.rotation, scene.world_from_tag[static_cast<size_t>(tag.id)].rotation), 1e-7);
+    EXPECT_LT(RotationAngle(tag.world_from_tag.rotation, scene.world_from_tag[static_cast<size_t>(tag.id)].rotation),
+              1e-7);
   }
   EXPECT_LT(report->edge_max_abs_error_m, 1e-7);
   // The cameras moved with the model.
@@ -119,7 +125,8 @@ TEST(TagRegistrationTest, AnyCompleteTagCanBeTheWorldAndOthersAreRefused) {
 
   Scene other = MakeScene();
   options.world_tag = 7;
-  EXPECT_EQ(RegisterToTags(other.observations, {}, options, &other.model).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(RegisterToTags(other.observations, {}, options, &other.model).status().code(),
+            StatusCode::kInvalidArgument);
 }
 
 TEST(TagRegistrationTest, WithoutATagInTwoViewsTheModelStaysAsItWas) {
@@ -134,7 +141,8 @@ TEST(TagRegistrationTest, WithoutATagInTwoViewsTheModelStaysAsItWas) {
   EXPECT_NE(report->reason.find("3 tag(s) seen"), std::string::npos) << report->reason;
   EXPECT_LT((scene.model.images[0].pose.Center() - centre).norm(), 1e-12);
   options.tag_size_m = 0.0;
-  EXPECT_EQ(RegisterToTags(scene.observations, {}, options, &scene.model).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(RegisterToTags(scene.observations, {}, options, &scene.model).status().code(),
+            StatusCode::kInvalidArgument);
 }
 
 TEST(TagRegistrationTest, CornersBecomeKeypointsAndMatchesOfEveryPairSharingATag) {
@@ -165,7 +173,7 @@ TEST(TagRegistrationTest, CornersBecomeKeypointsAndMatchesOfEveryPairSharingATag
   EXPECT_EQ(images[0].keypoint_weights[4], 0.0f);
   EXPECT_EQ(images[0].keypoint_weights[5], 2.0f);
   EXPECT_EQ(images[0].keypoints[9], Eigen::Vector2d(20, 1));  // tag 2, corner 0
-  ASSERT_EQ(pairs.size(), 1u);  // no new pair: image 2 keeps no tag
+  ASSERT_EQ(pairs.size(), 1u);                                // no new pair: image 2 keeps no tag
   ASSERT_EQ(pairs[0].matches.matches.size(), 6u);
   // Tag 2 is keypoints 9..12 of image 0 and 5..8 of image 1; the pair is (1, 0).
   EXPECT_EQ(pairs[0].matches.matches[2].index_a, 5);
