@@ -1,5 +1,6 @@
 // `reconar reconstruct`: photos in, a metric 3D model out (core/pipeline/reconstruct.h).
 #include <cstdio>
+#include <filesystem>
 #include <set>
 #include <sstream>
 #include <string>
@@ -195,7 +196,8 @@ int RunReconstruct(int argc, char** argv, int first) {
   const std::string preview_path = project.root() + "/preview.png";
   if (!args.Has("no-preview")) {
     const std::string mesh_path = project.MeshDir() + "/mesh.ply";
-    const std::string model = ReadMeshFile(mesh_path).ok() ? mesh_path : project.DensePointsPath();
+    std::error_code error;
+    const std::string model = std::filesystem::exists(mesh_path, error) ? mesh_path : project.DensePointsPath();
     if (Status s = WritePreview(project, model, preview_path); !s.ok()) {
       std::fprintf(stderr, "warning: no preview: %s\n", s.ToString().c_str());
     }

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
@@ -14,7 +15,6 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/json_reader.h"
-#include "core/mesh/mesh_file.h"
 #include "core/pipeline/project.h"
 #include "core/sfm/model_io.h"
 #include "core/io/image_write.h"
@@ -141,7 +141,8 @@ Result<ProjectScene> LoadProjectScene(const std::string& dir) {
   // The mesh, else the dense points, else the sparse points.
   for (const std::string& path : {project.MeshDir() + "/mesh.ply", project.DensePointsPath(), project.SparseDir() + "/points.ply"}) {
     scene.model_path = path;
-    if (ReadMeshFile(path).ok()) break;
+    std::error_code error;
+    if (std::filesystem::exists(path, error)) break;
   }
   RECONAR_ASSIGN_OR_RETURN(const JsonValue tags, ReadJsonFile(project.TagsJsonPath()));
   const JsonValue* metric = tags.Find("metric");
