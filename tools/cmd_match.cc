@@ -19,6 +19,8 @@ constexpr char kHelp[] =
     "  --pairs OUT.txt   write the verified matches, one 'xa ya xb yb' per line (pixels)\n"
     "  --project DIR     match all pairs of a project made by `reconar features --project DIR`;\n"
     "                    writes DIR/matches/matches.txt\n"
+    "  --memory-budget MiB  with --project: memory for features and kd-forests; when all images do not\n"
+    "                    fit, blocks of images are matched two at a time (same result; default: no limit)\n"
     "  --ratio R         Lowe ratio (default 0.6)   --checks N  leaf checks per query (default 200)\n"
     "  --min-inliers N   inliers a pair needs (default 100)\n"
     "  --f-threshold T   F inlier threshold as a fraction of the larger image side (default 0.006)\n"
@@ -43,13 +45,20 @@ Result<MatchStageOptions> MatchOptionsFromArgs(const Args& args) {
 
 namespace {
 
-int MatchProject(const Args& args, const MatchStageOptions& options) {
+int MatchProject(const Args& args, MatchStageOptions options) {
   const Project project(args.Get("project"));
+  auto budget_mib = args.GetInt("memory-budget", 0, 1, 1 << 24);
+  if (!budget_mib.ok()) return Fail(budget_mib.status());
+  options.memory_budget_bytes = static_cast<size_t>(*budget_mib) << 20;
   auto report = RunMatchStage(project, options);
   if (!report.ok()) return Fail(report.status());
   std::printf("matching: %d images, %d pairs: %d verified, %d planar or rotation-only, %d rejected; %.1fs\n",
               report->num_images, report->num_pairs, report->num_verified, report->num_planar, report->num_rejected,
               report->seconds);
+  if (report->num_blocks > 1) {
+    std::printf("matched in %d blocks of images, two at a time (estimated peak %.0f MiB)\n", report->num_blocks,
+                report->estimated_peak_bytes / (1 << 20));
+  }
   std::printf("written to %s\n", project.MatchesPath().c_str());
   return 0;
 }
@@ -103,7 +112,7 @@ int MatchTwo(const Args& args, const MatchStageOptions& options) {
 int RunMatch(int argc, char** argv, int first) {
   std::set<std::string> valued = kSiftValuedOptions;
   valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
-  valued.insert({"project", "pairs"});
+  valued.insert({"project", "pairs", "memory-budget"});
   Args args(valued, {});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {

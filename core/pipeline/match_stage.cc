@@ -1,6 +1,8 @@
 #include "core/pipeline/match_stage.h"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -28,6 +30,13 @@ std::vector<Eigen::Vector2d> Positions(const SiftFeatures& features, const std::
 
 }  // namespace
 
+double MatchBytesPerFeature(const MatchOptions& match, int workers) {
+  // A descriptor and its keypoint, and in every worker's forest one point id per tree plus about
+  // 2 / leaf_size nodes of 12 bytes per point (KdForest reserves that many).
+  const double forest = match.num_trees * (sizeof(int32_t) + 2.0 * 12.0 / std::max(1, match.leaf_size));
+  return 128.0 + sizeof(SiftKeypoint) + workers * forest;
+}
+
 Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int height_a, const SiftFeatures& b,
                                    int width_b, int height_b, const std::vector<FeatureMatch>& putative,
                                    const TwoViewOptions& options) {
@@ -49,59 +58,126 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
     return InvalidArgument(project.ImageListPath() + ": matching needs at least two images, the project has " +
                            std::to_string(images.size()));
   }
-  std::vector<FeatureFile> files;
-  files.reserve(images.size());
-  for (const ProjectImage& image : images) {
-    RECONAR_ASSIGN_OR_RETURN(FeatureFile file, ReadFeatureFile(project.FeaturePath(image.name)));
-    files.push_back(std::move(file));
-  }
-  std::vector<std::pair<int, int>> pairs;
-  for (int i = 0; i < static_cast<int>(images.size()); ++i) {
-    for (int j = i + 1; j < static_cast<int>(images.size()); ++j) pairs.emplace_back(i, j);
+  const int n = static_cast<int>(images.size());
+  const int threads = std::min<int>(ThreadPool::ResolveThreadCount(options.num_threads), n * (n - 1) / 2);
+  ThreadPool pool(threads);
+  const double per_feature = MatchBytesPerFeature(options.match, pool.num_threads());
+  const double budget = options.memory_budget_bytes > 0 ? static_cast<double>(options.memory_budget_bytes)
+                                                        : std::numeric_limits<double>::infinity();
+
+  // Every image's size and feature count; the features stay loaded while all of them fit.
+  std::vector<FeatureFile> files(images.size());
+  std::vector<double> image_bytes(images.size());
+  double total_bytes = 0.0;
+  bool all_loaded = true;
+  for (size_t i = 0; i < images.size(); ++i) {
+    RECONAR_ASSIGN_OR_RETURN(FeatureFile file, ReadFeatureFile(project.FeaturePath(images[i].name)));
+    image_bytes[i] = per_feature * static_cast<double>(file.features.keypoints.size());
+    total_bytes += image_bytes[i];
+    if (all_loaded && total_bytes > budget) {
+      all_loaded = false;
+      for (FeatureFile& loaded : files) loaded.features = SiftFeatures{};
+    }
+    if (!all_loaded) file.features = SiftFeatures{};
+    files[i] = std::move(file);
   }
 
-  const int threads = std::min<int>(ThreadPool::ResolveThreadCount(options.num_threads), static_cast<int>(pairs.size()));
-  ThreadPool pool(threads);
+  // Consecutive blocks of at most half the budget each, so that two fit at once.
+  std::vector<int> block_of(images.size(), 0);
+  int num_blocks = 1;
+  double block_bytes = 0.0, peak_bytes = total_bytes;
+  if (!all_loaded) {
+    std::vector<double> bytes_of_block = {0.0};
+    for (size_t i = 0; i < images.size(); ++i) {
+      if (block_bytes > 0.0 && block_bytes + image_bytes[i] > 0.5 * budget) {
+        bytes_of_block.push_back(0.0);
+        block_bytes = 0.0;
+        ++num_blocks;
+      }
+      block_bytes += image_bytes[i];
+      bytes_of_block.back() = block_bytes;
+      block_of[i] = num_blocks - 1;
+    }
+    std::sort(bytes_of_block.rbegin(), bytes_of_block.rend());
+    peak_bytes = bytes_of_block[0] + (bytes_of_block.size() > 1 ? bytes_of_block[1] : 0.0);
+  }
+  // The pairs in the usual order, grouped by the pair of blocks they fall in.
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<std::vector<size_t>> pairs_of_blocks(static_cast<size_t>(num_blocks * num_blocks));
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      pairs_of_blocks[static_cast<size_t>(block_of[i] * num_blocks + block_of[j])].push_back(pairs.size());
+      pairs.emplace_back(i, j);
+    }
+  }
+
   MatchOptions per_worker = options.match;
   per_worker.num_threads = 1;
   std::vector<std::unique_ptr<Matcher>> matchers(pool.num_threads());
   for (auto& matcher : matchers) {
     RECONAR_ASSIGN_OR_RETURN(matcher, Matcher::Create(per_worker));
-    for (size_t i = 0; i < files.size(); ++i) {
-      const SiftFeatures& f = files[i].features;
-      RECONAR_RETURN_IF_ERROR(matcher->AddImage(static_cast<int>(i), f.descriptors.data(),
-                                                static_cast<int>(f.keypoints.size())));
-    }
   }
+  // Holds exactly the images of blocks a and b in memory and in every worker's matcher.
+  const auto hold_blocks = [&](int a, int b) -> Status {
+    for (size_t i = 0; i < files.size(); ++i) {
+      const bool wanted = block_of[i] == a || block_of[i] == b;
+      if (!wanted && !all_loaded && !files[i].features.keypoints.empty()) {
+        for (auto& matcher : matchers) matcher->RemoveImage(static_cast<int>(i));
+        files[i].features = SiftFeatures{};
+      }
+      if (!wanted || matchers.front()->HasImage(static_cast<int>(i))) continue;
+      if (!all_loaded) {
+        RECONAR_ASSIGN_OR_RETURN(FeatureFile file, ReadFeatureFile(project.FeaturePath(images[i].name)));
+        files[i].features = std::move(file.features);
+      }
+      const SiftFeatures& f = files[i].features;
+      for (auto& matcher : matchers) {
+        RECONAR_RETURN_IF_ERROR(matcher->AddImage(static_cast<int>(i), f.descriptors.data(),
+                                                  static_cast<int>(f.keypoints.size())));
+      }
+    }
+    return Status::Ok();
+  };
+
   std::vector<std::optional<VerifiedPair>> results(pairs.size());
   std::vector<Status> errors(pairs.size());
   std::optional<Progress> progress;
   if (options.show_progress) progress.emplace("matching", pairs.size());
-  pool.ParallelFor(0, pairs.size(), [&](size_t p, int worker) {
-    const auto [i, j] = pairs[p];
-    auto putative = matchers[worker]->Match(i, j);
-    if (!putative.ok()) {
-      errors[p] = putative.status();
-    } else {
-      auto verified = VerifyMatches(files[i].features, files[i].image_width, files[i].image_height,
-                                    files[j].features, files[j].image_width, files[j].image_height, *putative,
-                                    options.two_view);
-      if (verified.ok()) {
-        verified->image_a = i;
-        verified->image_b = j;
-        results[p] = std::move(verified).value();
-      } else {
-        errors[p] = verified.status().WithContext(images[i].name + " / " + images[j].name);
-      }
+  for (int a = 0; a < num_blocks; ++a) {
+    for (int b = a; b < num_blocks; ++b) {
+      const std::vector<size_t>& block_pairs = pairs_of_blocks[static_cast<size_t>(a * num_blocks + b)];
+      if (block_pairs.empty()) continue;
+      RECONAR_RETURN_IF_ERROR(hold_blocks(a, b));
+      pool.ParallelFor(0, block_pairs.size(), [&](size_t k, int worker) {
+        const size_t p = block_pairs[k];
+        const auto [i, j] = pairs[p];
+        auto putative = matchers[worker]->Match(i, j);
+        if (!putative.ok()) {
+          errors[p] = putative.status();
+        } else {
+          auto verified = VerifyMatches(files[i].features, files[i].image_width, files[i].image_height,
+                                        files[j].features, files[j].image_width, files[j].image_height, *putative,
+                                        options.two_view);
+          if (verified.ok()) {
+            verified->image_a = i;
+            verified->image_b = j;
+            results[p] = std::move(verified).value();
+          } else {
+            errors[p] = verified.status().WithContext(images[i].name + " / " + images[j].name);
+          }
+        }
+        if (progress) progress->Advance();
+      });
+      for (size_t p : block_pairs) RECONAR_RETURN_IF_ERROR(errors[p]);
     }
-    if (progress) progress->Advance();
-  });
+  }
   if (progress) progress->Finish();
-  for (const Status& status : errors) RECONAR_RETURN_IF_ERROR(status);
 
   MatchStageReport report;
   report.num_images = static_cast<int>(images.size());
   report.num_pairs = static_cast<int>(pairs.size());
+  report.num_blocks = num_blocks;
+  report.estimated_peak_bytes = peak_bytes;
   std::ostringstream out;
   out << "# reconar matches v1\n";
   out.precision(12);

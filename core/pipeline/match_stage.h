@@ -6,6 +6,9 @@
 //   pair NAME_A NAME_B CONFIG NUM_INLIERS f11 f12 ... f33     (x_b^T F x_a = 0, pixels;
 //                                                             CONFIG: verified or planar)
 //   INDEX_A INDEX_B                                           (NUM_INLIERS lines, feature indices)
+// Under a memory budget too small for every image's features and kd-forests at once, the images
+// are cut into consecutive blocks and each pair of blocks is matched with only its two blocks in
+// memory; the pairs and the file are the same either way.
 #include <string>
 #include <vector>
 
@@ -24,6 +27,7 @@ struct MatchStageOptions {
   TwoViewOptions two_view;
   int num_threads = 0;  // pairs in parallel; <= 0: one per core
   bool show_progress = true;
+  size_t memory_budget_bytes = 0;  // for features and forests; 0: no limit
 };
 
 struct VerifiedPair {
@@ -40,9 +44,14 @@ struct MatchStageReport {
   int num_verified = 0;   // kVerified
   int num_planar = 0;     // kPlanarOrRotation (kept: good matches, low parallax)
   int num_rejected = 0;   // kTooFewInliers
+  int num_blocks = 1;     // image blocks matched a pair of blocks at a time (1: all images at once)
+  double estimated_peak_bytes = 0;  // features and forests held at once
   double seconds = 0;
   std::vector<VerifiedPair> pairs;  // kept pairs only, without per-pair rejects
 };
+
+// Estimated bytes one feature holds while its image is being matched by `workers` workers.
+double MatchBytesPerFeature(const MatchOptions& match, int workers);
 
 // Verifies putative matches between two feature sets of images of the given sizes.
 Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int height_a, const SiftFeatures& b,

@@ -217,7 +217,14 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
 
     MatchStageOptions matching = options.matching;
     matching.num_threads = threads;
-    const auto run_matching = [&](StageSummary*) -> Status { return RunMatchStage(project, matching).status(); };
+    matching.memory_budget_bytes = budget;
+    const auto run_matching = [&](StageSummary* summary) -> Status {
+      RECONAR_ASSIGN_OR_RETURN(const MatchStageReport r, RunMatchStage(project, matching));
+      if (r.num_blocks > 1) {
+        summary->note = "photos matched in " + std::to_string(r.num_blocks) + " blocks, two at a time, for the memory budget";
+      }
+      return Status::Ok();
+    };
     RECONAR_RETURN_IF_ERROR(runner.Run("matching",
                                        Settings({{"ratio", matching.match.max_ratio},
                                                  {"checks", matching.match.max_leaf_checks},

@@ -111,6 +111,17 @@ std::vector<Eigen::Vector3d> AsVector(const std::array<Eigen::Vector3d, 4>& corn
   return std::vector<Eigen::Vector3d>(corners.begin(), corners.end());
 }
 
+// Mean, standard deviation and largest |edge - tag_size| of `edges`.
+void EdgeFigures(const std::vector<double>& edges, double tag_size, double* mean, double* std, double* max_abs_error) {
+  *mean = *std = *max_abs_error = 0.0;
+  for (double e : edges) *mean += e / static_cast<double>(edges.size());
+  for (double e : edges) {
+    *std += (e - *mean) * (e - *mean) / static_cast<double>(edges.size());
+    *max_abs_error = std::max(*max_abs_error, std::abs(e - tag_size));
+  }
+  *std = std::sqrt(*std);
+}
+
 void ApplyToModel(const Sim3& world_from_model, Reconstruction* rec) {
   for (SfmPoint& point : rec->points) point.position = world_from_model.Apply(point.position);
   const Eigen::Matrix3d model_from_world_rotation = world_from_model.rotation.transpose();
@@ -304,12 +315,20 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
     if (fit.ok()) tag.world_from_tag = Rigid3{fit->rotation, fit->translation};
     report.tags.push_back(tag);
   }
-  for (double e : edges) report.edge_mean_m += e / static_cast<double>(edges.size());
-  for (double e : edges) {
-    report.edge_std_m += (e - report.edge_mean_m) * (e - report.edge_mean_m) / static_cast<double>(edges.size());
-    report.edge_max_abs_error_m = std::max(report.edge_max_abs_error_m, std::abs(e - options.tag_size_m));
+  EdgeFigures(edges, options.tag_size_m, &report.edge_mean_m, &report.edge_std_m, &report.edge_max_abs_error_m);
+  if (report.tags.size() >= 2) {
+    // Edges were scaled so that all of them average tag_size_m; at the scale of the other tags
+    // alone, a tag's edges are multiplied by (sum of all edges - its own) / (tag_size_m * (edges - 4)).
+    const double sum_all = options.tag_size_m * static_cast<double>(edges.size());
+    std::vector<double> held_out;
+    for (const RegisteredTag& tag : report.tags) {
+      const double own = tag.edges_m[0] + tag.edges_m[1] + tag.edges_m[2] + tag.edges_m[3];
+      const double rescale = options.tag_size_m * static_cast<double>(edges.size() - 4) / (sum_all - own);
+      for (double e : tag.edges_m) held_out.push_back(e * rescale);
+    }
+    EdgeFigures(held_out, options.tag_size_m, &report.held_out_edge_mean_m, &report.held_out_edge_std_m,
+                &report.held_out_edge_max_abs_error_m);
   }
-  report.edge_std_m = std::sqrt(report.edge_std_m);
   return report;
 }
 
@@ -326,6 +345,11 @@ std::string TagRegistrationJson(const TagRegistrationReport& report, const std::
   json.Key("edge_mean_m").Double(report.edge_mean_m);
   json.Key("edge_std_m").Double(report.edge_std_m);
   json.Key("edge_max_abs_error_m").Double(report.edge_max_abs_error_m);
+  if (report.tags.size() >= 2) {
+    json.Key("held_out_edge_mean_m").Double(report.held_out_edge_mean_m);
+    json.Key("held_out_edge_std_m").Double(report.held_out_edge_std_m);
+    json.Key("held_out_edge_max_abs_error_m").Double(report.held_out_edge_max_abs_error_m);
+  }
   json.Key("tags").BeginArray();
   for (const RegisteredTag& tag : report.tags) {
     json.BeginObject();

@@ -78,6 +78,9 @@ struct TagRegistrationReport {
   Sim3 world_from_model;
   std::vector<RegisteredTag> tags;                                         // complete tags, by id
   double edge_mean_m = 0.0, edge_std_m = 0.0, edge_max_abs_error_m = 0.0;  // over all edges of all tags
+  // The same with each tag measured at the scale of the other tags only, so that no tag checks the
+  // scale it helped set (the mean above equals the tag size by construction). Two tags or more.
+  double held_out_edge_mean_m = 0.0, held_out_edge_std_m = 0.0, held_out_edge_max_abs_error_m = 0.0;
 };
 
 // observations[i] are the tags seen in rec->images[i]; `corner_keypoints` (may be empty) says which
@@ -89,7 +92,8 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
                                              const TagRegistrationOptions& options, Reconstruction* rec);
 
 // PROJECT/tags.json: {"metric", "reason", "family", "tag_size_m", "world_tag", "tags_seen",
-// "metres_per_model_unit", "edge_mean_m", "edge_std_m", "edge_max_abs_error_m", "tags": [{"id",
+// "metres_per_model_unit", "edge_mean_m", "edge_std_m", "edge_max_abs_error_m", "held_out_edge_mean_m",
+// "held_out_edge_std_m", "held_out_edge_max_abs_error_m" (with two tags or more), "tags": [{"id",
 // "views", "adjusted", "corners": [[x, y, z] x 4] (metres, world frame), "edges_m": [4],
 // "rms_reprojection_px", "world_from_tag": {"R": [9, row-major], "t": [3]}}]}.
 std::string TagRegistrationJson(const TagRegistrationReport& report, const std::string& family, double tag_size_m);

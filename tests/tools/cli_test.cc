@@ -81,6 +81,16 @@ TEST(Cli, ProjectFeaturesThenMatchesOnTheBundledTemple) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("16 images, 120 pairs"), std::string::npos) << run.output;
   EXPECT_TRUE(fs::exists(project / "matches" / "matches.txt"));
+  // Under a budget that holds only a few images' features at once, blocks of images are matched
+  // two at a time, to the same file.
+  auto all_at_once = reconar::ReadFileToString((project / "matches" / "matches.txt").string());
+  ASSERT_TRUE(all_at_once.ok());
+  run = RunReconar("match --project " + project.string() + " --threads 2 --memory-budget 2");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find(" blocks of images, two at a time"), std::string::npos) << run.output;
+  auto in_blocks = reconar::ReadFileToString((project / "matches" / "matches.txt").string());
+  ASSERT_TRUE(in_blocks.ok());
+  EXPECT_TRUE(*in_blocks == *all_at_once);
   // Matching a project that has no features is a clear usage error.
   run = RunReconar("match --project " + TempDir("empty_project").string());
   EXPECT_EQ(run.exit_code, 2);

@@ -24,11 +24,12 @@ struct Scene {
   std::vector<Eigen::Vector3d> camera_centres_world;
 };
 
-Eigen::Vector3d TagCorner(const Rigid3& world_from_tag, int k) {
-  return world_from_tag * (Eigen::Vector3d(kTagCornerUnits[k][0], kTagCornerUnits[k][1], 0.0) * kTagSize / 2.0);
+Eigen::Vector3d TagCorner(const Rigid3& world_from_tag, int k, double size = kTagSize) {
+  return world_from_tag * (Eigen::Vector3d(kTagCornerUnits[k][0], kTagCornerUnits[k][1], 0.0) * size / 2.0);
 }
 
-Scene MakeScene() {
+// Tag 2 is printed `tag2_scale` times the nominal size.
+Scene MakeScene(double tag2_scale = 1.0) {
   Scene scene;
   scene.world_from_tag.push_back(Rigid3::Identity());
   scene.world_from_tag.push_back(
@@ -69,7 +70,8 @@ Scene MakeScene() {
       TagObservation tag;
       tag.tag_id = id;
       for (int k = 0; k < 4; ++k) {
-        const Eigen::Vector3d model_point = m.Apply(TagCorner(scene.world_from_tag[static_cast<size_t>(id)], k));
+        const double size = id == 2 ? tag2_scale * kTagSize : kTagSize;
+        const Eigen::Vector3d model_point = m.Apply(TagCorner(scene.world_from_tag[static_cast<size_t>(id)], k, size));
         tag.corners[static_cast<size_t>(k)] = camera.Project(image.pose.CamFromWorld(model_point));
       }
       seen.push_back(tag);
@@ -109,6 +111,25 @@ TEST(TagRegistrationTest, RecoversMetresAndTheWorldTagFrame) {
   for (size_t c = 0; c < scene.model.images.size(); ++c) {
     EXPECT_LT((scene.model.images[c].pose.Center() - scene.camera_centres_world[c]).norm(), 1e-7);
   }
+}
+
+// A tag of the wrong size shows in the held-out figures: it is measured at the scale of the
+// others, which are exact, while the plain mean is the nominal size by construction.
+TEST(TagRegistrationTest, HeldOutEdgesMeasureEachTagAtTheOtherTagsScale) {
+  Scene scene = MakeScene(1.03);
+  TagRegistrationOptions options;
+  options.tag_size_m = kTagSize;
+  auto report = RegisterToTags(scene.observations, {}, options, &scene.model);
+  ASSERT_TRUE(report.ok() && report->metric);
+  ASSERT_EQ(report->tags.size(), 3u);
+  EXPECT_NEAR(report->edge_mean_m, kTagSize, 1e-9);
+  // Tags 0 and 1 at the scale of {1, 2} or {0, 2}, whose mean edge is 1.015 x nominal.
+  const double small = kTagSize / 1.015, large = 1.03 * kTagSize;
+  EXPECT_NEAR(report->held_out_edge_max_abs_error_m, large - kTagSize, 1e-7);
+  EXPECT_NEAR(report->held_out_edge_mean_m, (2 * small + large) / 3, 1e-7);
+  const double mean = (2 * small + large) / 3;
+  EXPECT_NEAR(report->held_out_edge_std_m,
+              std::sqrt((2 * (small - mean) * (small - mean) + (large - mean) * (large - mean)) / 3), 1e-7);
 }
 
 TEST(TagRegistrationTest, AnyCompleteTagCanBeTheWorldAndOthersAreRefused) {
