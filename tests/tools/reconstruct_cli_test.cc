@@ -168,6 +168,9 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
   std::printf("tags not in BA:  %d tags, held-out edges mean %.5f m, spread %.5f m (%.2f %%), max |error| %.5f m (%.2f %%)\n",
               alone.tags, alone.edge_mean, alone.edge_std, 100 * alone.edge_std / kSwatTagSize, alone.edge_max_error,
               100 * alone.edge_max_error / kSwatTagSize);
+  // What the corner constraints are for: the tags measure at least as well with them as without.
+  EXPECT_EQ(alone.tags, with.tags);
+  EXPECT_LE(with.edge_std, alone.edge_std);
 }
 
 // Every file of a finished project except the reports (which hold timings and reuse flags).
