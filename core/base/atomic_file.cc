@@ -1,5 +1,6 @@
 #include "core/base/atomic_file.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -11,6 +12,18 @@ namespace reconar {
 namespace {
 
 std::string ErrnoText(int err) { return std::strerror(err); }
+
+// The pid of a "<name>.tmp-<pid>" file name, or -1.
+long TemporaryFilePid(const std::string& name) {
+  const size_t at = name.rfind(".tmp-");
+  if (at == std::string::npos || at + 5 == name.size()) return -1;
+  long pid = 0;
+  for (size_t i = at + 5; i < name.size(); ++i) {
+    if (name[i] < '0' || name[i] > '9' || pid > (1L << 40)) return -1;
+    pid = 10 * pid + (name[i] - '0');
+  }
+  return pid;
+}
 
 }  // namespace
 
@@ -69,6 +82,24 @@ Status CreateDirectories(const std::string& path) {
   std::filesystem::create_directories(path, ec);
   if (ec) return FileError(StatusCode::kIoError, path, "cannot create directory: " + ec.message());
   return Status::Ok();
+}
+
+Result<int> RemoveStaleTemporaryFiles(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_directory(dir, error)) return 0;
+  int removed = 0;
+  for (auto it = fs::recursive_directory_iterator(dir, error); !error && it != fs::recursive_directory_iterator();
+       it.increment(error)) {
+    if (!it->is_regular_file(error)) continue;
+    const long pid = TemporaryFilePid(it->path().filename().string());
+    if (pid <= 0 || pid == static_cast<long>(::getpid())) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
+    if (fs::remove(it->path(), error)) ++removed;
+    if (error) return FileError(StatusCode::kIoError, it->path().string(), "cannot remove: " + error.message());
+  }
+  if (error) return FileError(StatusCode::kIoError, dir, "cannot list: " + error.message());
+  return removed;
 }
 
 }  // namespace reconar

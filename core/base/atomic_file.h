@@ -15,6 +15,11 @@ namespace reconar {
 Status WriteFileAtomically(const std::string& path, const std::function<Status(std::FILE*)>& writer);
 Status WriteFileAtomically(const std::string& path, std::string_view content);
 
+// Removes the temporaries ("<name>.tmp-<pid>") that a process killed mid-write left anywhere
+// below `dir`: those whose process no longer exists. Returns how many were removed; a missing
+// `dir` removes none.
+Result<int> RemoveStaleTemporaryFiles(const std::string& dir);
+
 // Reads a whole file; errors name the file.
 Result<std::string> ReadFileToString(const std::string& path);
 

@@ -175,6 +175,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
                                          const ReconstructOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root()));
+  RECONAR_ASSIGN_OR_RETURN(const int stale, RemoveStaleTemporaryFiles(project.root()));
+  if (stale > 0) std::fprintf(stderr, "removed %d temporary file(s) of an interrupted run\n", stale);
   ReconstructReport report;
   StageRunner runner(project, options, &report);
   const int threads = ThreadPool::ResolveThreadCount(options.num_threads);
@@ -221,7 +223,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     const auto run_matching = [&](StageSummary* summary) -> Status {
       RECONAR_ASSIGN_OR_RETURN(const MatchStageReport r, RunMatchStage(project, matching));
       if (r.num_blocks > 1) {
-        summary->note = "photos matched in " + std::to_string(r.num_blocks) + " blocks, two at a time, for the memory budget";
+        summary->note =
+            "photos matched in " + std::to_string(r.num_blocks) + " blocks, two at a time, for the memory budget";
       }
       return Status::Ok();
     };

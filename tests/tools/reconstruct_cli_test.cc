@@ -106,7 +106,8 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
   EXPECT_GE(found, 0.95 * total);
 
   const TagFigures with = ReadTagFigures(project);
-  std::printf("with tags in BA: %d tags, held-out edges mean %.5f m, spread %.5f m (%.2f %%), max |error| %.5f m (%.2f %%)\n",
+  std::printf("with tags in BA: %d tags, held-out edges mean %.5f m, spread %.5f m (%.2f %%), max |error| %.5f m "
+              "(%.2f %%)\n",
               with.tags, with.edge_mean, with.edge_std, 100 * with.edge_std / kSwatTagSize, with.edge_max_error,
               100 * with.edge_max_error / kSwatTagSize);
   EXPECT_GE(with.tags, 18);
@@ -165,7 +166,8 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
   ASSERT_EQ(without.exit_code, 0) << without.output;
   EXPECT_NE(without.output.find("features  reused"), std::string::npos) << without.output;
   const TagFigures alone = ReadTagFigures(project);
-  std::printf("tags not in BA:  %d tags, held-out edges mean %.5f m, spread %.5f m (%.2f %%), max |error| %.5f m (%.2f %%)\n",
+  std::printf("tags not in BA:  %d tags, held-out edges mean %.5f m, spread %.5f m (%.2f %%), max |error| %.5f m "
+              "(%.2f %%)\n",
               alone.tags, alone.edge_mean, alone.edge_std, 100 * alone.edge_std / kSwatTagSize, alone.edge_max_error,
               100 * alone.edge_max_error / kSwatTagSize);
   // What the corner constraints are for: the tags measure at least as well with them as without.
@@ -222,6 +224,9 @@ TEST(ReconstructCli, KilledRunsResumeToTheSameFiles) {
     const CommandRun resumed = RunReconar("reconstruct " + data + " " + project + arguments);
     ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
     const auto files = ProjectFiles(project);
+    for (const auto& [name, content] : files) {
+      EXPECT_TRUE(expected.count(name)) << name << ": not in the uninterrupted run, killed at " << fraction;
+    }
     EXPECT_EQ(files.size(), expected.size()) << "killed at " << fraction;
     for (const auto& [name, content] : expected) {
       const auto it = files.find(name);

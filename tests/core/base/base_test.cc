@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -160,6 +161,34 @@ TEST(AtomicFile, WritesReplacesAndCleansUp) {
 
 // A full disk, simulated with a file-size limit: the write fails with a message naming the file,
 // the previous version survives and no half file is left.
+// What a SIGKILL during a write leaves: the temporary of a process that is gone is removed, a
+// live process's (this one's) and files that only look similar are kept.
+TEST(AtomicFile, StaleTemporariesOfDeadProcessesAreRemoved) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("reconar_stale_tmp_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "sub");
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);  // reaped: its pid names no process now
+  const std::string dead = std::to_string(child), alive = std::to_string(::getpid());
+  const std::vector<std::string> names = {"sub/points.ply.tmp-" + dead, "a.txt.tmp-" + alive, "b.tmp-x", "c.tmp-"};
+  for (const std::string& name : names) {
+    ASSERT_TRUE(WriteFileAtomically((dir / name).string(), "x").ok());
+  }
+  auto removed = RemoveStaleTemporaryFiles(dir.string());
+  ASSERT_TRUE(removed.ok()) << removed.status().ToString();
+  EXPECT_EQ(*removed, 1);
+  EXPECT_FALSE(std::filesystem::exists(dir / ("sub/points.ply.tmp-" + dead)));
+  EXPECT_TRUE(std::filesystem::exists(dir / ("a.txt.tmp-" + alive)));
+  EXPECT_TRUE(std::filesystem::exists(dir / "b.tmp-x"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "c.tmp-"));
+  EXPECT_EQ(*RemoveStaleTemporaryFiles((dir / "missing").string()), 0);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(AtomicFile, FullDiskLeavesNoHalfFile) {
   const fs::path dir = TempDir("full");
   const std::string path = (dir / "model.ply").string();
