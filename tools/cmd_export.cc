@@ -7,6 +7,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/json_writer.h"
 #include "core/mesh/mesh_file.h"
+#include "core/mesh/simplify.h"
 #include "tools/args.h"
 #include "tools/commands.h"
 
@@ -14,7 +15,7 @@ namespace reconar::tools {
 namespace {
 
 constexpr char kHelp[] =
-    "usage: reconar export INPUT.{ply,glb,obj} OUTPUT.{ply,obj,glb,wrl} [--ascii] [--json]\n"
+    "usage: reconar export INPUT.{ply,glb,obj} OUTPUT.{ply,obj,glb,wrl} [--max-faces N] [--ascii] [--json]\n"
     "\n"
     "Converts a triangle mesh or point cloud (positions, per-vertex normals and RGBA colours) from\n"
     "one format to another; the extensions choose the formats (any case):\n"
@@ -23,6 +24,8 @@ constexpr char kHelp[] =
     "  .glb   glTF 2.0 binary (normals must be unit length)\n"
     "  .wrl   VRML 2.0 IndexedFaceSet, or PointSet for a point cloud (write only)\n"
     "The output is written atomically; missing parent directories are created.\n"
+    "  --max-faces N  simplify a mesh of more triangles to N (quadric edge collapse; borders and\n"
+    "            colours kept): e.g. 500000 for a handheld\n"
     "  --ascii   write .ply as ASCII\n"
     "  --json    print a JSON summary on stdout\n";
 
@@ -46,7 +49,7 @@ void PrintMeshSummary(const char* verb, const std::string& path, const Mesh& mes
 }
 
 int RunExport(int argc, char** argv, int first) {
-  Args args({}, {"ascii", "json"});
+  Args args({"max-faces"}, {"ascii", "json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
     std::fputs(kHelp, stdout);
@@ -67,11 +70,23 @@ int RunExport(int argc, char** argv, int first) {
   if (options.ply_ascii && *output_format != MeshFileFormat::kPly) {
     return Fail(InvalidArgument(output + ": --ascii applies only to .ply output"));
   }
+  auto max_faces = args.GetInt("max-faces", 0, 0, 1 << 30);
+  if (!max_faces.ok()) return Fail(max_faces.status());
 
   const auto start = std::chrono::steady_clock::now();
   auto mesh = ReadMeshFile(input);
   if (!mesh.ok()) return Fail(mesh.status());
   const auto read = std::chrono::steady_clock::now();
+  const size_t triangles_read = mesh->triangles.size();
+  if (!args.Has("json")) PrintMeshSummary("read", input, *mesh);
+  SimplifyReport simplified;
+  if (*max_faces > 0 && mesh->triangles.size() > static_cast<size_t>(*max_faces)) {
+    SimplifyOptions simplify;
+    simplify.target_faces = static_cast<size_t>(*max_faces);
+    auto report = SimplifyMesh(simplify, &*mesh);
+    if (!report.ok()) return Fail(report.status().WithContext(input));
+    simplified = *report;
+  }
   if (Status s = CreateParentDirectory(output); !s.ok()) return Fail(s);
   if (Status s = WriteMeshFile(output, *mesh, options); !s.ok()) return Fail(s);
   const auto written = std::chrono::steady_clock::now();
@@ -83,16 +98,20 @@ int RunExport(int argc, char** argv, int first) {
     json.Key("input").String(input).Key("output").String(output);
     json.Key("vertices").Int(static_cast<long long>(mesh->positions.size()));
     json.Key("triangles").Int(static_cast<long long>(mesh->triangles.size()));
+    json.Key("triangles_read").Int(static_cast<long long>(triangles_read));
+    json.Key("seconds_simplify").Double(simplified.seconds);
     json.Key("normals").Bool(!mesh->normals.empty()).Key("colors").Bool(!mesh->colors.empty());
     json.Key("bytes").Int(static_cast<long long>(FileSize(output)));
     json.Key("seconds_read").Double(seconds(start, read)).Key("seconds_write").Double(seconds(read, written));
     json.EndObject();
     std::printf("%s\n", json.str().c_str());
   } else {
-    PrintMeshSummary("read", input, *mesh);
-    std::printf("wrote %s: %ju bytes (read %.2fs, write %.2fs)\n", output.c_str(),
-                FileSize(output), seconds(start, read),
-                seconds(read, written));
+    if (simplified.collapses > 0) {
+      std::printf("simplified to %zu vertices, %zu triangles (%.2fs)\n", mesh->positions.size(),
+                  mesh->triangles.size(), simplified.seconds);
+    }
+    std::printf("wrote %s: %ju bytes (read %.2fs, write %.2fs)\n", output.c_str(), FileSize(output),
+                seconds(start, read), seconds(read, written) - simplified.seconds);
   }
   return 0;
 }

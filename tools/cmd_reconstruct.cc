@@ -8,6 +8,7 @@
 #include "core/base/atomic_file.h"
 #include "core/io/image_write.h"
 #include "core/mesh/mesh_file.h"
+#include "core/mesh/simplify.h"
 #include "core/pipeline/reconstruct.h"
 #include "core/sfm/model_io.h"
 #include "tools/args.h"
@@ -44,6 +45,8 @@ constexpr char kHelp[] =
     "  --depth N             finest Poisson depth (default 10; never finer than the points' spacing,\n"
     "                        lowered when the budget demands)\n"
     "  --trim T              Poisson density trim (default 7)\n"
+    "  --max-faces N         simplify a larger mesh to N triangles (quadric edge collapse) before it is\n"
+    "                        written, for rendering on a handheld (default 500000; 0: keep all)\n"
     "  --formats LIST        mesh formats among ply,obj,glb,wrl (default all four)\n"
     "  --no-preview          do not render preview.png\n"
     "  --contrast-threshold T, --max-features N, --first-octave O, --sift-memory-mib M   as `reconar features`\n"
@@ -109,7 +112,7 @@ Status WritePreview(const Project& project, const std::string& model_path, const
 int RunReconstruct(int argc, char** argv, int first) {
   std::set<std::string> valued = kSiftValuedOptions;
   valued.insert({"tag-size", "tag-family", "world-tag", "memory-budget", "threads", "stages", "level", "depth", "trim",
-                 "formats"});
+                 "max-faces", "formats"});
   Args args(valued, {"no-tags-in-ba", "no-preview", "force", "json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
@@ -133,7 +136,9 @@ int RunReconstruct(int argc, char** argv, int first) {
   auto threads = args.GetInt("threads", 0, 0, 1024);
   auto depth = args.GetInt("depth", 10, 5, 11);
   auto trim = args.GetDouble("trim", 7.0, 0.0, 20.0);
-  for (const Status& s : {tag_size.status(), world_tag.status(), threads.status(), depth.status(), trim.status()}) {
+  auto max_faces = args.GetInt("max-faces", static_cast<int>(kHandheldMaxFaces), 0, 1 << 30);
+  for (const Status& s :
+       {tag_size.status(), world_tag.status(), threads.status(), depth.status(), trim.status(), max_faces.status()}) {
     if (!s.ok()) return Fail(s);
   }
   if (args.Has("tag-size") && !(*tag_size > 0.0)) return Fail(InvalidArgument("--tag-size must be positive"));
@@ -162,6 +167,7 @@ int RunReconstruct(int argc, char** argv, int first) {
   }
   options.mesh.poisson.depth = *depth;
   options.mesh.poisson.trim = *trim;
+  options.mesh.max_faces = static_cast<size_t>(*max_faces);
   if (args.Has("formats")) options.mesh.formats = SplitCommas(args.Get("formats"));
   if (args.Has("stages")) {
     options.run_sparse = options.run_dense = options.run_mesh = false;

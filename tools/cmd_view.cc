@@ -20,6 +20,7 @@
 #include "core/io/image_write.h"
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/simplify.h"
 #include "platform/camera/frame_source.h"
 #include "platform/egl/egl_context.h"
 #include "render/mesh_drawable.h"
@@ -61,6 +62,7 @@ constexpr char kHelp[] =
     "  --no-axes             do not draw the tag's axes and outline\n"
     "  --point-size PX       point size for point clouds (default 3)\n"
     "  --samples N           multisample anti-aliasing (default 0: off)\n"
+    "  --max-faces N         draw a mesh of more triangles simplified to N (default 500000; 0: all)\n"
     "  --smooth              draw at the tracker's smoothed pose (less jitter on a still camera, but\n"
     "                        it lags behind fast motion); default: each frame's measured pose\n"
     "  --window auto|x11|gbm (default auto)\n"
@@ -227,7 +229,7 @@ struct Latency {
 int RunView(int argc, char** argv, int first) {
   std::set<std::string> valued = kTrackerValuedOptions;
   valued.insert({"model", "project", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
-                 "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames"});
+                 "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces"});
   Args args(valued, {"no-axes", "smooth"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
@@ -277,6 +279,16 @@ int RunView(int argc, char** argv, int first) {
   const std::string model_path = scene ? scene->model_path : args.Get("model");
   auto mesh = ReadModel(model_path);
   if (!mesh.ok()) return Fail(mesh.status());
+  auto max_faces = args.GetInt("max-faces", static_cast<int>(kHandheldMaxFaces), 0, 1 << 30);
+  if (!max_faces.ok()) return Fail(max_faces.status());
+  if (*max_faces > 0 && mesh->triangles.size() > static_cast<size_t>(*max_faces)) {
+    SimplifyOptions simplify;
+    simplify.target_faces = static_cast<size_t>(*max_faces);
+    auto simplified = SimplifyMesh(simplify, &*mesh);
+    if (!simplified.ok()) return Fail(simplified.status().WithContext(model_path));
+    std::printf("%s: simplified from %zu to %zu faces for drawing (%.1fs; --max-faces)\n", model_path.c_str(),
+                simplified->faces_before, simplified->faces_after, simplified->seconds);
+  }
   Result<ModelPlacement> placement = ModelPlacement();
   if (!scene) placement = PlacementFromArgs(args, *mesh, tracker_options->tag_size);
   if (!placement.ok()) return Fail(placement.status());

@@ -107,7 +107,15 @@ Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOpti
   PoissonOptions poisson = options.poisson;
   poisson.depth = report.depth;
   if (poisson.trim > 0.0) poisson.trim = std::min(poisson.trim, static_cast<double>(report.depth - 1));
-  RECONAR_ASSIGN_OR_RETURN(const Mesh mesh, ReconstructPoissonSurface(*points, poisson, &report.poisson));
+  RECONAR_ASSIGN_OR_RETURN(Mesh mesh, ReconstructPoissonSurface(*points, poisson, &report.poisson));
+  if (options.max_faces > 0 && mesh.triangles.size() > options.max_faces) {
+    SimplifyOptions simplify;
+    simplify.target_faces = options.max_faces;
+    RECONAR_ASSIGN_OR_RETURN(report.simplify, SimplifyMesh(simplify, &mesh));
+    report.simplified = true;
+  }
+  report.vertices = mesh.positions.size();
+  report.faces = mesh.triangles.size();
   RECONAR_RETURN_IF_ERROR(CreateDirectories(project.MeshDir()));
   for (const std::string& format : options.formats) {
     const std::string path = project.MeshDir() + "/mesh." + format;
@@ -130,8 +138,15 @@ std::string MeshReportJson(const MeshStageReport& report) {
   json.Key("depth_lowered_for_memory_budget").Bool(report.depth_lowered_for_budget);
   json.Key("pilot_peak_mib").Double(Mib(report.pilot_peak_bytes));
   json.Key("estimated_peak_mib").Double(Mib(report.estimated_peak_bytes));
-  json.Key("vertices").Int(static_cast<long long>(report.poisson.vertices));
-  json.Key("triangles").Int(static_cast<long long>(report.poisson.triangles));
+  json.Key("vertices").Int(static_cast<long long>(report.vertices));
+  json.Key("triangles").Int(static_cast<long long>(report.faces));
+  json.Key("poisson_vertices").Int(static_cast<long long>(report.poisson.vertices));
+  json.Key("poisson_triangles").Int(static_cast<long long>(report.poisson.triangles));
+  json.Key("simplified").Bool(report.simplified);
+  if (report.simplified) {
+    json.Key("simplify_seconds").Double(report.simplify.seconds);
+    json.Key("simplify_max_error").Double(report.simplify.max_collapse_error);
+  }
   json.Key("octree_nodes").Int(report.poisson.octree_nodes).Key("unknowns").Int(report.poisson.unknowns);
   json.Key("watertight_gaps").Int(static_cast<long long>(report.poisson.cells_skipped));
   json.Key("seconds").Double(report.seconds);

@@ -9,12 +9,15 @@
 // pilot solve at depth - 2 measures its own peak (VmHWM, reset before it) and the depth used is the
 // finest, at most the requested one, whose extrapolated peak (pilot x 4^(depth - pilot depth),
 // plus what the process already holds) fits the budget; the report says when it was lowered.
+// Size: a mesh of more than max_faces triangles is simplified (core/mesh/simplify.h) before it is
+// written, so that a handheld renders it at video rate.
 #include <cstddef>
 #include <string>
 #include <vector>
 
 #include "core/base/status.h"
 #include "core/mesh/poisson/poisson.h"
+#include "core/mesh/simplify.h"
 #include "core/pipeline/project.h"
 
 namespace reconar {
@@ -23,6 +26,7 @@ struct MeshStageOptions {
   PoissonOptions poisson;                                           // depth is the finest allowed
   size_t memory_budget_bytes = 0;                                   // 0: no limit, no pilot
   std::vector<std::string> formats = {"ply", "obj", "glb", "wrl"};  // mesh/mesh.<format>
+  size_t max_faces = 0;                                             // 0: no limit
 
   Status Check() const;
 };
@@ -37,6 +41,9 @@ struct MeshStageReport {
   size_t estimated_peak_bytes = 0;  // for the depth used
   size_t points = 0;
   PoissonReport poisson;
+  bool simplified = false;  // over max_faces: `simplify` says from what to what
+  SimplifyReport simplify;
+  size_t vertices = 0, faces = 0;  // written
   double seconds = 0.0;
   size_t peak_rss_bytes = 0;
   std::vector<std::string> paths;  // written meshes

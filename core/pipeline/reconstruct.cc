@@ -317,6 +317,10 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       if (r.depth_lowered_for_budget) {
         summary->note = "Poisson depth " + std::to_string(r.depth) + " for the memory budget";
       }
+      if (r.simplified) {
+        summary->note += std::string(summary->note.empty() ? "" : "; ") + "simplified from " +
+                         std::to_string(r.simplify.faces_before) + " to " + std::to_string(r.faces) + " faces";
+      }
       return Status::Ok();
     };
     RECONAR_RETURN_IF_ERROR(runner.Run("mesh",
@@ -324,7 +328,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
                                                  {"depth", mesh.poisson.depth},
                                                  {"trim", mesh.poisson.trim},
                                                  {"point_weight", mesh.poisson.point_weight},
-                                                 {"budget_mib", Mib(budget)}}) +
+                                                 {"budget_mib", Mib(budget)},
+                                                 {"max_faces", static_cast<double>(mesh.max_faces)}}) +
                                            " formats=" + formats,
                                        Exists(project.MeshDir() + "/report.json"), runner.redone(), run_mesh));
   }

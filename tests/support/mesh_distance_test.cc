@@ -5,23 +5,14 @@
 #include <cmath>
 #include <random>
 
+#include "tests/core/mesh/mesh_test_util.h"
+
 namespace reconar::testing {
 namespace {
 
 // A flat grid of n x n quads on [0, size]^2 at height z, two triangles per quad.
 Mesh Square(int n, float size, float z, const Eigen::Vector3f& offset = Eigen::Vector3f::Zero()) {
-  Mesh mesh;
-  for (int j = 0; j <= n; ++j) {
-    for (int i = 0; i <= n; ++i) mesh.positions.push_back(Eigen::Vector3f(size * i / n, size * j / n, z) + offset);
-  }
-  const auto index = [n](int i, int j) { return static_cast<uint32_t>(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      mesh.triangles.push_back({index(i, j), index(i + 1, j), index(i + 1, j + 1)});
-      mesh.triangles.push_back({index(i, j), index(i + 1, j + 1), index(i, j + 1)});
-    }
-  }
-  return mesh;
+  return GridMesh(n, size, z, offset);
 }
 
 // A latitude-longitude sphere; the largest gap between it and the true sphere is about

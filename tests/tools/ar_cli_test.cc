@@ -103,9 +103,11 @@ TEST(ArCli, TrackJsonOnRecordedVideoMatchesReferenceCornersAndPoses) {
 
 TEST(ArCli, ViewWritesOneOverlayPerFrameWithTheModelOnTheTag) {
   const std::string dir = testing::MakeTestDirectory("reconar_ar_view");
+  // --max-faces under the bunny's 69,451: the overlay is drawn from the simplified mesh.
   const auto run = RunReconar("view --model " + kData + "/stanford_bunny/reconstruction/bun_zipper.ply --frames " +
-                              kVideo + "/frames " + kVideoCamera + " --out " + dir);
+                              kVideo + "/frames " + kVideoCamera + " --out " + dir + " --max-faces 20000");
   ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("simplified from 69451 to 20000 faces"), std::string::npos) << run.output;
   std::printf("%s", run.output.c_str());
   const auto reference = ReferenceCorners();
   int frames = 0, covered = 0;

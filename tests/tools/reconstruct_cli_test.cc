@@ -202,7 +202,8 @@ pid_t Spawn(const std::string& command) {
 TEST(ReconstructCli, KilledRunsResumeToTheSameFiles) {
   const std::string data = std::string(RECONAR_SOURCE_DIR) + "/data/templeSparseRing";
   const std::string dir = testing::MakeTestDirectory("reconar_reconstruct_resume");
-  const std::string arguments = " --threads 2 --no-preview --formats ply,glb";
+  // --max-faces below the temple mesh's ~25,000 triangles: the simplification is part of the run.
+  const std::string arguments = " --threads 2 --no-preview --formats ply,glb --max-faces 10000";
   const auto start = std::chrono::steady_clock::now();
   const CommandRun reference = RunReconar("reconstruct " + data + " " + dir + "/reference" + arguments);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -210,6 +211,11 @@ TEST(ReconstructCli, KilledRunsResumeToTheSameFiles) {
   const auto expected = ProjectFiles(dir + "/reference");
   ASSERT_TRUE(expected.count("mesh/mesh.glb") && expected.count("dense/points.ply") &&
               expected.count("sparse/points3D.txt"));
+  auto mesh_report = ReadJsonFile(dir + "/reference/mesh/report.json");
+  ASSERT_TRUE(mesh_report.ok()) << mesh_report.status().ToString();
+  EXPECT_TRUE(mesh_report->Find("simplified")->bool_value());
+  EXPECT_LE(Number(*mesh_report, "triangles"), 10000);
+  EXPECT_GT(Number(*mesh_report, "poisson_triangles"), 10000);
 
   int interrupted = 0;
   for (const double fraction : {0.2, 0.5, 0.8}) {

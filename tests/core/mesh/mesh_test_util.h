@@ -31,6 +31,23 @@ inline Mesh RandomMesh(int num_vertices, int num_triangles, bool with_normals, b
   return mesh;
 }
 
+// An n x n grid of square cells `size` wide in the plane z (moved by `offset`), each cell two
+// triangles counter-clockwise seen from +z; vertex (i, j) has index j (n + 1) + i.
+inline Mesh GridMesh(int n, float size, float z, const Eigen::Vector3f& offset = Eigen::Vector3f::Zero()) {
+  Mesh mesh;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) mesh.positions.push_back(Eigen::Vector3f(size * i / n, size * j / n, z) + offset);
+  }
+  const auto index = [n](int i, int j) { return static_cast<uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      mesh.triangles.push_back({index(i, j), index(i + 1, j), index(i + 1, j + 1)});
+      mesh.triangles.push_back({index(i, j), index(i + 1, j + 1), index(i, j + 1)});
+    }
+  }
+  return mesh;
+}
+
 inline void ExpectMeshesEqual(const Mesh& actual, const Mesh& expected) {
   ASSERT_EQ(actual.positions.size(), expected.positions.size());
   for (size_t i = 0; i < expected.positions.size(); ++i) {
