@@ -267,6 +267,7 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     MatchStageOptions matching = options.matching;
     matching.num_threads = threads;
     matching.memory_budget_bytes = budget;
+    matching.show_progress = options.show_progress;
     const auto run_matching = [&](StageSummary* summary) -> Status {
       RECONAR_ASSIGN_OR_RETURN(const MatchStageReport r, RunMatchStage(project, matching));
       if (r.num_blocks > 1) {
