@@ -6,8 +6,8 @@
 
 #include "core/io/image_write.h"
 #include "core/math/camera_intrinsics.h"
-#include "core/mesh/mesh_file.h"
 #include "core/math/rigid3.h"
+#include "core/mesh/mesh_file.h"
 #include "platform/egl/egl_context.h"
 #include "render/mesh_drawable.h"
 #include "render/overlay_renderer.h"

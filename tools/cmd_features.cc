@@ -2,7 +2,6 @@
 #include <optional>
 
 #include "core/base/json_writer.h"
-
 #include "core/pipeline/feature_stage.h"
 #include "core/pipeline/project.h"
 #include "tools/commands.h"

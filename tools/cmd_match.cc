@@ -99,7 +99,11 @@ int MatchTwo(const Args& args, const MatchStageOptions& options) {
   const TwoViewGeometry& g = verified->geometry;
   if (args.Has("json")) {
     JsonWriter json(2);
-    json.BeginObject().Key("image_a").String(a.name).Key("features_a").Int(static_cast<long long>(features[0].keypoints.size()));
+    json.BeginObject()
+        .Key("image_a")
+        .String(a.name)
+        .Key("features_a")
+        .Int(static_cast<long long>(features[0].keypoints.size()));
     json.Key("image_b").String(b.name).Key("features_b").Int(static_cast<long long>(features[1].keypoints.size()));
     json.Key("ratio").Double(match.max_ratio).Key("putative").Int(verified->num_putative);
     json.Key("f_threshold_px").Double(g.f_threshold_px).Key("f_inliers").Int(g.num_f_inliers);
@@ -108,10 +112,10 @@ int MatchTwo(const Args& args, const MatchStageOptions& options) {
     std::printf("%s\n", json.str().c_str());
   } else {
     std::printf("%s: %zu features, %s: %zu features\n", a.name.c_str(), features[0].keypoints.size(), b.name.c_str(),
-              features[1].keypoints.size());
-  std::printf("putative matches (ratio %.2f): %d\n", match.max_ratio, verified->num_putative);
-  std::printf("F-inliers (threshold %.2f px): %d, H-inliers among them (%.2f px): %d, ratio %.2f\n",
-              g.f_threshold_px, g.num_f_inliers, g.h_threshold_px, g.num_h_inliers, g.h_to_f_inlier_ratio);
+                features[1].keypoints.size());
+    std::printf("putative matches (ratio %.2f): %d\n", match.max_ratio, verified->num_putative);
+    std::printf("F-inliers (threshold %.2f px): %d, H-inliers among them (%.2f px): %d, ratio %.2f\n", g.f_threshold_px,
+                g.num_f_inliers, g.h_threshold_px, g.num_h_inliers, g.h_to_f_inlier_ratio);
     std::printf("result: %s%s%s\n", TwoViewConfigName(g.config), g.reason.empty() ? "" : " - ", g.reason.c_str());
   }
   if (args.Has("pairs")) {

@@ -87,10 +87,11 @@ int RunMesh(int argc, char** argv, int first) {
   }
   if (r.normals_estimated) std::printf("normals: estimated\n");
   const PoissonReport& p = r.poisson;
-  std::printf("poisson: depth %d, %d grid nodes, %d unknowns, %d CG iterations; octree %.2fs, solve %.2fs, "
-              "extract %.2fs, trim %.2fs\n",
-              r.depth, p.octree_nodes, p.unknowns, p.solver_iterations, p.seconds_octree, p.seconds_solve,
-              p.seconds_extract, p.seconds_trim);
+  std::printf(
+      "poisson: depth %d, %d grid nodes, %d unknowns, %d CG iterations; octree %.2fs, solve %.2fs, "
+      "extract %.2fs, trim %.2fs\n",
+      r.depth, p.octree_nodes, p.unknowns, p.solver_iterations, p.seconds_octree, p.seconds_solve, p.seconds_extract,
+      p.seconds_trim);
   if (p.cells_skipped > 0) {
     std::fprintf(stderr, "warning: %zu crossing cells left open at the edge of the solved band\n", p.cells_skipped);
   }

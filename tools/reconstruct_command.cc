@@ -54,8 +54,8 @@ Status ReadMapperArgs(const Args& args, MapperOptions* mapper) {
   if (args.Has("fixed-distortion")) mapper->refine_distortion = false;
   RECONAR_ASSIGN_OR_RETURN(mapper->max_reprojection_error_px,
                            args.GetDouble("max-error", mapper->max_reprojection_error_px, 0.1, 100.0));
-  mapper->registration_max_error_px = args.Has("max-error") ? mapper->max_reprojection_error_px
-                                                            : mapper->registration_max_error_px;
+  mapper->registration_max_error_px =
+      args.Has("max-error") ? mapper->max_reprojection_error_px : mapper->registration_max_error_px;
   return Status::Ok();
 }
 
@@ -112,10 +112,10 @@ void PrintReport(const ReconstructReport& report, const Project& project) {
   }
   const Table1& t = report.table1;
   if (t.images > 0) {
-    std::printf("model: %d of %d images registered, %d sparse points; focal ratio (focal / long side) mean %.4f, "
-                "rmse %.4f (35 mm equivalent %.1f mm)\n",
-                t.registered, t.images, t.sparse_points, t.mean_focal_ratio, t.rmse_focal_ratio,
-                t.focal_35mm_equivalent_mm);
+    std::printf(
+        "model: %d of %d images registered, %d sparse points; focal ratio (focal / long side) mean %.4f, "
+        "rmse %.4f (35 mm equivalent %.1f mm)\n",
+        t.registered, t.images, t.sparse_points, t.mean_focal_ratio, t.rmse_focal_ratio, t.focal_35mm_equivalent_mm);
   }
   if (t.dense_points > 0) std::printf("dense: %lld points\n", t.dense_points);
   if (t.mesh_faces > 0) std::printf("mesh: %lld vertices, %lld faces\n", t.mesh_vertices, t.mesh_faces);

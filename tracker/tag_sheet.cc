@@ -59,7 +59,9 @@ std::string Caption(const TagSheet& sheet, const SheetTag& bitmap) {
          " mm";
 }
 
-std::string ScaleBarCaption() { return "this bar must measure " + Number(kScaleBarMm) + " mm: print at 100 %, no fit-to-page"; }
+std::string ScaleBarCaption() {
+  return "this bar must measure " + Number(kScaleBarMm) + " mm: print at 100 %, no fit-to-page";
+}
 
 }  // namespace
 
@@ -81,8 +83,8 @@ Result<TagSheet> LayoutTagSheet(std::vector<SheetTag> bitmaps, const TagSheetOpt
   const int rows = static_cast<int>(std::floor((usable_height + options.gap_mm) / cell_height));
   if (columns < 1 || rows < 1) {
     return InvalidArgument("a " + Number(options.tag_size_mm) + " mm tag with its quiet zone does not fit on a " +
-                           Number(options.page_width_mm) + " x " + Number(options.page_height_mm) +
-                           " mm page with " + Number(options.margin_mm) + " mm margins");
+                           Number(options.page_width_mm) + " x " + Number(options.page_height_mm) + " mm page with " +
+                           Number(options.margin_mm) + " mm margins");
   }
   const size_t per_page = static_cast<size_t>(columns) * rows;
   for (size_t i = 0; i < sheet.bitmaps.size(); ++i) {
@@ -113,8 +115,8 @@ std::string RenderSvgPage(const TagSheet& sheet, size_t page) {
   std::ostringstream svg;
   svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Number(o.page_width_mm) << "mm\" height=\""
-      << Number(o.page_height_mm) << "mm\" viewBox=\"0 0 " << Number(o.page_width_mm) << ' '
-      << Number(o.page_height_mm) << "\" shape-rendering=\"crispEdges\">\n"
+      << Number(o.page_height_mm) << "mm\" viewBox=\"0 0 " << Number(o.page_width_mm) << ' ' << Number(o.page_height_mm)
+      << "\" shape-rendering=\"crispEdges\">\n"
       << "<rect x=\"0\" y=\"0\" width=\"" << Number(o.page_width_mm) << "\" height=\"" << Number(o.page_height_mm)
       << "\" fill=\"#fff\"/>\n";
   for (const PlacedTag& placed : sheet.pages[page].tags) {

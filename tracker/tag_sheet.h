@@ -23,7 +23,7 @@ struct TagSheetOptions {
   double page_width_mm = 210.0;  // A4 portrait
   double page_height_mm = 297.0;
   double margin_mm = 10.0;
-  double gap_mm = 8.0;           // between neighbouring bitmaps (their quiet zones add to it)
+  double gap_mm = 8.0;  // between neighbouring bitmaps (their quiet zones add to it)
   std::string family = "tag36h11";
 };
 

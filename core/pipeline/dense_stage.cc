@@ -205,9 +205,9 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
       for (int id : cluster) missing += cache.count(id) == 0 ? 1 : 0;
       std::unique_ptr<Progress> progress;
       if (options.show_progress && missing > 0) {
-        progress = std::make_unique<Progress>(cluster_label + "undistort " + std::to_string(missing) + " of " +
-                                                  std::to_string(cluster.size()) + " views",
-                                              missing);
+        progress = std::make_unique<Progress>(
+            cluster_label + "undistort " + std::to_string(missing) + " of " + std::to_string(cluster.size()) + " views",
+            missing);
       }
       RECONAR_RETURN_IF_ERROR(LoadClusterViews(cluster, model, paths, report.level, &pool, progress.get(), &cache,
                                                &report.views_undistorted));

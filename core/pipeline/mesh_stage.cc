@@ -87,8 +87,7 @@ Result<MeshStageReport> MeshPointsFile(const std::string& points_path, const std
     report.median_spacing = MedianSpacing(points.positions);
     const double cube = options.poisson.scale * static_cast<double>((hi - lo).maxCoeff());
     if (report.median_spacing > 0.0 && cube > 0.0) {
-      report.spacing_depth =
-          std::max(kMinDepth, static_cast<int>(std::ceil(std::log2(cube / report.median_spacing))));
+      report.spacing_depth = std::max(kMinDepth, static_cast<int>(std::ceil(std::log2(cube / report.median_spacing))));
       report.depth = std::min(report.depth, report.spacing_depth);
     }
   }
@@ -166,7 +165,8 @@ std::string MeshReportJson(const MeshStageReport& report) {
   json.BeginObject();
   json.Key("points").Int(static_cast<long long>(report.points));
   if (report.outliers.input_points > 0) {
-    json.Key("outliers_removed").Int(static_cast<long long>(report.outliers.input_points - report.outliers.kept_points()));
+    json.Key("outliers_removed")
+        .Int(static_cast<long long>(report.outliers.input_points - report.outliers.kept_points()));
   }
   json.Key("normals_estimated").Bool(report.normals_estimated);
   json.Key("requested_depth").Int(report.requested_depth).Key("median_spacing").Double(report.median_spacing);

@@ -32,7 +32,7 @@ struct MeshStageOptions {
   size_t max_faces = 0;                                             // 0: no limit
   // The depth no finer than the points' spacing, the trim at most depth - 1; false: as given.
   bool depth_from_spacing = true;
-  bool remove_outliers = false;  // drop isolated points and small floating pieces first
+  bool remove_outliers = false;   // drop isolated points and small floating pieces first
   OutlierFilterOptions outliers;  // its num_threads 0 takes poisson.num_threads
   bool estimate_normals = false;  // from the nearest neighbours, replacing the points' own
 
@@ -47,8 +47,8 @@ struct MeshStageReport {
   bool depth_lowered_for_budget = false;
   size_t pilot_peak_bytes = 0;      // above the baseline, at the pilot depth
   size_t estimated_peak_bytes = 0;  // for the depth used
-  size_t points = 0;             // read
-  OutlierFilterReport outliers;  // with remove_outliers
+  size_t points = 0;                // read
+  OutlierFilterReport outliers;     // with remove_outliers
   bool normals_estimated = false;
   PoissonReport poisson;
   bool simplified = false;  // over max_faces: `simplify` says from what to what

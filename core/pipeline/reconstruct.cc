@@ -210,7 +210,8 @@ Status ReconstructOptions::Check() const {
   if (tag_size_m < 0.0 || !std::isfinite(tag_size_m)) return InvalidArgument("the tag size must be positive");
   if (tag_size_m > 0.0 && !detect_tags) return InvalidArgument("reconstruct: tags requested without a tag detector");
   if (memory_budget_bytes < (64u << 20)) return InvalidArgument("the memory budget must be at least 64 MiB");
-  if (!(sfm.mapper.max_reprojection_error_px > 0.0)) return InvalidArgument("the maximum reprojection error must be positive");
+  if (!(sfm.mapper.max_reprojection_error_px > 0.0))
+    return InvalidArgument("the maximum reprojection error must be positive");
   RECONAR_RETURN_IF_ERROR(dense.Check());
   return mesh.Check();
 }

@@ -292,7 +292,8 @@ TEST(ReconstructCli, SfmAndReconstructReuseEachOthersStages) {
   const struct {
     const char* name;
     std::string first, second;
-  } orders[] = {{"sfm_first", "sfm", "reconstruct --stages sparse"}, {"reconstruct_first", "reconstruct --stages sparse", "sfm"}};
+  } orders[] = {{"sfm_first", "sfm", "reconstruct --stages sparse"},
+                {"reconstruct_first", "reconstruct --stages sparse", "sfm"}};
   for (const auto& order : orders) {
     const std::string project = dir + "/" + order.name;
     const CommandRun first = RunReconar(order.first + " " + data + " " + project + " --threads 2 --no-preview");
@@ -306,7 +307,8 @@ TEST(ReconstructCli, SfmAndReconstructReuseEachOthersStages) {
     ASSERT_EQ(second.exit_code, 0) << second.output;
     for (const char* stage : {"features ", "matching ", "mapping  "}) {
       EXPECT_NE(second.output.find(std::string(stage) + " reused"), std::string::npos)
-          << order.name << ": " << stage << "\n" << second.output;
+          << order.name << ": " << stage << "\n"
+          << second.output;
     }
     EXPECT_EQ(second.output.find("done"), std::string::npos) << order.name << ": nothing redone\n" << second.output;
     EXPECT_NE(second.output.find("of 16 images registered"), std::string::npos) << second.output;
