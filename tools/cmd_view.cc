@@ -3,12 +3,11 @@
 // render/ar/ar_view.h, this command parses, calls and prints.
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
-
-#include <Eigen/Geometry>
 
 #include "render/ar/ar_project.h"
 #include "render/ar/ar_view.h"
@@ -119,7 +118,8 @@ int RunView(int argc, char** argv, int first) {
     std::fputs(kTrackerOptionsHelp, stdout);
     return 0;
   }
-  if (!args.positionals().empty() || args.Has("model") == args.Has("project") || args.Has("camera") == args.Has("frames")) {
+  if (!args.positionals().empty() || args.Has("model") == args.Has("project") ||
+      args.Has("camera") == args.Has("frames")) {
     std::fputs(kHelp, stderr);
     std::fputs(kTrackerOptionsHelp, stderr);
     return 2;

@@ -1,5 +1,6 @@
 #include "core/sfm/tag_layout.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -7,8 +8,6 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
-
-#include <Eigen/Geometry>
 
 namespace reconar {
 
@@ -20,8 +19,8 @@ Status TagLayout::Add(const LayoutTag& tag) {
   if (!tag.layout_from_tag.rotation.allFinite() || !tag.layout_from_tag.translation.allFinite()) {
     return InvalidArgument("tag " + std::to_string(tag.id) + ": pose is not finite");
   }
-  const auto it = std::lower_bound(tags_.begin(), tags_.end(), tag.id,
-                                   [](const LayoutTag& a, int id) { return a.id < id; });
+  const auto it =
+      std::lower_bound(tags_.begin(), tags_.end(), tag.id, [](const LayoutTag& a, int id) { return a.id < id; });
   if (it != tags_.end() && it->id == tag.id) {
     return InvalidArgument("tag " + std::to_string(tag.id) + " is listed twice");
   }
@@ -67,8 +66,10 @@ Result<TagLayout> ParseTagLayout(const std::string& text, const std::string& nam
       values.push_back(value);
     }
     if (values.size() != 4 && values.size() != 5 && values.size() != 9) {
-      return CorruptData(where + "expected 'id size x y z qw qx qy qz' (9 fields) or 'id size cx cy [angle_deg]' "
-                                 "(4 or 5 fields), got " + std::to_string(values.size()) + " fields");
+      return CorruptData(where +
+                         "expected 'id size x y z qw qx qy qz' (9 fields) or 'id size cx cy [angle_deg]' "
+                         "(4 or 5 fields), got " +
+                         std::to_string(values.size()) + " fields");
     }
     if (values[0] != std::floor(values[0]) || values[0] < 0 || values[0] > std::numeric_limits<int>::max()) {
       return CorruptData(where + "tag id must be a non-negative integer, got " + tokens[0]);

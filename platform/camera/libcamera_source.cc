@@ -249,9 +249,8 @@ Result<std::unique_ptr<LibcameraFrameSource>> LibcameraFrameSource::Open(int cam
 Result<Frame> LibcameraFrameSource::NextFrame() {
   Impl& impl = *impl_;
   if (impl.buffers->all_held()) {
-    return CameraError(StatusCode::kFailedPrecondition,
-                       impl.name + ": all " + std::to_string(impl.buffers->count()) +
-                           " frame buffers are held; release one first");
+    return CameraError(StatusCode::kFailedPrecondition, impl.name + ": all " + std::to_string(impl.buffers->count()) +
+                                                            " frame buffers are held; release one first");
   }
   for (;;) {
     libcamera::Request* request = nullptr;

@@ -227,8 +227,8 @@ Status V4L2FrameSource::DeviceError(StatusCode code, const std::string& reason) 
 
 Result<Frame> V4L2FrameSource::NextFrame() {
   if (buffers_.all_held()) {
-    return DeviceError(StatusCode::kFailedPrecondition, "all " + std::to_string(buffers_.count()) +
-                                                            " frame buffers are held; release one first");
+    return DeviceError(StatusCode::kFailedPrecondition,
+                       "all " + std::to_string(buffers_.count()) + " frame buffers are held; release one first");
   }
   v4l2_buffer buffer{};
   for (;;) {

@@ -14,7 +14,8 @@ namespace reconar {
 Result<ArProject> LoadArProject(const std::string& dir) {
   const Project project(dir);
   ArProject scene;
-  for (const std::string& path : {project.MeshDir() + "/mesh.ply", project.DensePointsPath(), project.SparseDir() + "/points.ply"}) {
+  for (const std::string& path :
+       {project.MeshDir() + "/mesh.ply", project.DensePointsPath(), project.SparseDir() + "/points.ply"}) {
     scene.model_path = path;
     std::error_code error;
     if (std::filesystem::exists(path, error)) break;
@@ -43,11 +44,11 @@ Result<ArProject> LoadArProject(const std::string& dir) {
 
 Result<CameraIntrinsics> ScaleIntrinsicsToFrame(const CameraIntrinsics& photo, int width, int height) {
   if (photo.width == width && photo.height == height) return photo;
-  if (photo.width <= 0 || std::abs(static_cast<double>(photo.width) * height - static_cast<double>(photo.height) * width) >
-                              0.01 * photo.width * height) {
-    return InvalidArgument("the project's photos are " + std::to_string(photo.width) + "x" + std::to_string(photo.height) +
-                           ", the video " + std::to_string(width) + "x" + std::to_string(height) +
-                           ": pass --intrinsics for this camera");
+  if (photo.width <= 0 || std::abs(static_cast<double>(photo.width) * height -
+                                   static_cast<double>(photo.height) * width) > 0.01 * photo.width * height) {
+    return InvalidArgument("the project's photos are " + std::to_string(photo.width) + "x" +
+                           std::to_string(photo.height) + ", the video " + std::to_string(width) + "x" +
+                           std::to_string(height) + ": pass --intrinsics for this camera");
   }
   const double s = static_cast<double>(width) / photo.width;
   CameraIntrinsics scaled = photo;

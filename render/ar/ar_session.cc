@@ -19,8 +19,9 @@ Result<std::unique_ptr<ArSession>> ArSession::Open(const ArSessionOptions& optio
   session->height_ = session->frame_->height;
   TagPoseSourceOptions pose_options = options.pose;
   if (options.scale_intrinsics_to_video) {
-    RECONAR_ASSIGN_OR_RETURN(pose_options.tracker.intrinsics,
-                             ScaleIntrinsicsToFrame(pose_options.tracker.intrinsics, session->width_, session->height_));
+    RECONAR_ASSIGN_OR_RETURN(
+        pose_options.tracker.intrinsics,
+        ScaleIntrinsicsToFrame(pose_options.tracker.intrinsics, session->width_, session->height_));
   }
   RECONAR_ASSIGN_OR_RETURN(session->pose_source_, TagPoseSource::Create(pose_options));
   return session;

@@ -89,14 +89,13 @@ Status ArView::Draw(bool* drawn_model) {
   const WorldPose& pose = session_->pose();
   if (!pose.found) return Status::Ok();
   const CameraIntrinsics& intrinsics = session_->intrinsics();
-  const Eigen::Matrix4d cam_from_model = options_.placement ? CamFromModel(pose.cam_from_world, *options_.placement)
-                                                            : pose.cam_from_world.Matrix();
+  const Eigen::Matrix4d cam_from_model =
+      options_.placement ? CamFromModel(pose.cam_from_world, *options_.placement) : pose.cam_from_world.Matrix();
   RECONAR_RETURN_IF_ERROR(renderer_->DrawMesh(model_, intrinsics, cam_from_model, options_.style));
   *drawn_model = true;
   if (!options_.draw_axes) return Status::Ok();
   for (const LayoutTag& tag : pose.markers) {
-    RECONAR_RETURN_IF_ERROR(
-        renderer_->DrawTagAxes(intrinsics, pose.cam_from_world * tag.layout_from_tag, tag.size));
+    RECONAR_RETURN_IF_ERROR(renderer_->DrawTagAxes(intrinsics, pose.cam_from_world * tag.layout_from_tag, tag.size));
   }
   return Status::Ok();
 }

@@ -21,7 +21,8 @@ namespace reconar {
 
 struct ArViewOptions {
   ArSessionOptions session;  // frames.want_rgb is forced on
-  std::string out_dir;       // non-empty: write OUT_DIR/<frame>.png (headless) instead of a window
+  // Non-empty: write OUT_DIR/<frame>.png (headless) instead of showing a window.
+  std::string out_dir;
   EglContextKind window = EglContextKind::kAuto;  // when out_dir is empty
   // world_from_model: the model's place in the world (a tag's frame); nullopt: the model is already
   // in the world frame (a project's model, in metres).
