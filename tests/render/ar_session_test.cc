@@ -19,16 +19,6 @@ namespace {
 constexpr double kTagSize = 0.08;
 constexpr int kFrames = 5;
 
-CameraIntrinsics Camera() {
-  CameraIntrinsics camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 600.0;
-  camera.cx = 320.0;
-  camera.cy = 240.0;
-  return camera;
-}
-
 Rigid3 CamFromTag(int frame) {
   Rigid3 pose;
   pose.rotation =
@@ -46,7 +36,7 @@ std::string WriteFrames() {
     tag.id = 3;
     tag.size = kTagSize;
     tag.cam_from_tag = CamFromTag(i);
-    const Image<uint8_t> image = testing::RenderTags(&tag, 1, Camera(), testing::SyntheticRenderOptions());
+    const Image<uint8_t> image = testing::RenderTags(&tag, 1, testing::TestCamera(), testing::SyntheticRenderOptions());
     char name[32];
     std::snprintf(name, sizeof(name), "/frame%04d.png", i);
     EXPECT_TRUE(WritePng(dir + name, image.view(), 1).ok());
@@ -58,7 +48,7 @@ ArSessionOptions Options(const std::string& dir) {
   ArSessionOptions options;
   options.source = dir;
   options.frames.want_rgb = false;
-  options.pose.tracker.intrinsics = Camera();
+  options.pose.tracker.intrinsics = testing::TestCamera();
   options.pose.tracker.tag_size = kTagSize;
   return options;
 }
@@ -105,7 +95,7 @@ TEST(ArSessionTest, MaxFramesStopsEarly) {
 // The project's camera (photos twice the video's size) is scaled to the first frame.
 TEST(ArSessionTest, PhotoCameraIsScaledToTheVideo) {
   ArSessionOptions options = Options(WriteFrames());
-  CameraIntrinsics photo = Camera();
+  CameraIntrinsics photo = testing::TestCamera();
   photo.width = 1280;
   photo.height = 960;
   photo.fx = photo.fy = 1200.0;

@@ -15,16 +15,6 @@ namespace {
 
 constexpr double kTagSize = 0.07;
 
-CameraIntrinsics Camera() {
-  CameraIntrinsics camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 600.0;
-  camera.cx = 320.0;
-  camera.cy = 240.0;
-  return camera;
-}
-
 // cam_from_tag of tag 4 + i in frame `frame`: two tags side by side on one plane (a board whose
 // layout is tags 4 and 5, 0.2 m apart along x) moving slowly.
 Rigid3 CamFromTag(int i, int frame) {
@@ -47,7 +37,7 @@ std::vector<Image<uint8_t>> Frames(int count) {
       tags[i].size = kTagSize;
       tags[i].cam_from_tag = CamFromTag(i, frame);
     }
-    frames.push_back(testing::RenderTags(tags, 2, Camera(), testing::SyntheticRenderOptions()));
+    frames.push_back(testing::RenderTags(tags, 2, testing::TestCamera(), testing::SyntheticRenderOptions()));
   }
   return frames;
 }
@@ -66,7 +56,7 @@ TagLayout Board() {
 
 TagPoseSourceOptions Options() {
   TagPoseSourceOptions options;
-  options.tracker.intrinsics = Camera();
+  options.tracker.intrinsics = testing::TestCamera();
   options.tracker.tag_size = kTagSize;
   return options;
 }
