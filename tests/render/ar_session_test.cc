@@ -9,7 +9,9 @@
 #include <string>
 
 #include "core/io/image_write.h"
+#include "platform/camera/recorded_frames.h"
 #include "render/ar/ar_project.h"
+#include "tests/support/allocation_counter.h"
 #include "tests/support/run_command.h"
 #include "tests/tracker/synthetic_tag_image.h"
 
@@ -112,6 +114,50 @@ TEST(ArSessionTest, PhotoCameraIsScaledToTheVideo) {
   EXPECT_EQ(k.cy, 240.0);
   photo.width = 1000;  // another aspect ratio
   EXPECT_EQ(ScaleIntrinsicsToFrame(photo, 640, 480).status().code(), StatusCode::kInvalidArgument);
+}
+
+// The whole loop (a raw recording's frames, tracking, the world pose) makes no heap allocation per
+// frame once running.
+TEST(ArSessionTest, SteadyStateStepDoesNotAllocate) {
+  const std::string path = testing::MakeTestDirectory("reconar_ar_session_raw") + "/tags.frames";
+  constexpr int kRawFrames = 16;
+  {
+    auto writer = RecordedFramesWriter::Create(path);
+    ASSERT_TRUE(writer.ok()) << writer.status().ToString();
+    for (int i = 0; i < kRawFrames; ++i) {
+      testing::SyntheticTag tag;
+      tag.id = 3;
+      tag.size = kTagSize;
+      tag.cam_from_tag = CamFromTag(i % kFrames);
+      const Image<uint8_t> image =
+          testing::RenderTags(&tag, 1, testing::TestCamera(), testing::SyntheticRenderOptions());
+      RawFrame raw;
+      raw.layout = RawFrameLayout{PixelFormat::kGray8, image.width(), image.height(),
+                                  static_cast<uint32_t>(image.view().stride), YuvRange::kFull};
+      raw.data = image.view().row(0);
+      raw.size = static_cast<size_t>(image.view().stride) * image.height();
+      ASSERT_TRUE((*writer)->Append(raw, i).ok());
+    }
+    ASSERT_TRUE((*writer)->Finish().ok());
+  }
+  ArSessionOptions options = Options(path);
+  options.pose.tracker.full_frame_interval = 5;
+  auto session = ArSession::Open(options);
+  ASSERT_TRUE(session.ok()) << session.status().ToString();
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE((*session)->Step().ok());
+  long allocations = -1;
+  int found = 0;
+  {
+    testing::NoAllocationScope scope;
+    for (int i = 3; i < kRawFrames; ++i) {
+      const Result<bool> more = (*session)->Step();
+      if (!more.ok() || !*more) break;
+      found += (*session)->pose().found;
+    }
+    allocations = scope.allocations();
+  }
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(found, kRawFrames - 3);
 }
 
 TEST(ArSessionTest, BadSourceIsAnError) {
