@@ -76,7 +76,8 @@ struct Frame {
 class FrameSource;
 
 // One frame held from a FrameSource; gives its buffer back on destruction, reset() or move
-// assignment. Empty after a move or reset() (operator bool is false; * and -> are then invalid).
+// assignment. Empty after a move or reset() (operator bool is false; * and -> are then a
+// programmer error, RECONAR_CHECK).
 // Makes no allocation.
 class FrameHandle {
  public:
@@ -87,8 +88,11 @@ class FrameHandle {
   FrameHandle& operator=(const FrameHandle&) = delete;
   ~FrameHandle() { reset(); }
 
-  const Frame& operator*() const { return frame_; }
-  const Frame* operator->() const { return &frame_; }
+  const Frame& operator*() const {
+    RECONAR_CHECK(source_ != nullptr) << "an empty FrameHandle has no frame";
+    return frame_;
+  }
+  const Frame* operator->() const { return &**this; }
   explicit operator bool() const { return source_ != nullptr; }
   // Gives the buffer back now; the views become invalid.
   void reset();

@@ -138,6 +138,12 @@ TEST(RecordedFrames, FrameHandlesGiveTheirBufferBack) {
   EXPECT_EQ((*third)->index, 2);
 }
 
+TEST(RecordedFramesDeathTest, AnEmptyHandleHasNoFrame) {
+  FrameHandle empty;
+  EXPECT_FALSE(empty);
+  EXPECT_DEATH((void)empty->index, "an empty FrameHandle has no frame");
+}
+
 TEST(RecordedFramesDeathTest, DestroyingASourceWhileAFrameIsHeldIsAProgrammerError) {
   EXPECT_DEATH(
       {
