@@ -37,7 +37,7 @@ class Project {
   std::string ReportPath() const { return root_ + "/report.json"; }
   std::string TagDetectionsPath() const { return root_ + "/tags/detections.txt"; }  // core/sfm/tag_observations.h
   std::string TagsJsonPath() const { return root_ + "/tags.json"; }  // core/sfm/tag_registration.h
-  // The registered tags as a tracker/tag_layout.h layout (world_from_tag per id), for `track --layout`.
+  // The registered tags as a core/sfm/tag_layout.h layout (world_from_tag per id), for `track --layout`.
   std::string TagLayoutPath() const { return root_ + "/tags.layout"; }
   std::string DensePointsPath() const { return root_ + "/dense/points.ply"; }
   std::string MeshDir() const { return root_ + "/mesh"; }
