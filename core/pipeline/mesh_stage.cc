@@ -128,12 +128,8 @@ Result<MeshStageReport> MeshPointsFile(const std::string& points_path, const std
   auto surface = ReconstructPoissonSurface(points, poisson, &report.poisson);
   if (!surface.ok()) return surface.status().WithContext(points_path);
   Mesh mesh = std::move(*surface);
-  if (options.max_faces > 0 && mesh.triangles.size() > options.max_faces) {
-    SimplifyOptions simplify;
-    simplify.target_faces = options.max_faces;
-    RECONAR_ASSIGN_OR_RETURN(report.simplify, SimplifyMesh(simplify, &mesh));
-    report.simplified = true;
-  }
+  RECONAR_ASSIGN_OR_RETURN(report.simplify, SimplifyToFaceBudget(options.max_faces, &mesh));
+  report.simplified = report.simplify.simplified;
   report.vertices = mesh.positions.size();
   report.faces = mesh.triangles.size();
   for (const std::string& path : mesh_paths) {
