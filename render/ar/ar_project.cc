@@ -64,13 +64,9 @@ Result<CameraIntrinsics> ScaleIntrinsicsToFrame(const CameraIntrinsics& photo, i
 Result<ArModel> LoadArModel(const std::string& path, size_t max_faces) {
   ArModel model;
   RECONAR_ASSIGN_OR_RETURN(model.mesh, ReadMeshFile(path));
-  if (max_faces > 0 && model.mesh.triangles.size() > max_faces) {
-    SimplifyOptions simplify;
-    simplify.target_faces = max_faces;
-    auto simplified = SimplifyMesh(simplify, &model.mesh);
-    if (!simplified.ok()) return simplified.status().WithContext(path);
-    model.simplified = *simplified;
-  }
+  auto simplified = SimplifyToFaceBudget(max_faces, &model.mesh);
+  if (!simplified.ok()) return simplified.status().WithContext(path);
+  if (simplified->simplified) model.simplified = *simplified;
   return model;
 }
 
