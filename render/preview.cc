@@ -4,8 +4,10 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/io/image_write.h"
 #include "core/math/camera_intrinsics.h"
 #include "core/math/rigid3.h"
+#include "core/mesh/mesh_file.h"
 #include "platform/egl/egl_context.h"
 #include "render/mesh_drawable.h"
 #include "render/overlay_renderer.h"
@@ -99,6 +101,17 @@ Image<uint8_t> TileImages(const std::vector<Image<uint8_t>>& views, int columns)
       std::memcpy(tiled.row(y0 + y) + 3 * x0, views[i].row(y), 3 * static_cast<size_t>(width));
   }
   return tiled;
+}
+
+Status WriteModelPreview(const std::string& model_path, const Eigen::Vector3d& up, const std::string& png_path) {
+  RECONAR_ASSIGN_OR_RETURN(const Mesh mesh, ReadMeshFile(model_path));
+  PreviewOptions preview;
+  preview.width = 480;
+  preview.height = 360;
+  preview.up = up;
+  preview.directions = PreviewOptions::Ring(5, 20.0);
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<Image<uint8_t>> views, RenderPreviewViews(mesh, preview));
+  return WritePng(png_path, TileImages(views, 3).view(), 3);
 }
 
 }  // namespace reconar

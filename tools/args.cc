@@ -1,7 +1,7 @@
 #include "tools/args.h"
 
+#include <algorithm>
 #include <cctype>
-
 #include <cstdio>
 #include <cstdlib>
 
@@ -71,6 +71,39 @@ Result<double> Args::GetDouble(const std::string& name, double fallback, double 
                            std::to_string(max) + "], got '" + text + "'");
   }
   return value;
+}
+
+Result<size_t> Args::GetMemoryBudget(size_t fallback) const {
+  if (!Has("memory-budget")) return fallback;
+  const std::string text = Get("memory-budget");
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  const std::string unit = end;
+  double mib = value;
+  if (unit == "G" || unit == "g" || unit == "GiB" || unit == "GB") {
+    mib = value * 1024.0;
+  } else if (unit == "K" || unit == "k" || unit == "KiB" || unit == "KB") {
+    mib = value / 1024.0;
+  } else if (!(unit.empty() || unit == "M" || unit == "m" || unit == "MiB" || unit == "MB")) {
+    return InvalidArgument("--memory-budget: '" + text + "' is not a size (MiB, or a number with K, M or G)");
+  }
+  if (text.empty() || end == text.c_str() || !(mib >= 1.0) || mib > 1e7) {
+    return InvalidArgument("--memory-budget must be a size of at least 1M, got '" + text + "'");
+  }
+  return static_cast<size_t>(mib * (1 << 20));
+}
+
+Result<int> Args::GetThreads() const { return GetInt("threads", 0, 0, 1024); }
+
+std::vector<std::string> SplitCommas(const std::string& text) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    if (comma > start) parts.push_back(text.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return parts;
 }
 
 std::string LowercaseExtension(const std::string& path) {

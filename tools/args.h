@@ -1,6 +1,13 @@
 #pragma once
 // Minimal command-line parsing for the reconar subcommands: positionals, "--name value" options
 // and "--flag" switches, each declared up front so that unknown options are usage errors.
+// The options several commands share mean the same everywhere and are read here:
+//   --memory-budget SIZE   GetMemoryBudget: a size with K, M or G (KiB, MiB, GiB; a plain number
+//                          is MiB; at least 1M, the stages set their own minimum); default
+//                          kDefaultMemoryBudgetBytes (2560M, core/pipeline/project.h)
+//   --threads N            GetThreads: worker threads, 0 or absent: one per core
+//   --json                 the command's result as JSON on stdout instead of its summary
+//   --help, -h             the command's usage on stdout
 #include <map>
 #include <set>
 #include <string>
@@ -22,12 +29,19 @@ class Args {
   // InvalidArgument naming the option when the value is not a number in [min, max].
   Result<int> GetInt(const std::string& name, int fallback, int min, int max) const;
   Result<double> GetDouble(const std::string& name, double fallback, double min, double max) const;
+  // --memory-budget in bytes (see above); `fallback` when absent.
+  Result<size_t> GetMemoryBudget(size_t fallback) const;
+  // --threads: 0 (one per core) when absent.
+  Result<int> GetThreads() const;
 
  private:
   std::set<std::string> valued_, flags_;
   std::vector<std::string> positionals_;
   std::map<std::string, std::string> values_;
 };
+
+// "a,b,,c" -> {"a", "b", "c"}.
+std::vector<std::string> SplitCommas(const std::string& text);
 
 // The file name's extension in lower case, dot included ("sheet.PDF" -> ".pdf"); "" without one.
 std::string LowercaseExtension(const std::string& path);

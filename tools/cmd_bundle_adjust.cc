@@ -103,7 +103,7 @@ int RunBundleAdjust(int argc, char** argv, int first) {
   auto max_iterations = args.GetInt("max-iterations", options.max_iterations, 1, 1000000);
   if (!max_iterations.ok()) return Fail(max_iterations.status());
   options.max_iterations = *max_iterations;
-  auto threads = args.GetInt("threads", 0, 0, 1024);
+  auto threads = args.GetThreads();
   if (!threads.ok()) return Fail(threads.status());
   options.num_threads = *threads;
   // Check the solver name before the (possibly long) read; `auto` is resolved after it.

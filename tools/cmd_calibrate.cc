@@ -5,13 +5,10 @@
 #include <vector>
 
 #include "core/base/json_writer.h"
-#include "core/base/progress.h"
-#include "core/io/image_io.h"
 #include "core/pipeline/project.h"
 #include "tools/commands.h"
 #include "tracker/calibration.h"
-#include "tracker/tag_detector.h"
-#include "tracker/tag_layout.h"
+#include "tracker/calibration_photos.h"
 
 namespace reconar::tools {
 namespace {
@@ -46,15 +43,13 @@ int RunCalibrate(int argc, char** argv, int first) {
   }
   auto tag_size = args.GetDouble("tag-size", 0.0, 1e-4, 100.0);
   if (!tag_size.ok()) return Fail(tag_size.status());
-  TagDetectorOptions detector_options;
+  CalibrationPhotoOptions photo_options;
   auto family = ParseTagFamily(args.Get("family", "tag36h11"));
   if (!family.ok()) return Fail(family.status());
-  detector_options.family = *family;
+  photo_options.detector.family = *family;
   auto decimate = args.GetDouble("decimate", 1.0, 1.0, 8.0);
   if (!decimate.ok()) return Fail(decimate.status());
-  detector_options.quad_decimate = static_cast<float>(*decimate);
-  auto detector = TagDetector::Create(detector_options);
-  if (!detector.ok()) return Fail(detector.status());
+  photo_options.detector.quad_decimate = static_cast<float>(*decimate);
   auto paths = CollectImagePaths(args.positionals());
   if (!paths.ok()) return Fail(paths.status());
 
@@ -65,20 +60,10 @@ int RunCalibrate(int argc, char** argv, int first) {
     if (!layout.ok()) return Fail(layout.status());
     observations.layout = std::move(*layout);
   }
-  TagDetectionList detections(256);
   int total_tags = 0;
-  Progress progress("calibrate: detecting tags", paths->size());
-  for (size_t i = 0; i < paths->size(); ++i) {
-    const std::string& path = (*paths)[i];
-    auto image = ReadImage(path);
-    if (!image.ok()) return Fail(image.status());
-    const Image<uint8_t> gray = ToGray8(image->rgb);
-    if (Status s = (*detector)->Detect(gray.view(), &detections); !s.ok()) return Fail(s.WithContext(path));
-    total_tags += detections.size();
-    progress.Advance();
-    observations.images.push_back(MakeCalibrationImage(path, gray.width(), gray.height(), detections));
-  }
-  progress.Finish();
+  auto images = DetectCalibrationImages(*paths, photo_options, &total_tags);
+  if (!images.ok()) return Fail(images.status());
+  observations.images = std::move(*images);
 
   CalibrationOptions options;
   options.fix_principal_point = args.Has("fix-principal-point");

@@ -23,7 +23,7 @@ constexpr char kHelp[] =
     "  --level 0|1|2|auto     image resolution: full, half, quarter; auto (default) takes the finest\n"
     "                         whose memory estimate fits --memory-budget\n"
     "  --max-cluster-size N   images per PMVS run (default 20; smaller needs less memory)\n"
-    "  --memory-budget MiB    memory the run may use (default 3072)\n"
+    "  --memory-budget SIZE   memory the run may use: MiB, or 512K, 1500M, 1G (default 2560M)\n"
     "  --keep-outliers        keep isolated points and small floating pieces (removed by default)\n"
     "  --threads N            worker threads (default: one per core)\n"
     "  --json                 print the report as JSON instead of a summary\n";
@@ -91,12 +91,12 @@ int RunDense(int argc, char** argv, int first) {
   auto cluster_size = args.GetInt("max-cluster-size", options.clustering.max_cluster_size, 3, 10000);
   if (!cluster_size.ok()) return Fail(cluster_size.status());
   options.clustering.max_cluster_size = *cluster_size;
-  auto threads = args.GetInt("threads", 0, 0, 1024);
+  auto threads = args.GetThreads();
   if (!threads.ok()) return Fail(threads.status());
   options.num_threads = *threads;
-  auto budget = args.GetInt("memory-budget", static_cast<int>(options.memory_budget_bytes >> 20), 16, 1 << 24);
+  auto budget = args.GetMemoryBudget(options.memory_budget_bytes);
   if (!budget.ok()) return Fail(budget.status());
-  options.memory_budget_bytes = static_cast<size_t>(*budget) << 20;
+  options.memory_budget_bytes = *budget;
   const bool json = args.Has("json");
   options.remove_outliers = !args.Has("keep-outliers");
   options.show_progress = true;

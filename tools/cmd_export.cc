@@ -79,14 +79,9 @@ int RunExport(int argc, char** argv, int first) {
   const auto read = std::chrono::steady_clock::now();
   const size_t triangles_read = mesh->triangles.size();
   if (!args.Has("json")) PrintMeshSummary("read", input, *mesh);
-  SimplifyReport simplified;
-  if (*max_faces > 0 && mesh->triangles.size() > static_cast<size_t>(*max_faces)) {
-    SimplifyOptions simplify;
-    simplify.target_faces = static_cast<size_t>(*max_faces);
-    auto report = SimplifyMesh(simplify, &*mesh);
-    if (!report.ok()) return Fail(report.status().WithContext(input));
-    simplified = *report;
-  }
+  auto simplify_report = SimplifyToFaceBudget(static_cast<size_t>(*max_faces), &*mesh);
+  if (!simplify_report.ok()) return Fail(simplify_report.status().WithContext(input));
+  const SimplifyReport simplified = *simplify_report;
   if (Status s = CreateParentDirectory(output); !s.ok()) return Fail(s);
   if (Status s = WriteMeshFile(output, *mesh, options); !s.ok()) return Fail(s);
   const auto written = std::chrono::steady_clock::now();

@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "core/base/json_writer.h"
 #include "core/pipeline/feature_stage.h"
 #include "core/pipeline/project.h"
 #include "tools/commands.h"
@@ -22,7 +23,23 @@ constexpr char kHelp[] =
     "  --contrast-threshold C  DoG contrast threshold before division by the 3 levels (default 0.04, Lowe)\n"
     "  --sift-memory-mib M working-memory bound per thread (default 512); larger photos fall back to\n"
     "                      first octave 0 with a warning\n"
-    "  --threads N         photos processed in parallel (default: one per core)\n";
+    "  --threads N         photos processed in parallel (default: one per core)\n"
+    "  --json              print the per-image results as JSON on stdout\n";
+
+void PrintJson(const FeatureStageReport& report) {
+  JsonWriter json(2);
+  json.BeginObject().Key("images").BeginArray();
+  for (const ImageFeatureSummary& s : report.extracted) {
+    json.BeginObject().Key("name").String(s.image.name).Key("path").String(s.image.path);
+    json.Key("width").Int(s.image.width).Key("height").Int(s.image.height).Key("features").Int(s.num_features);
+    json.Key("focal_px").Double(s.image.focal_px).Key("focal_source").String(s.image.focal_source);
+    json.Key("seconds").Double(s.seconds).EndObject();
+  }
+  json.EndArray().Key("skipped").BeginArray();
+  for (const std::string& skipped : report.skipped) json.String(skipped);
+  json.EndArray().Key("seconds").Double(report.seconds).EndObject();
+  std::printf("%s\n", json.str().c_str());
+}
 
 }  // namespace
 
@@ -41,7 +58,7 @@ Result<SiftOptions> SiftOptionsFromArgs(const Args& args) {
 int RunFeatures(int argc, char** argv, int first) {
   std::set<std::string> valued = kSiftValuedOptions;
   valued.insert({"project", "key", "threads"});
-  Args args(valued, {});
+  Args args(valued, {"json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
     std::fputs(kHelp, stdout);
@@ -58,7 +75,7 @@ int RunFeatures(int argc, char** argv, int first) {
   auto sift = SiftOptionsFromArgs(args);
   if (!sift.ok()) return Fail(sift.status());
   options.sift = *sift;
-  auto threads = args.GetInt("threads", 0, 0, 1024);
+  auto threads = args.GetThreads();
   if (!threads.ok()) return Fail(threads.status());
   options.num_threads = *threads;
   options.key_output = args.Get("key");
@@ -71,6 +88,10 @@ int RunFeatures(int argc, char** argv, int first) {
   if (!report.ok()) return Fail(report.status());
 
   for (const std::string& skipped : report->skipped) std::fprintf(stderr, "warning: skipped %s\n", skipped.c_str());
+  if (args.Has("json")) {
+    PrintJson(*report);
+    return 0;
+  }
   size_t total = 0;
   bool default_focal_said = false;
   for (const ImageFeatureSummary& s : report->extracted) {

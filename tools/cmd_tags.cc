@@ -3,10 +3,9 @@
 #include <string>
 #include <vector>
 
-#include "core/base/atomic_file.h"
 #include "tools/commands.h"
-#include "tools/tag_sheet.h"
 #include "tracker/tag_detector.h"
+#include "tracker/tag_sheet.h"
 
 namespace reconar::tools {
 namespace {
@@ -48,29 +47,6 @@ Result<std::vector<int>> ParseIds(const std::string& text) {
   return ids;
 }
 
-Status ApplyPaper(const std::string& name, TagSheetOptions* options) {
-  if (name == "a4") {
-    options->page_width_mm = 210, options->page_height_mm = 297;
-  } else if (name == "a3") {
-    options->page_width_mm = 297, options->page_height_mm = 420;
-  } else if (name == "letter") {
-    options->page_width_mm = 215.9, options->page_height_mm = 279.4;
-  } else {
-    double width = 0, height = 0;
-    char extra = 0;
-    if (std::sscanf(name.c_str(), "%lfx%lf%c", &width, &height, &extra) != 2 || width <= 0 || height <= 0) {
-      return InvalidArgument("--paper: '" + name + "' is not a4, a3, letter or WIDTHxHEIGHT in mm");
-    }
-    options->page_width_mm = width, options->page_height_mm = height;
-  }
-  return Status::Ok();
-}
-
-std::string PagePath(const std::string& out, size_t page) {
-  if (page == 0) return out;
-  return out.substr(0, out.size() - 4) + "-" + std::to_string(page + 1) + ".svg";
-}
-
 }  // namespace
 
 int RunTags(int argc, char** argv, int first) {
@@ -96,43 +72,22 @@ int RunTags(int argc, char** argv, int first) {
   auto size = args.GetDouble("size", 0.0, 1e-4, 10.0);
   if (!size.ok()) return Fail(size.status());
   options.tag_size_mm = *size * 1000.0;
-  if (Status s = ApplyPaper(args.Get("paper", "a4"), &options); !s.ok()) return Fail(s);
-  auto margin = args.GetDouble("margin", 10.0, 0.0, 100.0);
+  if (Status s = SetPaperSize(args.Get("paper", "a4"), &options); !s.ok()) return Fail(s.WithContext("--paper"));
+  auto margin = args.GetDouble("margin", options.margin_mm, 0.0, 100.0);
   if (!margin.ok()) return Fail(margin.status());
   options.margin_mm = *margin;
   auto ids = ParseIds(args.Get("ids"));
   if (!ids.ok()) return Fail(ids.status());
 
-  std::vector<SheetTag> bitmaps;
-  for (int id : *ids) {
-    auto rendered = RenderTagBitmap(*family, id);
-    if (!rendered.ok()) return Fail(rendered.status().WithContext("--ids"));
-    SheetTag bitmap;
-    bitmap.id = id;
-    bitmap.total_width = rendered->pixels.width();
-    bitmap.width_at_border = rendered->width_at_border;
-    for (int y = 0; y < rendered->pixels.height(); ++y) {
-      for (int x = 0; x < rendered->pixels.width(); ++x) bitmap.black.push_back(rendered->pixels.row(y)[x] < 128);
-    }
-    bitmaps.push_back(std::move(bitmap));
-  }
-  auto sheet = LayoutTagSheet(std::move(bitmaps), options);
+  auto bitmaps = RenderSheetTags(*family, *ids);
+  if (!bitmaps.ok()) return Fail(bitmaps.status().WithContext("--ids"));
+  auto sheet = LayoutTagSheet(std::move(*bitmaps), options);
   if (!sheet.ok()) return Fail(sheet.status());
-
-  std::vector<std::string> written;
-  if (extension == ".pdf") {
-    if (Status s = WriteFileAtomically(out, RenderPdf(*sheet)); !s.ok()) return Fail(s);
-    written.push_back(out);
-  } else {
-    for (size_t page = 0; page < sheet->pages.size(); ++page) {
-      const std::string path = PagePath(out, page);
-      if (Status s = WriteFileAtomically(path, RenderSvgPage(*sheet, page)); !s.ok()) return Fail(s);
-      written.push_back(path);
-    }
-  }
+  auto written = WriteTagSheet(*sheet, out);
+  if (!written.ok()) return Fail(written.status());
   std::fprintf(stderr, "reconar tags: %zu %s tag(s) of %.1f mm on %zu page(s):", ids->size(), options.family.c_str(),
                options.tag_size_mm, sheet->pages.size());
-  for (const std::string& path : written) std::fprintf(stderr, " %s", path.c_str());
+  for (const std::string& path : *written) std::fprintf(stderr, " %s", path.c_str());
   std::fputc('\n', stderr);
   return 0;
 }

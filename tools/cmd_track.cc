@@ -1,16 +1,14 @@
-// reconar track: AprilTag 6-DoF tracking over a camera or recorded frames, one line per frame.
+// reconar track: AprilTag 6-DoF tracking over a camera or recorded frames, one line per frame; the
+// runtime is render/ar/ar_session.h, this command parses, calls and prints.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "core/base/json_writer.h"
-#include "platform/camera/frame_source.h"
+#include "render/ar/ar_session.h"
 #include "tools/ar_args.h"
 #include "tools/commands.h"
-#include "tracker/tag_layout.h"
-#include "tracker/tag_tracker.h"
 
 namespace reconar::tools {
 namespace {
@@ -83,60 +81,41 @@ int RunTrack(int argc, char** argv, int first) {
     std::fputs(kTrackerOptionsHelp, stderr);
     return 2;
   }
-  auto options = TrackerOptionsFromArgs(args);
-  if (!options.ok()) return Fail(options.status());
+  ArSessionOptions options;
+  options.source = args.positionals()[0];
+  options.frames.want_rgb = false;
+  auto tracker_options = TrackerOptionsFromArgs(args);
+  if (!tracker_options.ok()) return Fail(tracker_options.status());
+  options.pose.tracker = *tracker_options;
   auto max_frames = args.GetInt("max-frames", 0, 0, 2000000000);
   if (!max_frames.ok()) return Fail(max_frames.status());
-  TagLayout layout;
+  options.max_frames = *max_frames;
   if (args.Has("layout")) {
-    auto read = ReadTagLayout(args.Get("layout"));
-    if (!read.ok()) return Fail(read.status());
-    layout = std::move(*read);
+    auto layout = ReadTagLayout(args.Get("layout"));
+    if (!layout.ok()) return Fail(layout.status());
+    options.pose.layout = std::move(*layout);
   }
   const bool json = args.Has("json");
+  auto session = ArSession::Open(options);
+  if (!session.ok()) return Fail(session.status());
+  std::fprintf(stderr, "reconar track: %s\n", (*session)->Describe().c_str());
 
-  FrameSourceOptions source_options;
-  source_options.want_rgb = false;
-  auto source = OpenFrameSource(args.positionals()[0], source_options);
-  if (!source.ok()) return Fail(source.status());
-  auto tracker = TagTracker::Create(*options);
-  if (!tracker.ok()) return Fail(tracker.status());
-  std::fprintf(stderr, "reconar track: %s\n", (*source)->Describe().c_str());
-
-  TagTrackerFrameReport report;
-  TagDetectionList layout_detections(options->max_tags);
   std::vector<double> frame_ms;
   long frames_with_tags = 0;
-  long frames = 0;
-  while (*max_frames == 0 || frames < *max_frames) {
-    auto frame = (*source)->Next();
-    if (!frame.ok()) {
-      if (IsEndOfStream(frame.status())) break;
-      return Fail(frame.status());
-    }
-    Status tracked = (*tracker)->Track(frame->gray, &report);
-    if (!tracked.ok()) {
-      (*source)->Release(*frame);
-      return Fail(tracked.WithContext(std::string(frame->name)));
-    }
-    BoardPose board;
-    bool have_board = false;
-    if (!layout.empty()) {
-      layout_detections.Clear();
-      for (const TrackedTag& tag : report.tags) {
-        if (tag.measured) layout_detections.Add(tag.detection);
-      }
-      auto estimated = EstimateBoardPose(layout, layout_detections, options->intrinsics);
-      if (estimated.ok()) board = *estimated, have_board = true;
-    }
+  for (;;) {
+    auto more = (*session)->Step();
+    if (!more.ok()) return Fail(more.status());
+    if (!*more) break;
+    const Frame& frame = (*session)->frame();
+    const TagTrackerFrameReport& report = (*session)->tags().report();
     int measured = 0;
     for (const TrackedTag& tag : report.tags) measured += tag.measured ? 1 : 0;
     frames_with_tags += measured > 0 ? 1 : 0;
     frame_ms.push_back(report.total_ms);
     if (json) {
-      std::printf("%s\n", FrameJson(*frame, report, have_board ? &board : nullptr).c_str());
+      std::printf("%s\n", FrameJson(frame, report, (*session)->tags().board()).c_str());
     } else {
-      std::printf("%.*s: %d tag(s)", static_cast<int>(frame->name.size()), frame->name.data(), measured);
+      std::printf("%.*s: %d tag(s)", static_cast<int>(frame.name.size()), frame.name.data(), measured);
       for (const TrackedTag& tag : report.tags) {
         if (!tag.measured) continue;
         const Eigen::Vector3d& t = tag.cam_from_tag.translation;
@@ -146,10 +125,8 @@ int RunTrack(int argc, char** argv, int first) {
       std::printf("  [%s, %.2f ms]\n", SearchName(report.search), report.total_ms);
     }
     std::fflush(stdout);
-    (*source)->Release(*frame);
-    ++frames;
   }
-  if (frames == 0) return Fail(FailedPrecondition(args.positionals()[0] + ": no frames"));
+  const long frames = (*session)->frames();
   std::vector<double> sorted = frame_ms;
   std::sort(sorted.begin(), sorted.end());
   double total = 0.0;

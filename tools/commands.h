@@ -15,6 +15,8 @@ int RunExport(int argc, char** argv, int first);
 int RunMesh(int argc, char** argv, int first);
 int RunDense(int argc, char** argv, int first);
 int RunReconstruct(int argc, char** argv, int first);
+// reconstruct and sfm (sparse_only: the sparse stages, no preview): tools/reconstruct_command.cc.
+int RunReconstructCommand(int argc, char** argv, int first, const char* help, bool sparse_only);
 
 }  // namespace reconar::tools
 
@@ -26,12 +28,14 @@ int RunReconstruct(int argc, char** argv, int first);
 
 namespace reconar::tools {
 
-// --first-octave, --max-features and --memory-budget (MiB) shared by features and match.
+// --first-octave, --max-features, --contrast-threshold and --sift-memory-mib (MiB) shared by
+// features, match, sfm and reconstruct.
 Result<SiftOptions> SiftOptionsFromArgs(const Args& args);
 inline const std::set<std::string> kSiftValuedOptions = {"first-octave", "max-features", "sift-memory-mib",
                                                            "contrast-threshold"};
 
-Result<MatchStageOptions> MatchOptionsFromArgs(const Args& args);
+// --ratio, --checks, --min-inliers, --f-threshold and --threads over the values `options` holds.
+Status ReadMatchArgs(const Args& args, MatchStageOptions* options);
 inline const std::set<std::string> kMatchValuedOptions = {"ratio", "checks", "min-inliers", "f-threshold",
                                                             "threads"};
 

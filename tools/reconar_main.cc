@@ -3,12 +3,15 @@
 #include <cstring>
 #include <string>
 
+#include "core/base/build_info.h"
+#include "core/base/cpu_features.h"
 #include "tools/commands.h"
 
 namespace {
 
 constexpr char kUsage[] =
     "usage: reconar COMMAND [ARGS] [--help]\n"
+    "       reconar --version                              version, build type and the SIMD kernels this CPU runs\n"
     "\n"
     "commands:\n"
     "  reconstruct IMAGES_DIR PROJECT_DIR [--tag-size M]   the whole job: photos to a metric mesh (+ preview)\n"
@@ -27,6 +30,16 @@ constexpr char kUsage[] =
     "\n"
     "exit codes: 0 ok, 1 failed run, 2 bad usage or input\n";
 
+// "reconar 0.1.0 (Release)", the CPU's SIMD features and the kernel each dispatcher selected.
+int PrintVersion() {
+  std::printf("reconar %s (%s)\ncpu: %s\n", reconar::ReconarVersion(), reconar::ReconarBuildType(),
+              reconar::CpuFeatureNames(reconar::HostCpuFeatures()).c_str());
+  for (const reconar::SimdKernelChoice& choice : reconar::SelectedSimdKernels()) {
+    std::printf("kernel %s: %s\n", choice.dispatcher.c_str(), choice.kernel.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -35,6 +48,7 @@ int main(int argc, char** argv) {
     return argc < 2 ? 2 : 0;
   }
   const std::string command = argv[1];
+  if (command == "--version") return PrintVersion();
   if (command == "features") return reconar::tools::RunFeatures(argc, argv, 2);
   if (command == "match") return reconar::tools::RunMatch(argc, argv, 2);
   if (command == "sfm") return reconar::tools::RunSfm(argc, argv, 2);

@@ -14,6 +14,7 @@
 #include <Eigen/SVD>
 
 #include "core/base/atomic_file.h"
+#include "core/base/number_format.h"
 #include "core/geometry/homography_four_point.h"
 #include "core/math/normal_lm.h"
 #include "tracker/tag_pose.h"
@@ -476,13 +477,6 @@ CameraIntrinsics ToIntrinsics(const Vector6d& k, int width, int height) {
   return intrinsics;
 }
 
-// Shortest round-trip text of a double.
-std::string FormatDouble(double value) {
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  return std::string(buffer, result.ptr);
-}
-
 }  // namespace
 
 CalibrationImage MakeCalibrationImage(std::string name, int width, int height, const TagDetectionList& detections) {
@@ -750,7 +744,7 @@ Status WriteIntrinsics(const std::string& path, const CameraIntrinsics& intrinsi
       "# A camera point X (z forward) maps to p = X.xy / X.z, d = 1 + k1 |p|^2 + k2 |p|^4,\n"
       "# u = fx d p.x + cx, v = fy d p.y + cy. width and height are 0 when unknown.\n"
       "# fx fy cx cy k1 k2 width height\n";
-  for (double v : values) text += FormatDouble(v) + " ";
+  for (double v : values) text += FormatShortest(v) + " ";
   text += std::to_string(intrinsics.width) + " " + std::to_string(intrinsics.height) + "\n";
   return WriteFileAtomically(path, text);
 }

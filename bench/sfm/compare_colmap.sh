@@ -161,7 +161,7 @@ stage_seconds() {
     [[ $stage == mapping ]] && stage=mapper
     if [[ -s $work/colmap_$stage.time ]]; then wall_seconds "$work/colmap_$stage.time"; else echo -; fi
   elif [[ -s $work/reconar/report.json ]]; then
-    awk -v stage="\"$stage\":" '$1 == stage { inside = 1 }
+    awk -v stage="\"$stage\"," '$1 == "\"name\":" && $2 == stage { inside = 1 }
       inside && $1 == "\"seconds\":" { v = $2; sub(/,$/, "", v); printf "%.1f", v; found = 1; exit }
       END { if (!found) print "-" }' "$work/reconar/report.json"
   else

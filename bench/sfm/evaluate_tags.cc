@@ -2,7 +2,8 @@
 // seen in its photos. Each tag's corners are triangulated from the model's cameras (the path
 // `reconar reconstruct --no-tags-in-ba` takes), the model is scaled by the mean edge of all tags,
 // and the edges are compared with the printed size, also with each tag held out of the scale.
-// One JSON line on stdout (a compact form of tags.json); --tags-json writes the full tags.json.
+// A JSON object on stdout (a compact form of tags.json, written by core/base JsonWriter with one
+// key per line); --tags-json writes the full tags.json.
 //
 //   evaluate_tags MODEL_DIR DETECTIONS --tag-size METRES [--tags-json FILE]
 //
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "core/base/atomic_file.h"
+#include "core/base/json_writer.h"
 #include "core/sfm/model_io.h"
 #include "core/sfm/tag_observations.h"
 #include "core/sfm/tag_registration.h"
@@ -73,30 +75,38 @@ int Run(int argc, char** argv) {
     const Status written = WriteFileAtomically(tags_json, TagRegistrationJson(*report, detections->family, tag_size));
     if (!written.ok()) return Usage(written.ToString().c_str());
   }
+  // Pretty-printed: compare_tag_edges.sh reads one "key": value per line.
+  JsonWriter json(2);
+  json.BeginObject();
   if (!report->metric) {
-    std::printf("{\"metric\": false, \"reason\": \"%s\"}\n", report->reason.c_str());
+    json.Key("metric").Bool(false).Key("reason").String(report->reason).EndObject();
+    std::printf("%s\n", json.str().c_str());
     return 1;
   }
   // Edges 0 and 2 run along the tag's x axis, 1 and 3 along y: a difference between the two shows
   // a print (or pixel) aspect error rather than a reconstruction one.
   double x_sum = 0.0, y_sum = 0.0;
-  std::string per_tag;
   for (const RegisteredTag& tag : report->tags) {
     x_sum += tag.edges_m[0] + tag.edges_m[2];
     y_sum += tag.edges_m[1] + tag.edges_m[3];
-    char entry[64];
-    std::snprintf(entry, sizeof(entry), "%s\"%d\": %.5f", per_tag.empty() ? "" : ", ", tag.id,
-                  (tag.edges_m[0] + tag.edges_m[1] + tag.edges_m[2] + tag.edges_m[3]) / 4.0);
-    per_tag += entry;
   }
   const double pairs = 2.0 * static_cast<double>(report->tags.size());
-  std::printf(
-      "{\"registered\": %d, \"tags\": %zu, \"edge_mean_m\": %.6f, \"edge_std_m\": %.6f, \"edge_max_abs_error_m\": "
-      "%.6f, \"held_out_edge_mean_m\": %.6f, \"held_out_edge_std_m\": %.6f, \"held_out_edge_max_abs_error_m\": %.6f, "
-      "\"x_edge_mean_m\": %.6f, \"y_edge_mean_m\": %.6f, \"tag_mean_edge_m\": {%s}}\n",
-      model->NumRegisteredImages(), report->tags.size(), report->edge_mean_m, report->edge_std_m,
-      report->edge_max_abs_error_m, report->held_out_edge_mean_m, report->held_out_edge_std_m,
-      report->held_out_edge_max_abs_error_m, x_sum / pairs, y_sum / pairs, per_tag.c_str());
+  json.Key("registered").Int(model->NumRegisteredImages());
+  json.Key("tags").Int(static_cast<long long>(report->tags.size()));
+  json.Key("edge_mean_m").Double(report->edge_mean_m);
+  json.Key("edge_std_m").Double(report->edge_std_m);
+  json.Key("edge_max_abs_error_m").Double(report->edge_max_abs_error_m);
+  json.Key("held_out_edge_mean_m").Double(report->held_out_edge_mean_m);
+  json.Key("held_out_edge_std_m").Double(report->held_out_edge_std_m);
+  json.Key("held_out_edge_max_abs_error_m").Double(report->held_out_edge_max_abs_error_m);
+  json.Key("x_edge_mean_m").Double(x_sum / pairs);
+  json.Key("y_edge_mean_m").Double(y_sum / pairs);
+  json.Key("tag_mean_edge_m").BeginObject();
+  for (const RegisteredTag& tag : report->tags) {
+    json.Key(std::to_string(tag.id)).Double((tag.edges_m[0] + tag.edges_m[1] + tag.edges_m[2] + tag.edges_m[3]) / 4.0);
+  }
+  json.EndObject().EndObject();
+  std::printf("%s\n", json.str().c_str());
   return 0;
 }
 

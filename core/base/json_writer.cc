@@ -1,8 +1,9 @@
 #include "core/base/json_writer.h"
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
+
+#include "core/base/number_format.h"
 
 namespace reconar {
 
@@ -107,10 +108,7 @@ JsonWriter& JsonWriter::Double(double value) {
     out_ += "null";
     return *this;
   }
-  // Shortest text that reads back as the same double (as core/sfm/model_io writes numbers).
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out_.append(buffer, result.ptr);
+  AppendShortest(&out_, value);
   return *this;
 }
 

@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "core/base/cpu_features.h"
 #include "core/features/descriptor_distance_kernels.h"
 
 namespace reconar {
@@ -38,8 +39,7 @@ std::vector<DescriptorDistanceKernel> AvailableDescriptorDistanceKernels() {
   kernels.push_back({"sse2", internal::DescriptorDistanceSse2, internal::DescriptorDistanceBatchSse2});
 #endif
 #if defined(RECONAR_FEATURES_HAVE_AVX2)
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2")) {
+  if (HostCpuFeatures().avx2) {
     kernels.push_back({"avx2", internal::DescriptorDistanceAvx2, internal::DescriptorDistanceBatchAvx2});
   }
 #endif
@@ -62,5 +62,10 @@ const DescriptorDistanceKernel& ActiveDescriptorDistanceKernel() {
   }();
   return active;
 }
+
+namespace {
+[[maybe_unused]] const bool kRegistered =
+    RegisterSimdDispatcher({"descriptor_distance", [] { return ActiveDescriptorDistanceKernel().name; }});
+}  // namespace
 
 }  // namespace reconar

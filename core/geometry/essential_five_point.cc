@@ -1,11 +1,8 @@
 #include "core/geometry/essential_five_point.h"
 
-#include <cmath>
-#include <complex>
-
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "core/geometry/essential_five_point_internal.h"
 #include "core/geometry/null_space.h"
 #include "core/geometry/residuals.h"
 
@@ -149,29 +146,11 @@ int EssentialFivePoint::Estimate(const Sample* samples, int count, std::array<Mo
   action(8, MonomialIndex(1, 0, 1) - kFirstQuadratic) = 1.0;  // x * z = xz
   action(9, MonomialIndex(1, 0, 0) - kFirstQuadratic) = 1.0;  // x * 1 = x
 
-  const Eigen::EigenSolver<Eigen::Matrix<double, 10, 10>> eigen(action, /*computeEigenvectors=*/true);
-  if (eigen.info() != Eigen::Success) return 0;
-
-  const int y_index = MonomialIndex(0, 1, 0) - kFirstQuadratic;
-  const int z_index = MonomialIndex(0, 0, 1) - kFirstQuadratic;
-  const int one_index = MonomialIndex(0, 0, 0) - kFirstQuadratic;
-  const Eigen::Matrix<std::complex<double>, 10, 10> eigenvectors = eigen.eigenvectors();
-  int num_models = 0;
-  for (int k = 0; k < 10; ++k) {
-    const std::complex<double> lambda = eigen.eigenvalues()(k);
-    if (std::abs(lambda.imag()) > 1e-8 * (1.0 + std::abs(lambda.real()))) continue;  // complex root
-    const Eigen::Matrix<std::complex<double>, 10, 1> v = eigenvectors.col(k);
-    if (std::abs(v(one_index)) < 1e-12 * v.norm()) continue;  // solution at infinity
-    const double x = lambda.real();
-    const double y = (v(y_index) / v(one_index)).real();
-    const double z = (v(z_index) / v(one_index)).real();
-    const Eigen::Matrix<double, 9, 1> e =
-        x * null_space.col(0) + y * null_space.col(1) + z * null_space.col(2) + null_space.col(3);
-    const double norm = e.norm();
-    if (!(norm > 0.0) || !e.allFinite()) continue;
-    (*models)[num_models++] = Matrix3FromVector(e / norm);
-  }
-  return num_models;
+  // The eigen decomposition and the solutions it gives (essential_five_point_roots.cc).
+  static_assert(MonomialIndex(0, 1, 0) - kFirstQuadratic == five_point_internal::kBasisY, "basis order");
+  static_assert(MonomialIndex(0, 0, 1) - kFirstQuadratic == five_point_internal::kBasisZ, "basis order");
+  static_assert(MonomialIndex(0, 0, 0) - kFirstQuadratic == five_point_internal::kBasisOne, "basis order");
+  return five_point_internal::SolutionsFromActionMatrix(action, null_space, models);
 }
 
 void EssentialFivePoint::Residuals(const Sample* samples, int count, const Model& E, double* squared_residuals) {

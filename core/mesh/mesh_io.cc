@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/base/atomic_file.h"
+#include "core/base/number_format.h"
 #include "core/mesh/byte_order.h"
 #include "core/mesh/text_format.h"
 
@@ -526,12 +527,12 @@ void AppendAsciiBody(const Mesh& mesh, std::string* out) {
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     for (int axis = 0; axis < 3; ++axis) {
       if (axis > 0) out->push_back(' ');
-      mesh_internal::AppendShortestText(out, mesh.positions[i][axis]);
+      AppendShortest(out, mesh.positions[i][axis]);
     }
     if (!mesh.normals.empty()) {
       for (int axis = 0; axis < 3; ++axis) {
         out->push_back(' ');
-        mesh_internal::AppendShortestText(out, mesh.normals[i][axis]);
+        AppendShortest(out, mesh.normals[i][axis]);
       }
     }
     if (!mesh.colors.empty()) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/base/atomic_file.h"
+#include "core/base/number_format.h"
 #include "core/mesh/text_format.h"
 
 namespace reconar {
@@ -36,7 +37,7 @@ std::string ObjText(const Mesh& mesh) {
     if (with_colours) {
       for (int channel = 0; channel < 3; ++channel) {
         out.push_back(' ');
-        mesh_internal::AppendShortestText(&out, mesh_internal::ColourChannel(mesh.colors[i][channel]));
+        AppendShortest(&out, mesh_internal::ColourChannel(mesh.colors[i][channel]));
       }
     }
     out.push_back('\n');

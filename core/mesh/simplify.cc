@@ -363,9 +363,17 @@ Result<SimplifyReport> SimplifyMesh(const SimplifyOptions& options, Mesh* mesh) 
     report.faces_before = report.faces_after = mesh->triangles.size();
   } else {
     report = Simplifier(options, mesh).Run();
+    report.simplified = true;
   }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
+}
+
+Result<SimplifyReport> SimplifyToFaceBudget(size_t max_faces, Mesh* mesh) {
+  if (max_faces == 0 || mesh->triangles.size() <= max_faces) return SimplifyReport();
+  SimplifyOptions options;
+  options.target_faces = max_faces;
+  return SimplifyMesh(options, mesh);
 }
 
 }  // namespace reconar

@@ -35,6 +35,7 @@ struct SimplifyReport {
   size_t vertices_before = 0, faces_before = 0;
   size_t vertices_after = 0, faces_after = 0;
   size_t collapses = 0;
+  bool simplified = false;          // the mesh was over target_faces and went through the collapses
   double max_collapse_error = 0.0;  // largest quadric error of a collapse done
   double seconds = 0.0;
 };
@@ -42,5 +43,11 @@ struct SimplifyReport {
 // Simplifies *mesh in place (dropping unused vertices). A mesh already within target_faces is
 // left as it is. InvalidArgument for bad options or a mesh that fails ValidateMesh.
 Result<SimplifyReport> SimplifyMesh(const SimplifyOptions& options, Mesh* mesh);
+
+// The face budget of `reconar reconstruct`, `view` and `export` (--max-faces): a mesh of more
+// than max_faces triangles is simplified to at most max_faces with the default options; a mesh
+// within the budget, or max_faces 0 (no budget), is left as it is, unread, and the report is all
+// zero (simplified false).
+Result<SimplifyReport> SimplifyToFaceBudget(size_t max_faces, Mesh* mesh);
 
 }  // namespace reconar

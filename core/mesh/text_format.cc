@@ -1,20 +1,15 @@
 #include "core/mesh/text_format.h"
 
-#include <charconv>
 #include <string>
 
-namespace reconar::mesh_internal {
+#include "core/base/number_format.h"
 
-void AppendShortestText(std::string* out, float value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out->append(buffer, result.ptr);
-}
+namespace reconar::mesh_internal {
 
 void AppendShortestText(std::string* out, const Eigen::Vector3f& value) {
   for (int axis = 0; axis < 3; ++axis) {
     if (axis > 0) out->push_back(' ');
-    AppendShortestText(out, value[axis]);
+    AppendShortest(out, value[axis]);
   }
 }
 

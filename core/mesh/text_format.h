@@ -11,9 +11,8 @@
 
 namespace reconar::mesh_internal {
 
-// The shortest text that reads back as the same float.
-void AppendShortestText(std::string* out, float value);
-void AppendShortestText(std::string* out, const Eigen::Vector3f& value);  // "x y z"
+// "x y z", each coordinate as the shortest text that reads back as the same float.
+void AppendShortestText(std::string* out, const Eigen::Vector3f& value);
 // The colour byte as a channel in 0..1, as the text formats store it (byte / 255).
 float ColourChannel(uint8_t byte);
 // kInvalidArgument naming `path` and the first vertex with a non-finite position or normal,

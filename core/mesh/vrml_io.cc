@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/base/atomic_file.h"
+#include "core/base/number_format.h"
 #include "core/mesh/text_format.h"
 
 namespace reconar {
@@ -30,7 +31,7 @@ void AppendColorNode(const std::string& indent, const Mesh& mesh, std::string* o
     *out += "    ";
     for (int channel = 0; channel < 3; ++channel) {
       if (channel > 0) out->push_back(' ');
-      mesh_internal::AppendShortestText(out, mesh_internal::ColourChannel(colour[channel]));
+      AppendShortest(out, mesh_internal::ColourChannel(colour[channel]));
     }
     *out += ",\n";
   }

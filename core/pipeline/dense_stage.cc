@@ -188,17 +188,6 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   if (mvs_options.num_threads == 0) mvs_options.num_threads = num_threads;
   mvs_options.show_progress = options.show_progress;
   ThreadPool pool(num_threads);
-  size_t loads = 0;  // views the undistortion will produce, for the progress bar
-  {
-    std::vector<int> previous;
-    for (const std::vector<int>& cluster : clustering.clusters) {
-      if (static_cast<int>(cluster.size()) < mvs_options.min_visible_views) continue;
-      for (int id : cluster) loads += std::binary_search(previous.begin(), previous.end(), id) ? 0 : 1;
-      previous = cluster;
-    }
-  }
-  std::unique_ptr<Progress> progress;
-  if (options.show_progress) progress = std::make_unique<Progress>("undistort", loads);
   std::map<int, std::unique_ptr<DenseView>> cache;
   std::vector<MergeInput> parts;
   for (size_t c = 0; c < clustering.clusters.size(); ++c) {
@@ -207,17 +196,26 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
       ++report.clusters_without_points;
       continue;
     }
+    // Progress: one line per phase of each cluster, "dense: cluster 2/4: undistort 5 views: ...".
+    const std::string cluster_label =
+        "dense: cluster " + std::to_string(c + 1) + "/" + std::to_string(clustering.clusters.size()) + ": ";
     {
       PhaseTimer timer(&report.undistort);
+      size_t missing = 0;
+      for (int id : cluster) missing += cache.count(id) == 0 ? 1 : 0;
+      std::unique_ptr<Progress> progress;
+      if (options.show_progress && missing > 0) {
+        progress = std::make_unique<Progress>(
+            cluster_label + "undistort " + std::to_string(missing) + " of " + std::to_string(cluster.size()) + " views",
+            missing);
+      }
       RECONAR_RETURN_IF_ERROR(LoadClusterViews(cluster, model, paths, report.level, &pool, progress.get(), &cache,
                                                &report.views_undistorted));
-      if (progress && report.views_undistorted == loads) progress->Finish();
+      if (progress) progress->Finish();
     }
     std::vector<const DenseView*> views;
     for (int id : cluster) views.push_back(cache.at(id).get());
-    if (options.show_progress) {
-      std::fprintf(stderr, "dense: cluster %zu of %zu, %zu views\n", c + 1, clustering.clusters.size(), cluster.size());
-    }
+    mvs_options.progress_label = cluster_label + "patch MVS";
     PhaseTimer timer(&report.mvs);
     PatchMvsReport cluster_report;
     auto points = RunPatchMvs(views, mvs_options, &cluster_report);
@@ -237,7 +235,6 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
     report.points_before_merge += part.points.size();
     parts.push_back(std::move(part));
   }
-  if (progress) progress->Finish();
   cache.clear();
   if (report.points_before_merge == 0) {
     return FailedPrecondition("dense: no cluster of " + project.SparseDir() +

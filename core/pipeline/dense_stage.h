@@ -21,7 +21,7 @@ namespace reconar {
 
 struct DenseStageOptions {
   int level = -1;  // -1: the finest level 0..2 whose memory estimate fits the budget; else 0, 1 or 2
-  size_t memory_budget_bytes = 3ull << 30;
+  size_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
   ViewClusteringOptions clustering;
   PatchMvsOptions mvs;  // its num_threads 0 takes the stage's
   bool remove_outliers = true;

@@ -71,8 +71,20 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
   double total_bytes = 0.0;
   bool all_loaded = true;
   for (size_t i = 0; i < images.size(); ++i) {
-    RECONAR_ASSIGN_OR_RETURN(FeatureFile file, ReadFeatureFile(project.FeaturePath(images[i].name)));
-    image_bytes[i] = per_feature * static_cast<double>(file.features.keypoints.size());
+    // Once over the budget, only the headers are read (the counts); the blocks load the rest.
+    FeatureFile file;
+    size_t count = 0;
+    if (all_loaded) {
+      RECONAR_ASSIGN_OR_RETURN(file, ReadFeatureFile(project.FeaturePath(images[i].name)));
+      count = file.features.keypoints.size();
+    } else {
+      RECONAR_ASSIGN_OR_RETURN(const FeatureFileHeader header,
+                               ReadFeatureFileHeader(project.FeaturePath(images[i].name)));
+      file.image_width = header.image_width;
+      file.image_height = header.image_height;
+      count = header.count;
+    }
+    image_bytes[i] = per_feature * static_cast<double>(count);
     total_bytes += image_bytes[i];
     if (all_loaded && total_bytes > budget) {
       all_loaded = false;

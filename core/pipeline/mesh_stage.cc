@@ -1,5 +1,7 @@
 #include "core/pipeline/mesh_stage.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -7,9 +9,11 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/json_writer.h"
+#include "core/base/keep_masked.h"
 #include "core/base/memory_usage.h"
 #include "core/mesh/mesh_file.h"
 #include "core/mesh/poisson/point_kdtree.h"
+#include "core/mesh/poisson/point_normals.h"
 
 namespace reconar {
 namespace {
@@ -46,34 +50,46 @@ Status MeshStageOptions::Check() const {
   return Status::Ok();
 }
 
-Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOptions& options) {
-  RECONAR_RETURN_IF_ERROR(options.Check());
+Result<MeshStageReport> MeshPointsFile(const std::string& points_path, const std::vector<std::string>& mesh_paths,
+                                       const MeshStageOptions& options, const MeshFileOptions& file_options) {
+  RECONAR_RETURN_IF_ERROR(options.poisson.Check());
+  RECONAR_RETURN_IF_ERROR(ReadableMeshFileFormatOf(points_path).status());
+  for (const std::string& path : mesh_paths) RECONAR_RETURN_IF_ERROR(MeshFileFormatOf(path).status());
   const auto start = std::chrono::steady_clock::now();
   ResetPeakResidentBytes();
   MeshStageReport report;
-  auto points = ReadMeshFile(project.DensePointsPath());
-  if (!points.ok()) {
-    if (points.status().code() == StatusCode::kNotFound) {
-      return FailedPrecondition(project.DensePointsPath() + ": no dense points; run the dense stage first");
-    }
-    return points.status();
+  RECONAR_ASSIGN_OR_RETURN(Mesh points, ReadMeshFile(points_path));
+  points.triangles.clear();
+  report.points = points.positions.size();
+  if (options.remove_outliers) {
+    OutlierFilterOptions outliers = options.outliers;
+    if (outliers.num_threads == 0) outliers.num_threads = options.poisson.num_threads;
+    const auto keep = FindInlierPoints(points.positions, outliers, &report.outliers);
+    if (!keep.ok()) return keep.status().WithContext(points_path);
+    KeepMasked(*keep, &points.positions);
+    KeepMasked(*keep, &points.normals);
+    KeepMasked(*keep, &points.colors);
   }
-  points->triangles.clear();
-  report.points = points->positions.size();
-  if (points->normals.empty()) {
-    return FileError(StatusCode::kCorruptData, project.DensePointsPath(), "the points have no normals");
+  if (options.estimate_normals) {
+    RECONAR_RETURN_IF_ERROR(EstimateNormals(&points, NormalEstimationOptions()).WithContext(points_path));
+    report.normals_estimated = true;
+  } else if (points.normals.empty()) {
+    return FileError(StatusCode::kInvalidArgument, points_path,
+                     "the points have no normals (Poisson needs oriented points; --estimate-normals estimates them)");
   }
   report.requested_depth = report.depth = options.poisson.depth;
-  Eigen::Vector3f lo = points->positions.front(), hi = lo;
-  for (const Eigen::Vector3f& p : points->positions) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  report.median_spacing = MedianSpacing(points->positions);
-  const double cube = options.poisson.scale * static_cast<double>((hi - lo).maxCoeff());
-  if (report.median_spacing > 0.0 && cube > 0.0) {
-    report.spacing_depth = std::max(kMinDepth, static_cast<int>(std::ceil(std::log2(cube / report.median_spacing))));
-    report.depth = std::min(report.depth, report.spacing_depth);
+  if (options.depth_from_spacing) {
+    Eigen::Vector3f lo = points.positions.front(), hi = lo;
+    for (const Eigen::Vector3f& p : points.positions) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    report.median_spacing = MedianSpacing(points.positions);
+    const double cube = options.poisson.scale * static_cast<double>((hi - lo).maxCoeff());
+    if (report.median_spacing > 0.0 && cube > 0.0) {
+      report.spacing_depth = std::max(kMinDepth, static_cast<int>(std::ceil(std::log2(cube / report.median_spacing))));
+      report.depth = std::min(report.depth, report.spacing_depth);
+    }
   }
 
   if (options.memory_budget_bytes > 0 && report.depth > kMinDepth) {
@@ -84,7 +100,7 @@ Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOpti
     ReleaseFreeHeapMemory();
     const size_t baseline = CurrentMemoryUsage().resident_bytes;
     ResetPeakResidentBytes();
-    RECONAR_RETURN_IF_ERROR(ReconstructPoissonSurface(*points, pilot, nullptr).status());
+    RECONAR_RETURN_IF_ERROR(ReconstructPoissonSurface(points, pilot, nullptr).status());
     report.pilot_peak_bytes = PeakResidentBytes() > baseline ? PeakResidentBytes() - baseline : 0;
     ResetPeakResidentBytes();
     int depth = report.depth;
@@ -106,24 +122,35 @@ Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOpti
 
   PoissonOptions poisson = options.poisson;
   poisson.depth = report.depth;
-  if (poisson.trim > 0.0) poisson.trim = std::min(poisson.trim, static_cast<double>(report.depth - 1));
-  RECONAR_ASSIGN_OR_RETURN(Mesh mesh, ReconstructPoissonSurface(*points, poisson, &report.poisson));
-  if (options.max_faces > 0 && mesh.triangles.size() > options.max_faces) {
-    SimplifyOptions simplify;
-    simplify.target_faces = options.max_faces;
-    RECONAR_ASSIGN_OR_RETURN(report.simplify, SimplifyMesh(simplify, &mesh));
-    report.simplified = true;
+  if (options.depth_from_spacing && poisson.trim > 0.0) {
+    poisson.trim = std::min(poisson.trim, static_cast<double>(report.depth - 1));
   }
+  auto surface = ReconstructPoissonSurface(points, poisson, &report.poisson);
+  if (!surface.ok()) return surface.status().WithContext(points_path);
+  Mesh mesh = std::move(*surface);
+  RECONAR_ASSIGN_OR_RETURN(report.simplify, SimplifyToFaceBudget(options.max_faces, &mesh));
+  report.simplified = report.simplify.simplified;
   report.vertices = mesh.positions.size();
   report.faces = mesh.triangles.size();
-  RECONAR_RETURN_IF_ERROR(CreateDirectories(project.MeshDir()));
-  for (const std::string& format : options.formats) {
-    const std::string path = project.MeshDir() + "/mesh." + format;
-    RECONAR_RETURN_IF_ERROR(WriteMeshFile(path, mesh, MeshFileOptions()));
+  for (const std::string& path : mesh_paths) {
+    const size_t slash = path.find_last_of('/');
+    if (slash != std::string::npos && slash > 0) RECONAR_RETURN_IF_ERROR(CreateDirectories(path.substr(0, slash)));
+    RECONAR_RETURN_IF_ERROR(WriteMeshFile(path, mesh, file_options));
     report.paths.push_back(path);
   }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report.peak_rss_bytes = PeakResidentBytes();
+  return report;
+}
+
+Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOptions& options) {
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  if (::access(project.DensePointsPath().c_str(), F_OK) != 0) {
+    return FailedPrecondition(project.DensePointsPath() + ": no dense points; run the dense stage first");
+  }
+  std::vector<std::string> paths;
+  for (const std::string& format : options.formats) paths.push_back(project.MeshDir() + "/mesh." + format);
+  RECONAR_ASSIGN_OR_RETURN(MeshStageReport report, MeshPointsFile(project.DensePointsPath(), paths, options));
   report.report_path = project.MeshDir() + "/report.json";
   RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, MeshReportJson(report)));
   return report;
@@ -133,6 +160,11 @@ std::string MeshReportJson(const MeshStageReport& report) {
   JsonWriter json(2);
   json.BeginObject();
   json.Key("points").Int(static_cast<long long>(report.points));
+  if (report.outliers.input_points > 0) {
+    json.Key("outliers_removed")
+        .Int(static_cast<long long>(report.outliers.input_points - report.outliers.kept_points()));
+  }
+  json.Key("normals_estimated").Bool(report.normals_estimated);
   json.Key("requested_depth").Int(report.requested_depth).Key("median_spacing").Double(report.median_spacing);
   json.Key("spacing_depth").Int(report.spacing_depth).Key("depth").Int(report.depth);
   json.Key("depth_lowered_for_memory_budget").Bool(report.depth_lowered_for_budget);

@@ -11,11 +11,14 @@
 // plus what the process already holds) fits the budget; the report says when it was lowered.
 // Size: a mesh of more than max_faces triangles is simplified (core/mesh/simplify.h) before it is
 // written, so that a handheld renders it at video rate.
+// `reconar mesh` runs the same work (MeshPointsFile) on any oriented points file.
 #include <cstddef>
 #include <string>
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/mesh/mesh_file.h"
+#include "core/mesh/poisson/point_outliers.h"
 #include "core/mesh/poisson/poisson.h"
 #include "core/mesh/simplify.h"
 #include "core/pipeline/project.h"
@@ -27,6 +30,11 @@ struct MeshStageOptions {
   size_t memory_budget_bytes = 0;                                   // 0: no limit, no pilot
   std::vector<std::string> formats = {"ply", "obj", "glb", "wrl"};  // mesh/mesh.<format>
   size_t max_faces = 0;                                             // 0: no limit
+  // The depth no finer than the points' spacing, the trim at most depth - 1; false: as given.
+  bool depth_from_spacing = true;
+  bool remove_outliers = false;   // drop isolated points and small floating pieces first
+  OutlierFilterOptions outliers;  // its num_threads 0 takes poisson.num_threads
+  bool estimate_normals = false;  // from the nearest neighbours, replacing the points' own
 
   Status Check() const;
 };
@@ -39,7 +47,9 @@ struct MeshStageReport {
   bool depth_lowered_for_budget = false;
   size_t pilot_peak_bytes = 0;      // above the baseline, at the pilot depth
   size_t estimated_peak_bytes = 0;  // for the depth used
-  size_t points = 0;
+  size_t points = 0;                // read
+  OutlierFilterReport outliers;     // with remove_outliers
+  bool normals_estimated = false;
   PoissonReport poisson;
   bool simplified = false;  // over max_faces: `simplify` says from what to what
   SimplifyReport simplify;
@@ -52,6 +62,13 @@ struct MeshStageReport {
 
 // FailedPrecondition without dense points; ResourceExhausted when even depth 5 does not fit.
 Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOptions& options);
+
+// The stage's work on any file of oriented points (.ply, .obj, .glb), written to each of
+// mesh_paths (format by extension; options.formats is not used). InvalidArgument naming the file
+// when the points have no normals and estimate_normals is off. Writes no report.
+Result<MeshStageReport> MeshPointsFile(const std::string& points_path, const std::vector<std::string>& mesh_paths,
+                                       const MeshStageOptions& options,
+                                       const MeshFileOptions& file_options = MeshFileOptions());
 
 std::string MeshReportJson(const MeshStageReport& report);
 

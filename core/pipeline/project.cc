@@ -1,6 +1,10 @@
 #include "core/pipeline/project.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -56,8 +60,10 @@ Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string
     std::error_code ec;
     if (fs::is_directory(argument, ec)) {
       std::vector<std::string> found;
-      for (const auto& entry : fs::directory_iterator(argument, ec)) {
-        if (!entry.is_regular_file()) continue;
+      for (auto it = fs::directory_iterator(argument, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        const fs::directory_entry& entry = *it;
+        std::error_code type_error;
+        if (!entry.is_regular_file(type_error)) continue;
         std::string ext = entry.path().extension().string();
         std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
         if (ext == ".jpg" || ext == ".jpeg" || ext == ".png") found.push_back(entry.path().string());
@@ -80,6 +86,11 @@ Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string
     }
   }
   return paths;
+}
+
+Status RemoveFileIfPresent(const std::string& path) {
+  if (::unlink(path.c_str()) == 0 || errno == ENOENT) return Status::Ok();
+  return FileError(StatusCode::kIoError, path, std::string("cannot remove: ") + std::strerror(errno));
 }
 
 }  // namespace reconar

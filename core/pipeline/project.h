@@ -3,12 +3,17 @@
 // sparse/ (the sparse model, see sfm_stage.h) and report.json.
 // images.txt lists, one image per line, "name width height focal_px focal_source path"; names are
 // unique within a project and key every other file.
+#include <cstddef>
 #include <string>
 #include <vector>
 
 #include "core/base/status.h"
 
 namespace reconar {
+
+// The memory budget of every stage and command unless one is given (`--memory-budget`): it suits a
+// 4 GB board, with room for the OS, a display and the AR viewer.
+inline constexpr size_t kDefaultMemoryBudgetBytes = 2560ull << 20;
 
 struct ProjectImage {
   std::string name;   // file name, e.g. "0004.jpg"
@@ -32,7 +37,7 @@ class Project {
   std::string ReportPath() const { return root_ + "/report.json"; }
   std::string TagDetectionsPath() const { return root_ + "/tags/detections.txt"; }  // core/sfm/tag_observations.h
   std::string TagsJsonPath() const { return root_ + "/tags.json"; }  // core/sfm/tag_registration.h
-  // The registered tags as a tracker/tag_layout.h layout (world_from_tag per id), for `track --layout`.
+  // The registered tags as a core/sfm/tag_layout.h layout (world_from_tag per id), for `track --layout`.
   std::string TagLayoutPath() const { return root_ + "/tags.layout"; }
   std::string DensePointsPath() const { return root_ + "/dense/points.ply"; }
   std::string MeshDir() const { return root_ + "/mesh"; }
@@ -48,5 +53,8 @@ class Project {
 // sorted by name), a file is taken as is. NotFound for a missing argument; InvalidArgument when two
 // images share a file name or nothing is left.
 Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string>& arguments);
+
+// Removes a file when it exists; IoError naming the file when it cannot be removed.
+Status RemoveFileIfPresent(const std::string& path);
 
 }  // namespace reconar

@@ -15,6 +15,7 @@
 #include "core/base/thread_pool.h"
 #include "core/io/image_io.h"
 #include "core/pipeline/stage_record.h"
+#include "core/sfm/model_io.h"
 
 namespace reconar {
 namespace {
@@ -115,27 +116,48 @@ std::string ReadOr(const std::string& path, const std::string& fallback) {
   return text.ok() ? *text : fallback;
 }
 
-std::string ReportJson(const Project& project, const ReconstructOptions& options, const ReconstructReport& report) {
-  const std::string sparse_text = ReadOr(project.SparseDir() + "/report.json", "null");
-  const std::string tags_text = ReadOr(project.TagsJsonPath(), "null");
-  const std::string dense_text = ReadOr(project.root() + "/dense/report.json", "null");
-  const std::string mesh_text = ReadOr(project.MeshDir() + "/report.json", "null");
-  const auto sparse = ParseJson(sparse_text, "sparse/report.json");
-  const auto dense = ParseJson(dense_text, "dense/report.json");
-  const auto mesh = ParseJson(mesh_text, "mesh/report.json");
+struct StageReports {
+  std::string sparse_text, tags_text, dense_text, mesh_text;
+};
+
+StageReports ReadStageReports(const Project& project) {
+  return {ReadOr(project.SparseDir() + "/report.json", "null"), ReadOr(project.TagsJsonPath(), "null"),
+          ReadOr(project.root() + "/dense/report.json", "null"), ReadOr(project.MeshDir() + "/report.json", "null")};
+}
+
+Table1 Table1From(const StageReports& reports) {
+  const auto sparse = ParseJson(reports.sparse_text, "sparse/report.json");
+  const auto dense = ParseJson(reports.dense_text, "dense/report.json");
+  const auto mesh = ParseJson(reports.mesh_text, "mesh/report.json");
   const JsonValue* s = sparse.ok() ? &*sparse : nullptr;
+  Table1 table;
+  table.images = static_cast<int>(NumberAt(s, "images"));
+  table.registered = static_cast<int>(NumberAt(s, "registered"));
+  table.sparse_points = static_cast<int>(NumberAt(s, "points"));
+  table.mean_focal_ratio = NumberAt(s, "mean_focal_ratio");
+  table.rmse_focal_ratio = NumberAt(s, "rmse_focal_ratio");
+  table.focal_35mm_equivalent_mm = NumberAt(s, "focal_35mm_equivalent_mm");
+  table.dense_points = static_cast<long long>(NumberAt(dense.ok() ? &*dense : nullptr, "points"));
+  table.mesh_vertices = static_cast<long long>(NumberAt(mesh.ok() ? &*mesh : nullptr, "vertices"));
+  table.mesh_faces = static_cast<long long>(NumberAt(mesh.ok() ? &*mesh : nullptr, "triangles"));
+  return table;
+}
+
+std::string ReportJson(const StageReports& reports, const ReconstructOptions& options,
+                       const ReconstructReport& report) {
+  const Table1& table = report.table1;
   JsonWriter json(2);
   json.BeginObject();
   json.Key("table1").BeginObject();  // the paper's Table 1 columns
-  json.Key("images").Int(static_cast<long long>(NumberAt(s, "images")));
-  json.Key("registered").Int(static_cast<long long>(NumberAt(s, "registered")));
-  json.Key("sparse_points").Int(static_cast<long long>(NumberAt(s, "points")));
-  json.Key("mean_focal_ratio").Double(NumberAt(s, "mean_focal_ratio"));
-  json.Key("rmse_focal_ratio").Double(NumberAt(s, "rmse_focal_ratio"));
-  json.Key("focal_35mm_equivalent_mm").Double(NumberAt(s, "focal_35mm_equivalent_mm"));
-  json.Key("dense_points").Int(static_cast<long long>(NumberAt(dense.ok() ? &*dense : nullptr, "points")));
-  json.Key("mesh_vertices").Int(static_cast<long long>(NumberAt(mesh.ok() ? &*mesh : nullptr, "vertices")));
-  json.Key("mesh_faces").Int(static_cast<long long>(NumberAt(mesh.ok() ? &*mesh : nullptr, "triangles")));
+  json.Key("images").Int(table.images);
+  json.Key("registered").Int(table.registered);
+  json.Key("sparse_points").Int(table.sparse_points);
+  json.Key("mean_focal_ratio").Double(table.mean_focal_ratio);
+  json.Key("rmse_focal_ratio").Double(table.rmse_focal_ratio);
+  json.Key("focal_35mm_equivalent_mm").Double(table.focal_35mm_equivalent_mm);
+  json.Key("dense_points").Int(table.dense_points);
+  json.Key("mesh_vertices").Int(table.mesh_vertices);
+  json.Key("mesh_faces").Int(table.mesh_faces);
   json.EndObject();
   json.Key("metric").Bool(report.metric);
   json.Key("scale").String(report.metric ? "metres, world frame of the reference tag (tags.json)" : report.scale_note);
@@ -153,20 +175,43 @@ std::string ReportJson(const Project& project, const ReconstructOptions& options
   }
   json.EndArray();
   json.Key("seconds").Double(seconds).Key("peak_rss_mib").Double(Mib(peak));
-  json.Key("sparse").Raw(sparse.ok() ? sparse_text : "null");
-  json.Key("tags").Raw(ParseJson(tags_text, "tags.json").ok() ? tags_text : "null");
-  json.Key("dense").Raw(dense.ok() ? dense_text : "null");
-  json.Key("mesh").Raw(mesh.ok() ? mesh_text : "null");
+  const auto raw_or_null = [](const std::string& text, const char* name) {
+    return ParseJson(text, name).ok() ? text : std::string("null");
+  };
+  json.Key("sparse").Raw(raw_or_null(reports.sparse_text, "sparse/report.json"));
+  json.Key("tags").Raw(raw_or_null(reports.tags_text, "tags.json"));
+  json.Key("dense").Raw(raw_or_null(reports.dense_text, "dense/report.json"));
+  json.Key("mesh").Raw(raw_or_null(reports.mesh_text, "mesh/report.json"));
   json.EndObject();
   return json.str() + "\n";
 }
 
 }  // namespace
 
+ReconstructOptions::ReconstructOptions() {
+  matching.match.max_ratio = 0.8;
+  matching.two_view.min_inliers = 30;
+  mesh.poisson.depth = 10;
+  mesh.poisson.trim = 7.0;
+  mesh.max_faces = kHandheldMaxFaces;
+}
+
+Eigen::Vector3d UpFromCameras(const Project& project) {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  if (auto model = ReadColmapTextModel(project.SparseDir()); model.ok()) {
+    for (const SfmImage& image : model->images) {
+      if (image.registered) up -= image.pose.cam_from_world_rotation.row(1).transpose();
+    }
+  }
+  return up.norm() > 1e-9 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d(-Eigen::Vector3d::UnitY());
+}
+
 Status ReconstructOptions::Check() const {
   if (tag_size_m < 0.0 || !std::isfinite(tag_size_m)) return InvalidArgument("the tag size must be positive");
   if (tag_size_m > 0.0 && !detect_tags) return InvalidArgument("reconstruct: tags requested without a tag detector");
   if (memory_budget_bytes < (64u << 20)) return InvalidArgument("the memory budget must be at least 64 MiB");
+  if (!(sfm.mapper.max_reprojection_error_px > 0.0))
+    return InvalidArgument("the maximum reprojection error must be positive");
   RECONAR_RETURN_IF_ERROR(dense.Check());
   return mesh.Check();
 }
@@ -174,6 +219,9 @@ Status ReconstructOptions::Check() const {
 Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_paths, const Project& project,
                                          const ReconstructOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
+  if (options.run_sparse && image_paths.size() < 2) {
+    return InvalidArgument("reconstruct needs at least 2 photos, got " + std::to_string(image_paths.size()));
+  }
   RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root()));
   RECONAR_ASSIGN_OR_RETURN(const int stale, RemoveStaleTemporaryFiles(project.root()));
   if (stale > 0) std::fprintf(stderr, "removed %d temporary file(s) of an interrupted run\n", stale);
@@ -220,6 +268,7 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     MatchStageOptions matching = options.matching;
     matching.num_threads = threads;
     matching.memory_budget_bytes = budget;
+    matching.show_progress = options.show_progress;
     const auto run_matching = [&](StageSummary* summary) -> Status {
       RECONAR_ASSIGN_OR_RETURN(const MatchStageReport r, RunMatchStage(project, matching));
       if (r.num_blocks > 1) {
@@ -259,8 +308,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
       if (with_tags && !r.tags.metric) summary->note = "no metric registration: " + r.tags.reason;
       if (!with_tags) {
-        std::filesystem::remove(project.TagsJsonPath());
-        std::filesystem::remove(project.TagLayoutPath());
+        RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagsJsonPath()));
+        RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagLayoutPath()));
       }
       JsonWriter json(2);
       json.BeginObject();
@@ -344,8 +393,28 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
   } else {
     report.scale_note = "arbitrary (no --tag-size given)";
   }
+  const StageReports reports = ReadStageReports(project);
+  report.table1 = Table1From(reports);
   report.report_path = project.ReportPath();
-  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, ReportJson(project, options, report)));
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, ReportJson(reports, options, report)));
+
+  if (options.render_preview) {
+    // What this run made last.
+    std::string model = options.run_dense ? project.DensePointsPath() : project.SparseDir() + "/points.ply";
+    for (const char* format : {"ply", "glb", "obj"}) {  // the readable mesh formats, the fastest first
+      const auto& formats = options.mesh.formats;
+      if (options.run_mesh && std::find(formats.begin(), formats.end(), format) != formats.end()) {
+        model = project.MeshDir() + "/mesh." + format;
+        break;
+      }
+    }
+    const std::string png = project.root() + "/preview.png";
+    if (Status s = options.render_preview(model, UpFromCameras(project), png); s.ok()) {
+      report.preview_path = png;
+    } else {
+      report.preview_error = s.ToString();
+    }
+  }
   return report;
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <map>
 #include <memory>
 
@@ -177,7 +176,7 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     if (report.tags.metric) {
       RECONAR_RETURN_IF_ERROR(WriteFileAtomically(project.TagLayoutPath(), TagLayoutText(report.tags, size)));
     } else {
-      std::filesystem::remove(project.TagLayoutPath());
+      RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagLayoutPath()));
     }
     RECONAR_RETURN_IF_ERROR(WriteFileAtomically(project.TagsJsonPath(), TagRegistrationJson(report.tags, tag_family, size)));
   }
@@ -205,6 +204,10 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("aspect_refined").Bool(m.aspect_refined);
   json->Key("tracks").Int(m.num_tracks);
   json->Key("inconsistent_tracks_dropped").Int(m.num_inconsistent_tracks);
+  json->Key("seconds_mapping").Double(sfm.seconds_mapping);
+  json->Key("seconds_bundle_adjustment").Double(m.seconds_ba);
+  json->Key("local_bundle_adjustments").Int(m.num_local_ba);
+  json->Key("global_bundle_adjustments").Int(m.num_global_ba);
   json->Key("unregistered").BeginArray();
   for (const MapperReport::Unregistered& u : m.unregistered) {
     json->BeginObject().Key("image").String(u.name).Key("reason").String(u.reason).EndObject();

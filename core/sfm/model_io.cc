@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/base/atomic_file.h"
+#include "core/base/number_format.h"
 
 namespace reconar {
 
@@ -78,17 +79,10 @@ Status CheckIndices(const Reconstruction& reconstruction) {
 // ---------------------------------------------------------------------------------------------
 // Text output.
 
-// Shortest text that reads back as the same double.
-void AppendNumber(std::string* out, double value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out->append(buffer, result.ptr);
-}
-
 void AppendNumbers(std::string* out, std::initializer_list<double> values) {
   for (const double value : values) {
     if (!out->empty() && out->back() != '\n') out->push_back(' ');
-    AppendNumber(out, value);
+    AppendShortest(out, value);
   }
 }
 
@@ -254,9 +248,9 @@ Status WriteColmapImages(const Reconstruction& reconstruction, const std::string
       for (size_t k = 0; k < image.keypoints.size(); ++k) {
         const int point_id = image.point3d_ids[k];
         if (k > 0) line += ' ';
-        AppendNumber(&line, image.keypoints[k].x() + kColmapPixelOffset);
+        AppendShortest(&line, image.keypoints[k].x() + kColmapPixelOffset);
         line += ' ';
-        AppendNumber(&line, image.keypoints[k].y() + kColmapPixelOffset);
+        AppendShortest(&line, image.keypoints[k].y() + kColmapPixelOffset);
         line += ' ';
         line += IsExportedPoint(reconstruction, point_id) ? std::to_string(point_id + 1) : "-1";
       }
@@ -292,7 +286,7 @@ Status WriteColmapPoints(const Reconstruction& reconstruction, const std::string
       AppendNumbers(&line, {point.position.x(), point.position.y(), point.position.z()});
       for (const uint8_t c : point.color) line += " " + std::to_string(c);
       line += ' ';
-      AppendNumber(&line, point.error);
+      AppendShortest(&line, point.error);
       for (const TrackElement& element : point.track) {
         if (!IsRegisteredImage(reconstruction, element.image_id)) continue;
         line += " " + std::to_string(element.image_id + 1) + " " + std::to_string(element.keypoint_id);
@@ -616,9 +610,9 @@ Status WriteBundlerModel(const Reconstruction& reconstruction, const std::string
         const SfmCamera& camera = reconstruction.cameras[image.camera_id];
         const Eigen::Vector2d& key = image.keypoints[element.keypoint_id];
         views += " " + std::to_string(element.image_id) + " " + std::to_string(element.keypoint_id) + " ";
-        AppendNumber(&views, key.x() - 0.5 * (camera.width - 1));
+        AppendShortest(&views, key.x() - 0.5 * (camera.width - 1));
         views += ' ';
-        AppendNumber(&views, 0.5 * (camera.height - 1) - key.y());
+        AppendShortest(&views, 0.5 * (camera.height - 1) - key.y());
         ++num_views;
       }
       text += std::to_string(num_views) + views + "\n";

@@ -11,6 +11,7 @@
 
 #include "core/base/json_writer.h"
 #include "core/geometry/triangulation.h"
+#include "core/sfm/tag_layout.h"
 
 namespace reconar {
 namespace {
@@ -338,16 +339,9 @@ std::string TagRegistrationJson(const TagRegistrationReport& report, const std::
 }
 
 std::string TagLayoutText(const TagRegistrationReport& report, double tag_size_m) {
-  std::string text = "# reconar tag layout: id size x y z qw qx qy qz (world_from_tag, metres)\n";
-  char line[320];
-  for (const RegisteredTag& tag : report.tags) {
-    const Eigen::Quaterniond q(tag.world_from_tag.rotation);
-    const Eigen::Vector3d& t = tag.world_from_tag.translation;
-    std::snprintf(line, sizeof(line), "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", tag.id, tag_size_m, t.x(),
-                  t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
-    text += line;
-  }
-  return text;
+  std::vector<LayoutTag> tags;
+  for (const RegisteredTag& tag : report.tags) tags.push_back(LayoutTag{tag.id, tag_size_m, tag.world_from_tag});
+  return FormatTagLayout(tags);
 }
 
 }  // namespace reconar

@@ -98,7 +98,7 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
 // "rms_reprojection_px", "world_from_tag": {"R": [9, row-major], "t": [3]}}]}.
 std::string TagRegistrationJson(const TagRegistrationReport& report, const std::string& family, double tag_size_m);
 
-// The registered tags in the text format of tracker/tag_layout.h ("id size x y z qw qx qy qz", the
+// The registered tags in the text format of core/sfm/tag_layout.h ("id size x y z qw qx qy qz", the
 // layout frame being the world frame), so that the AR tracker can use all of them at once.
 std::string TagLayoutText(const TagRegistrationReport& report, double tag_size_m);
 

@@ -48,6 +48,39 @@ Status FrameSourceOptions::Check() const {
   return Status::Ok();
 }
 
+FrameHandle::FrameHandle(FrameHandle&& other) noexcept : source_(other.source_), frame_(other.frame_) {
+  other.source_ = nullptr;
+}
+
+FrameHandle& FrameHandle::operator=(FrameHandle&& other) noexcept {
+  if (this != &other) {
+    reset();
+    source_ = other.source_;
+    frame_ = other.frame_;
+    other.source_ = nullptr;
+  }
+  return *this;
+}
+
+void FrameHandle::reset() {
+  if (source_ == nullptr) return;
+  FrameSource* source = source_;
+  source_ = nullptr;
+  --source->frames_held_;
+  source->ReleaseFrame(frame_);
+}
+
+FrameSource::~FrameSource() {
+  RECONAR_CHECK(frames_held_ == 0) << frames_held_ << " frame(s) still held when their source was destroyed";
+}
+
+Result<FrameHandle> FrameSource::Next() {
+  Result<Frame> frame = NextFrame();
+  if (!frame.ok()) return frame.status();
+  ++frames_held_;
+  return FrameHandle(this, *frame);
+}
+
 Status EndOfStream(std::string_view source_name) {
   return Status(StatusCode::kNotFound, std::string(source_name) + std::string(kEndOfStreamSuffix));
 }

@@ -2,18 +2,21 @@
 // FrameSource: a stream of camera frames (live V4L2 / libcamera device, image folder, recorded
 // .frames file) delivered as strided 8-bit views over buffers the source owns.
 //
-// Ownership and lifetime. Next() hands out a Frame whose views (and name) point into one of the
-// source's `buffer_count()` buffers: a device buffer (V4L2 mmap, libcamera dmabuf), a recording's
-// memory map, or a source-owned conversion buffer. The frame stays valid until Release(frame)
-// or the source's destruction, whichever comes first. Up to buffer_count() frames may be held at
-// once; while all of them are held, Next() returns kFailedPrecondition ("all N frame buffers are
-// held") without blocking, so a caller that forgets Release() gets an error, not a dead lock.
-// For devices, holding frames also starves the driver's queue (it drops frames meanwhile).
+// Ownership and lifetime. Next() hands out a FrameHandle: a move-only owner of one of the source's
+// `buffer_count()` buffers (a device buffer: V4L2 mmap, libcamera dmabuf; a recording's memory
+// map; or a source-owned conversion buffer), into which the frame's views and name point. The
+// buffer goes back to the source when the handle is destroyed, reset or assigned over (as a
+// completed request's handle does in rpicam-apps), so no path can forget it. Handles must not
+// outlive their source (destroying a source while one of its frames is held is a programmer
+// error, RECONAR_CHECK). Up to buffer_count() frames may be held at once; while all of them are
+// held, Next() returns kFailedPrecondition ("all N frame buffers are held") without blocking, so a
+// caller that keeps too many gets an error, not a dead lock. For devices, holding frames also
+// starves the driver's queue (it drops frames meanwhile).
 //
 // Zero copy where the layout allows it: NV12's Y plane and GRAY8 buffers are the gray image and
 // RGB24 buffers are the rgb image (views straight into the device or recorded buffer); YUYV,
 // MJPEG and the other combinations are converted into buffers preallocated when the frame size
-// is first seen. After the first frame, Next()+Release() on raw (non-JPEG) frames does not
+// is first seen. After the first frame, Next() and releasing the handle on raw (non-JPEG) frames does not
 // allocate.
 //
 // Streams end with IsEndOfStream(status) (code kNotFound, message "<source>: end of stream").
@@ -67,20 +70,60 @@ struct Frame {
   PixelFormat source_format = PixelFormat::kUnknown;  // the raw layout the frame came from
   ImageView<const uint8_t> gray;  // width x height
   ImageView<const uint8_t> rgb;   // interleaved, view width = 3 * width; empty unless want_rgb
-  int buffer = -1;                // which source buffer holds it (for Release)
+  int buffer = -1;                // which source buffer holds it (given back by its FrameHandle)
+};
+
+class FrameSource;
+
+// One frame held from a FrameSource; gives its buffer back on destruction, reset() or move
+// assignment. Empty after a move or reset() (operator bool is false; * and -> are then a
+// programmer error, RECONAR_CHECK).
+// Makes no allocation.
+class FrameHandle {
+ public:
+  FrameHandle() = default;
+  FrameHandle(FrameHandle&& other) noexcept;
+  FrameHandle& operator=(FrameHandle&& other) noexcept;
+  FrameHandle(const FrameHandle&) = delete;
+  FrameHandle& operator=(const FrameHandle&) = delete;
+  ~FrameHandle() { reset(); }
+
+  const Frame& operator*() const {
+    RECONAR_CHECK(source_ != nullptr) << "an empty FrameHandle has no frame";
+    return frame_;
+  }
+  const Frame* operator->() const { return &**this; }
+  explicit operator bool() const { return source_ != nullptr; }
+  // Gives the buffer back now; the views become invalid.
+  void reset();
+
+ private:
+  friend class FrameSource;
+  FrameHandle(FrameSource* source, const Frame& frame) : source_(source), frame_(frame) {}
+
+  FrameSource* source_ = nullptr;  // not owned; nullptr when empty
+  Frame frame_;
 };
 
 class FrameSource {
  public:
-  virtual ~FrameSource() = default;
+  virtual ~FrameSource();  // RECONAR_CHECK: no FrameHandle of this source is still held
   // Blocks until the next frame (live sources: at most options.timeout_ms).
-  virtual Result<Frame> Next() = 0;
-  // Gives the frame's buffer back to the source. Releasing a frame twice, or one from another
-  // source, is a programmer error (RECONAR_CHECK).
-  virtual void Release(const Frame& frame) = 0;
+  Result<FrameHandle> Next();
   // "V4L2 /dev/video0 (uvcvideo, USB Camera) 640x480 MJPG", "folder photos/ (93 images)", ...
   virtual std::string Describe() const = 0;
   virtual int buffer_count() const = 0;
+  int frames_held() const { return frames_held_; }
+
+ protected:
+  // What each source implements: deliver a frame in one of its buffers, and take a buffer back
+  // (called once per delivered frame, by its FrameHandle).
+  virtual Result<Frame> NextFrame() = 0;
+  virtual void ReleaseFrame(const Frame& frame) = 0;
+
+ private:
+  friend class FrameHandle;
+  int frames_held_ = 0;
 };
 
 Status EndOfStream(std::string_view source_name);

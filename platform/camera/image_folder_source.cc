@@ -100,11 +100,11 @@ Status ImageFolderFrameSource::DecodeInto(const std::string& path, int buffer) {
   return Status::Ok();
 }
 
-Result<Frame> ImageFolderFrameSource::Next() {
+Result<Frame> ImageFolderFrameSource::NextFrame() {
   if (next_ >= file_names_.size()) return EndOfStream(directory_);
   if (buffers_.all_held()) {
     return FileError(StatusCode::kFailedPrecondition, directory_,
-                     "all " + std::to_string(buffers_.count()) + " frame buffers are held; Release() one first");
+                     "all " + std::to_string(buffers_.count()) + " frame buffers are held; release one first");
   }
   const size_t index = next_++;
   const std::string& name = file_names_[index];
@@ -152,7 +152,7 @@ Result<Frame> ImageFolderFrameSource::Next() {
   return frame;
 }
 
-void ImageFolderFrameSource::Release(const Frame& frame) { buffers_.Release(frame.buffer); }
+void ImageFolderFrameSource::ReleaseFrame(const Frame& frame) { buffers_.Release(frame.buffer); }
 
 std::string ImageFolderFrameSource::Describe() const {
   return "folder " + directory_ + " (" + std::to_string(file_names_.size()) + " images)";

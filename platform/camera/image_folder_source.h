@@ -22,14 +22,14 @@ class ImageFolderFrameSource final : public FrameSource {
                                                               const FrameSourceOptions& options = {});
 
   // Decode errors (kCorruptData/kUnsupported) name the file; the next call moves on to the next file.
-  Result<Frame> Next() override;
-  void Release(const Frame& frame) override;
   std::string Describe() const override;
   int buffer_count() const override { return buffers_.count(); }
 
   const std::vector<std::string>& file_names() const { return file_names_; }
 
  private:
+  Result<Frame> NextFrame() override;
+  void ReleaseFrame(const Frame& frame) override;
   ImageFolderFrameSource(std::string directory, std::vector<std::string> file_names, const FrameSourceOptions& options);
   Status DecodeInto(const std::string& path, int buffer);
 

@@ -246,12 +246,11 @@ Result<std::unique_ptr<LibcameraFrameSource>> LibcameraFrameSource::Open(int cam
   return std::unique_ptr<LibcameraFrameSource>(new LibcameraFrameSource(std::move(impl)));
 }
 
-Result<Frame> LibcameraFrameSource::Next() {
+Result<Frame> LibcameraFrameSource::NextFrame() {
   Impl& impl = *impl_;
   if (impl.buffers->all_held()) {
-    return CameraError(StatusCode::kFailedPrecondition,
-                       impl.name + ": all " + std::to_string(impl.buffers->count()) +
-                           " frame buffers are held; Release() one first");
+    return CameraError(StatusCode::kFailedPrecondition, impl.name + ": all " + std::to_string(impl.buffers->count()) +
+                                                            " frame buffers are held; release one first");
   }
   for (;;) {
     libcamera::Request* request = nullptr;
@@ -305,14 +304,14 @@ Result<Frame> LibcameraFrameSource::Next() {
     Status status = impl.converter.Convert(raw, frame.name, impl.buffers->gray(index), impl.buffers->rgb(index),
                                            &frame.gray, &frame.rgb);
     if (!status.ok()) {
-      Release(frame);
+      ReleaseFrame(frame);
       return status;
     }
     return frame;
   }
 }
 
-void LibcameraFrameSource::Release(const Frame& frame) {
+void LibcameraFrameSource::ReleaseFrame(const Frame& frame) {
   Impl& impl = *impl_;
   impl.buffers->Release(frame.buffer);
   libcamera::Request* request = impl.slots[static_cast<size_t>(frame.buffer)].request.get();

@@ -3,7 +3,7 @@
 // → one Viewfinder stream configured at options.width x options.height → FrameBufferAllocator
 // buffers (dmabuf planes mmap'ed read-only) → one Request per buffer. The requestCompleted
 // signal (libcamera's thread) pushes finished requests into a small locked queue; Next() waits
-// on it for at most options.timeout_ms. Release() re-queues the frame's request.
+// on it for at most options.timeout_ms. Releasing a frame re-queues its request.
 //
 // Pixel format: options.pixel_format if the stream offers it, else NV12 (the native ISP output
 // on Raspberry Pi class boards, zero-copy gray), YUYV, MJPEG. Quantisation from the stream's
@@ -27,14 +27,14 @@ class LibcameraFrameSource final : public FrameSource {
   // Stops the camera, frees its buffers, releases it; commits the recording (if any).
   ~LibcameraFrameSource() override;
 
-  Result<Frame> Next() override;
-  void Release(const Frame& frame) override;
   std::string Describe() const override;
   int buffer_count() const override;
 
   struct Impl;  // libcamera objects stay out of this header
 
  private:
+  Result<Frame> NextFrame() override;
+  void ReleaseFrame(const Frame& frame) override;
   explicit LibcameraFrameSource(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

@@ -165,11 +165,11 @@ Status RecordedFrameSource::FrameError(StatusCode code, const std::string& reaso
   return FileError(code, path_, "frame " + std::to_string(next_index_) + ": " + reason);
 }
 
-Result<Frame> RecordedFrameSource::Next() {
+Result<Frame> RecordedFrameSource::NextFrame() {
   if (offset_ == size_) return EndOfStream(path_);
   if (buffers_.all_held()) {
     return FileError(StatusCode::kFailedPrecondition, path_,
-                     "all " + std::to_string(buffers_.count()) + " frame buffers are held; Release() one first");
+                     "all " + std::to_string(buffers_.count()) + " frame buffers are held; release one first");
   }
   const size_t left = size_ - offset_;
   if (left < kRecordedFrameRecordBytes) {
@@ -238,7 +238,7 @@ Result<Frame> RecordedFrameSource::Next() {
   return frame;
 }
 
-void RecordedFrameSource::Release(const Frame& frame) { buffers_.Release(frame.buffer); }
+void RecordedFrameSource::ReleaseFrame(const Frame& frame) { buffers_.Release(frame.buffer); }
 
 std::string RecordedFrameSource::Describe() const {
   return "recording " + path_ + " (" + std::to_string(size_) + " bytes)";

@@ -67,12 +67,12 @@ class RecordedFrameSource final : public FrameSource {
                                                            const FrameSourceOptions& options = {});
   ~RecordedFrameSource() override;
 
-  Result<Frame> Next() override;
-  void Release(const Frame& frame) override;
   std::string Describe() const override;
   int buffer_count() const override { return buffers_.count(); }
 
  private:
+  Result<Frame> NextFrame() override;
+  void ReleaseFrame(const Frame& frame) override;
   RecordedFrameSource(std::string path, const uint8_t* map, size_t size, const FrameSourceOptions& options);
   Status FrameError(StatusCode code, const std::string& reason) const;
 

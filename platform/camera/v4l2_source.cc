@@ -225,10 +225,10 @@ Status V4L2FrameSource::DeviceError(StatusCode code, const std::string& reason) 
   return FileError(code, device_, reason);
 }
 
-Result<Frame> V4L2FrameSource::Next() {
+Result<Frame> V4L2FrameSource::NextFrame() {
   if (buffers_.all_held()) {
-    return DeviceError(StatusCode::kFailedPrecondition, "all " + std::to_string(buffers_.count()) +
-                                                            " frame buffers are held; Release() one first");
+    return DeviceError(StatusCode::kFailedPrecondition,
+                       "all " + std::to_string(buffers_.count()) + " frame buffers are held; release one first");
   }
   v4l2_buffer buffer{};
   for (;;) {
@@ -288,14 +288,14 @@ Result<Frame> V4L2FrameSource::Next() {
   Status status = converter_.Convert(raw, frame.name, buffers_.gray(index), buffers_.rgb(index), &frame.gray,
                                      &frame.rgb);
   if (!status.ok()) {
-    Release(frame);
+    ReleaseFrame(frame);
     return status;
   }
   ++delivered_;
   return frame;
 }
 
-void V4L2FrameSource::Release(const Frame& frame) {
+void V4L2FrameSource::ReleaseFrame(const Frame& frame) {
   buffers_.Release(frame.buffer);
   v4l2_buffer buffer{};
   buffer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;

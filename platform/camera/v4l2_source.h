@@ -2,7 +2,7 @@
 // V4L2FrameSource: a Linux video capture device through the V4L2 ioctl interface (no libv4l),
 // mmap streaming I/O with options.buffer_count driver buffers (the driver may grant more or
 // fewer; buffer_count() says how many). Frames point into those buffers: a held frame is a
-// buffer the driver cannot fill, so hold few and Release() promptly (Release = VIDIOC_QBUF).
+// buffer the driver cannot fill, so hold few and release them promptly (a FrameHandle's release = VIDIOC_QBUF).
 //
 // Format negotiation: options.pixel_format if the device offers it, else the first of MJPEG,
 // YUYV, NV12, GREY, RGB3 that it offers (VIDIOC_ENUM_FMT), at options.width x options.height as
@@ -31,8 +31,6 @@ class V4L2FrameSource final : public FrameSource {
   // STREAMOFF, unmaps the buffers, closes the device, commits the recording (if any).
   ~V4L2FrameSource() override;
 
-  Result<Frame> Next() override;
-  void Release(const Frame& frame) override;
   std::string Describe() const override;
   int buffer_count() const override { return buffers_.count(); }
 
@@ -40,6 +38,8 @@ class V4L2FrameSource final : public FrameSource {
   const RawFrameLayout& layout() const { return layout_; }
 
  private:
+  Result<Frame> NextFrame() override;
+  void ReleaseFrame(const Frame& frame) override;
   struct Mapping {
     void* data = nullptr;
     size_t length = 0;

@@ -106,4 +106,13 @@ TEST(Cli, TwoUnrelatedPhotosAreReportedNotCrashed) {
   EXPECT_NE(run.output.find("too few inliers"), std::string::npos) << run.output;
 }
 
+TEST(Cli, VersionNamesTheBuildAndTheKernelsThisCpuRuns) {
+  const CommandRun run = RunReconar("--version");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(run.output.rfind("reconar 0.", 0), 0u) << run.output;
+  for (const char* line : {"\ncpu: ", "\nkernel descriptor_distance: ", "\nkernel ncc: ", "\nkernel sift: "}) {
+    EXPECT_NE(run.output.find(line), std::string::npos) << line << " in\n" << run.output;
+  }
+}
+
 }  // namespace

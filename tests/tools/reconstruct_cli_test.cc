@@ -284,5 +284,37 @@ TEST(ReconstructCli, PhotosWithoutTagsKeepAnArbitraryScaleAndSaySo) {
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
 }
 
+// `sfm` is `reconstruct --stages sparse`: either command continues a project the other started,
+// reusing its features, matches and model (the stage lines say "reused", the files stay as they were).
+TEST(ReconstructCli, SfmAndReconstructReuseEachOthersStages) {
+  const std::string data = std::string(RECONAR_SOURCE_DIR) + "/data/templeSparseRing";
+  const std::string dir = testing::MakeTestDirectory("reconar_sfm_then_reconstruct");
+  const struct {
+    const char* name;
+    std::string first, second;
+  } orders[] = {{"sfm_first", "sfm", "reconstruct --stages sparse"},
+                {"reconstruct_first", "reconstruct --stages sparse", "sfm"}};
+  for (const auto& order : orders) {
+    const std::string project = dir + "/" + order.name;
+    const CommandRun first = RunReconar(order.first + " " + data + " " + project + " --threads 2 --no-preview");
+    ASSERT_EQ(first.exit_code, 0) << first.output;
+    EXPECT_NE(first.output.find("mapping   done"), std::string::npos) << first.output;
+    const auto before = ProjectFiles(project);
+    ASSERT_TRUE(before.count("features/images.txt") && before.count("matches/matches.txt") &&
+                before.count("sparse/points3D.txt"))
+        << order.name;
+    const CommandRun second = RunReconar(order.second + " " + data + " " + project + " --threads 2 --no-preview");
+    ASSERT_EQ(second.exit_code, 0) << second.output;
+    for (const char* stage : {"features ", "matching ", "mapping  "}) {
+      EXPECT_NE(second.output.find(std::string(stage) + " reused"), std::string::npos)
+          << order.name << ": " << stage << "\n"
+          << second.output;
+    }
+    EXPECT_EQ(second.output.find("done"), std::string::npos) << order.name << ": nothing redone\n" << second.output;
+    EXPECT_NE(second.output.find("of 16 images registered"), std::string::npos) << second.output;
+    EXPECT_TRUE(ProjectFiles(project) == before) << order.name << ": the files changed";
+  }
+}
+
 }  // namespace
 }  // namespace reconar

@@ -113,5 +113,15 @@ Image<uint8_t> RenderTags(const SyntheticTag* tags, int count, const CameraIntri
   return image;
 }
 
+CameraIntrinsics TestCamera() {
+  CameraIntrinsics camera;
+  camera.width = 640;
+  camera.height = 480;
+  camera.fx = camera.fy = 600.0;
+  camera.cx = 320.0;
+  camera.cy = 240.0;
+  return camera;
+}
+
 }  // namespace testing
 }  // namespace reconar

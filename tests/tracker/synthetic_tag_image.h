@@ -34,6 +34,8 @@ struct SyntheticRenderOptions {
 // Returns false when the family cannot be rendered or the tag is not in front of the camera.
 bool DrawTag(const SyntheticTag& tag, const CameraIntrinsics& camera, int supersampling, Image<uint8_t>* image);
 
+// The tests' camera: 640x480, f = 600 px, principal point (320, 240), no distortion.
+CameraIntrinsics TestCamera();
 // A camera.width x camera.height frame of the background with the tags drawn, then blurred.
 Image<uint8_t> RenderTags(const SyntheticTag* tags, int count, const CameraIntrinsics& camera,
                           const SyntheticRenderOptions& options);

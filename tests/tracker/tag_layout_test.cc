@@ -16,6 +16,31 @@ using testing::RenderTags;
 using testing::SyntheticRenderOptions;
 using testing::SyntheticTag;
 
+// The writer (tag registration's tags.layout) and the reader are one module: what is written reads
+// back to the same tags, and writing that again gives the same bytes.
+TEST(TagLayoutTest, FormatReadsBackExactly) {
+  std::vector<LayoutTag> tags(2);
+  tags[0].id = 2;
+  tags[0].size = 0.127;
+  tags[0].layout_from_tag.translation = Eigen::Vector3d(0.1, -1.0 / 3.0, 2.5);
+  tags[0].layout_from_tag.rotation = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  tags[1].id = 9;
+  tags[1].size = 0.127;
+  const std::string text = FormatTagLayout(tags);
+  EXPECT_EQ(text.rfind("# reconar tag layout: id size x y z qw qx qy qz (world_from_tag, metres)\n2 0.127 ", 0), 0u)
+      << text;
+  const Result<TagLayout> layout = ParseTagLayout(text, "tags.layout");
+  ASSERT_TRUE(layout.ok()) << layout.status().ToString();
+  ASSERT_EQ(layout->tags().size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(layout->tags()[i].id, tags[i].id);
+    EXPECT_EQ(layout->tags()[i].size, tags[i].size);
+    EXPECT_EQ(layout->tags()[i].layout_from_tag.translation, tags[i].layout_from_tag.translation);
+    EXPECT_LT((layout->tags()[i].layout_from_tag.rotation - tags[i].layout_from_tag.rotation).norm(), 1e-15);
+  }
+  EXPECT_EQ(FormatTagLayout(layout->tags()), text);
+}
+
 TEST(TagLayoutTest, ParsesBothLineFormsAndComments) {
   const Result<TagLayout> layout = ParseTagLayout(
       "# a board\n"

@@ -14,12 +14,7 @@ namespace reconar {
 namespace {
 
 TEST(TagTrackerAllocationTest, SteadyStateTrackingDoesNotAllocate) {
-  CameraIntrinsics camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 600.0;
-  camera.cx = 320.0;
-  camera.cy = 240.0;
+  const CameraIntrinsics camera = testing::TestCamera();
   std::vector<Image<uint8_t>> frames;
   std::vector<testing::SyntheticTag> truth;
   for (int frame = 0; frame < 24; ++frame) {

@@ -15,16 +15,7 @@ using testing::ProjectedCorners;
 using testing::RenderTags;
 using testing::SyntheticRenderOptions;
 using testing::SyntheticTag;
-
-CameraIntrinsics TestCamera() {
-  CameraIntrinsics camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 600.0;
-  camera.cx = 320.0;
-  camera.cy = 240.0;
-  return camera;
-}
+using testing::TestCamera;
 
 // Tag 21 sliding and turning slowly in front of the camera.
 SyntheticTag MovingTag(int frame) {

@@ -2,6 +2,7 @@
 // reports both. Tails shorter than a vector fall back to the reference.
 #include <immintrin.h>
 
+#include "core/base/cpu_features.h"
 #include "core/features/sift/kernels.h"
 
 namespace reconar {
@@ -166,7 +167,7 @@ void GradientRowAvx2(const float* above, const float* row, const float* below, i
 const SiftKernels* sift_internal::Avx2SiftKernels() {
   static const SiftKernels kernels{"avx2", ConvolveColumnsAvx2, ConvolveColumns2Avx2, ConvolveRowAvx2, DifferenceOfGaussiansAvx2, FindExtremaAvx2,
                                    GradientRowAvx2};
-  static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  static const bool supported = HostCpuFeatures().avx2 && HostCpuFeatures().fma;
   return supported ? &kernels : nullptr;
 }
 

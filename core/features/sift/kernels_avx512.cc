@@ -3,6 +3,7 @@
 // a vector fall back to the reference.
 #include <immintrin.h>
 
+#include "core/base/cpu_features.h"
 #include "core/features/sift/kernels.h"
 
 namespace reconar {
@@ -134,7 +135,7 @@ int FindExtremaAvx512(const float* const* dog, int x_begin, int x_end, float thr
 }  // namespace
 
 const SiftKernels* sift_internal::Avx512SiftKernels() {
-  static const bool supported = __builtin_cpu_supports("avx512f") && Avx2SiftKernels() != nullptr;
+  static const bool supported = HostCpuFeatures().avx512f && Avx2SiftKernels() != nullptr;
   if (!supported) return nullptr;
   static const SiftKernels kernels{"avx512",       ConvolveColumnsAvx512, ConvolveColumns2Avx512,
                                    ConvolveRowAvx512, DifferenceOfGaussiansAvx512,     FindExtremaAvx512,

@@ -1,7 +1,9 @@
 #include "core/features/sift/sift_io.h"
 
+#include <cerrno>
 #include <cinttypes>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 
@@ -23,6 +25,35 @@ static_assert(sizeof(PackedKeypoint) == 24, "feature file layout");
 template <typename T>
 void Append(std::string* out, const T& value) {
   out->append(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+constexpr size_t kHeader = sizeof(kMagic) + 5 * sizeof(uint32_t);
+
+// Checks the first kHeader bytes of a file of file_size bytes (head holds min(kHeader, file_size)).
+Result<FeatureFileHeader> ParseHeader(const std::string& path, const char* head, uint64_t file_size) {
+  if (file_size < kHeader || std::memcmp(head, kMagic, sizeof(kMagic)) != 0) {
+    return FileError(StatusCode::kCorruptData, path, "not a reconar feature file");
+  }
+  uint32_t header[5];
+  std::memcpy(header, head + sizeof(kMagic), sizeof(header));
+  if (header[0] != kVersion) {
+    return FileError(StatusCode::kUnsupported, path, "feature file version " + std::to_string(header[0]));
+  }
+  if (header[4] != kDescriptorBytes) {
+    return FileError(StatusCode::kCorruptData, path, "descriptor size " + std::to_string(header[4]));
+  }
+  const uint64_t count = header[3];
+  const uint64_t expected = kHeader + count * (sizeof(PackedKeypoint) + kDescriptorBytes);
+  if (file_size != expected) {
+    return FileError(StatusCode::kCorruptData, path,
+                     "truncated or padded: " + std::to_string(file_size) + " bytes, expected " +
+                         std::to_string(expected));
+  }
+  FeatureFileHeader parsed;
+  parsed.image_width = static_cast<int>(header[1]);
+  parsed.image_height = static_cast<int>(header[2]);
+  parsed.count = static_cast<size_t>(count);
+  return parsed;
 }
 
 }  // namespace
@@ -49,28 +80,11 @@ Status WriteFeatureFile(const std::string& path, const FeatureFile& file) {
 
 Result<FeatureFile> ReadFeatureFile(const std::string& path) {
   RECONAR_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
-  constexpr size_t kHeader = sizeof(kMagic) + 5 * sizeof(uint32_t);
-  if (bytes.size() < kHeader || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
-    return FileError(StatusCode::kCorruptData, path, "not a reconar feature file");
-  }
-  uint32_t header[5];
-  std::memcpy(header, bytes.data() + sizeof(kMagic), sizeof(header));
-  if (header[0] != kVersion) {
-    return FileError(StatusCode::kUnsupported, path, "feature file version " + std::to_string(header[0]));
-  }
-  if (header[4] != kDescriptorBytes) {
-    return FileError(StatusCode::kCorruptData, path, "descriptor size " + std::to_string(header[4]));
-  }
-  const uint64_t count = header[3];
-  const uint64_t expected = kHeader + count * (sizeof(PackedKeypoint) + kDescriptorBytes);
-  if (bytes.size() != expected) {
-    return FileError(StatusCode::kCorruptData, path,
-                     "truncated or padded: " + std::to_string(bytes.size()) + " bytes, expected " +
-                         std::to_string(expected));
-  }
+  RECONAR_ASSIGN_OR_RETURN(const FeatureFileHeader header, ParseHeader(path, bytes.data(), bytes.size()));
+  const size_t count = header.count;
   FeatureFile file;
-  file.image_width = static_cast<int>(header[1]);
-  file.image_height = static_cast<int>(header[2]);
+  file.image_width = header.image_width;
+  file.image_height = header.image_height;
   file.features.keypoints.resize(count);
   const char* cursor = bytes.data() + kHeader;
   for (SiftKeypoint& kp : file.features.keypoints) {
@@ -82,6 +96,26 @@ Result<FeatureFile> ReadFeatureFile(const std::string& path) {
   file.features.descriptors.assign(reinterpret_cast<const uint8_t*>(cursor),
                                    reinterpret_cast<const uint8_t*>(cursor) + count * kDescriptorBytes);
   return file;
+}
+
+Result<FeatureFileHeader> ReadFeatureFileHeader(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    const int err = errno;
+    return FileError(err == ENOENT ? StatusCode::kNotFound : StatusCode::kIoError, path,
+                     std::string("cannot open: ") + std::strerror(err));
+  }
+  char head[kHeader] = {};
+  const size_t read = std::fread(head, 1, sizeof(head), file);
+  const bool sized = std::fseek(file, 0, SEEK_END) == 0;
+  const long size = sized ? std::ftell(file) : -1;
+  const bool failed = std::ferror(file) != 0 || size < 0;
+  std::fclose(file);
+  if (failed) return FileError(StatusCode::kIoError, path, "read failed");
+  if (read < kHeader && static_cast<uint64_t>(size) >= kHeader) {
+    return FileError(StatusCode::kIoError, path, "read failed");
+  }
+  return ParseHeader(path, head, static_cast<uint64_t>(size));
 }
 
 Status WriteLoweKeyFile(const std::string& path, const SiftFeatures& features) {

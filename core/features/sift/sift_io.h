@@ -20,8 +20,19 @@ struct FeatureFile {
   SiftFeatures features;
 };
 
+// What a feature file's header says; ReadFeatureFileHeader reads only these 32 bytes.
+struct FeatureFileHeader {
+  int image_width = 0;
+  int image_height = 0;
+  size_t count = 0;  // keypoints (and descriptors)
+};
+
 Status WriteFeatureFile(const std::string& path, const FeatureFile& file);
 Result<FeatureFile> ReadFeatureFile(const std::string& path);
+// The header alone, checked as ReadFeatureFile checks it (magic, version, descriptor size, and
+// the file's size against the count), for passes that need only the sizes (the matcher's
+// memory plan).
+Result<FeatureFileHeader> ReadFeatureFileHeader(const std::string& path);
 
 Status WriteLoweKeyFile(const std::string& path, const SiftFeatures& features);
 Result<SiftFeatures> ReadLoweKeyFile(const std::string& path);

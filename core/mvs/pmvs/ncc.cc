@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "core/base/cpu_features.h"
 #include "core/mvs/pmvs/ncc_kernels.h"
 
 namespace reconar {
@@ -34,8 +35,7 @@ std::vector<NccKernel> AvailableNccKernels() {
   kernels.push_back({"sse2", internal::NccSumsSse2});
 #endif
 #if defined(RECONAR_PMVS_HAVE_AVX2)
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) kernels.push_back({"avx2", internal::NccSumsAvx2});
+  if (HostCpuFeatures().avx2 && HostCpuFeatures().fma) kernels.push_back({"avx2", internal::NccSumsAvx2});
 #endif
 #if defined(RECONAR_PMVS_HAVE_NEON)
   kernels.push_back({"neon", internal::NccSumsNeon});
@@ -55,6 +55,11 @@ const NccKernel& ActiveNccKernel() {
   }();
   return active;
 }
+
+namespace {
+[[maybe_unused]] const bool kRegistered =
+    RegisterSimdDispatcher({"ncc", [] { return ActiveNccKernel().name; }});
+}  // namespace
 
 bool NormalizeNccReference(float* values, int count, int padded_count, float min_std) {
   if (count <= 1) return false;

@@ -96,7 +96,8 @@ Result<OrientedPoints> RunPatchMvs(const std::vector<const DenseView*>& dense_vi
   features.clear();
 
   std::unique_ptr<Progress> progress;
-  if (options.show_progress) progress = std::make_unique<Progress>("patch MVS expansion", options.expansion_iterations);
+  if (options.show_progress)
+    progress = std::make_unique<Progress>(options.progress_label, options.expansion_iterations);
   for (int iteration = 0; iteration < options.expansion_iterations; ++iteration) {
     start = std::chrono::steady_clock::now();
     std::vector<int> seeds(patches.size());

@@ -10,6 +10,7 @@
 // cam_from_world poses. Output in world coordinates.
 #include <cmath>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "core/base/status.h"
@@ -34,6 +35,7 @@ struct PatchMvsOptions {
   int expansion_iterations = 3;    // rounds of expansion followed by filtering
   int num_threads = 0;             // 0 = all cores
   bool show_progress = false;
+  std::string progress_label = "patch MVS expansion";  // of the expansion rounds' progress line
 
   Status Check() const;
   // The texture floor sigma_n / sqrt(1 - min_ncc) in grey levels (see image_noise_std).

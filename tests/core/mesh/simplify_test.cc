@@ -178,5 +178,32 @@ TEST(SimplifyTest, BadOptionsAndMeshesAreRefused) {
   EXPECT_EQ(SimplifyMesh(options, &mesh).status().code(), StatusCode::kInvalidArgument);
 }
 
+TEST(SimplifyTest, FaceBudgetSimplifiesOnlyMeshesOverIt) {
+  Mesh sphere = Icosphere(3);
+  Mesh by_options = sphere;
+  auto report = SimplifyToFaceBudget(200, &sphere);
+  ASSERT_TRUE(report.ok());
+  EXPECT_TRUE(report->simplified);
+  EXPECT_LE(sphere.triangles.size(), 200u);
+  SimplifyOptions options;
+  options.target_faces = 200;
+  ASSERT_TRUE(SimplifyMesh(options, &by_options).ok());
+  EXPECT_EQ(sphere.triangles, by_options.triangles);  // the default options
+  EXPECT_EQ(sphere.positions, by_options.positions);
+
+  // Within the budget, or no budget: untouched, not even validated, and an all-zero report.
+  Mesh broken = Icosphere(1);
+  broken.triangles.push_back({0, 1, 99999});
+  const Mesh before = broken;
+  for (const size_t budget : {size_t{0}, broken.triangles.size()}) {
+    report = SimplifyToFaceBudget(budget, &broken);
+    ASSERT_TRUE(report.ok());
+    EXPECT_FALSE(report->simplified);
+    EXPECT_EQ(report->faces_before, 0u);
+    EXPECT_EQ(broken.triangles, before.triangles);
+  }
+  EXPECT_EQ(SimplifyToFaceBudget(10, &broken).status().code(), StatusCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace reconar

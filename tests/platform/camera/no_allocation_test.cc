@@ -1,4 +1,4 @@
-// After the first frame, Next() + Release() on a recording of raw YUYV / NV12 buffers makes no
+// After the first frame, Next() and the FrameHandle's release on a recording of raw YUYV / NV12 buffers makes no
 // heap allocation (the steady state of a tracking loop fed by a camera).
 #include <gtest/gtest.h>
 
@@ -47,16 +47,16 @@ TEST(CameraNoAllocation, RecordedYuyvAndNv12SteadyState) {
       {
         auto first = (*source)->Next();
         ASSERT_TRUE(first.ok()) << first.status().ToString();
-        (*source)->Release(*first);
+        first->reset();
         testing::NoAllocationScope scope;
         for (int i = 1; i < 16; ++i) {
-          Result<Frame> frame = (*source)->Next();
+          Result<FrameHandle> frame = (*source)->Next();
           if (!frame.ok()) {
             loop.all_ok = false;
             break;
           }
           ++loop.frames;
-          (*source)->Release(*frame);
+          frame->reset();
         }
         loop.allocations = scope.allocations();
       }

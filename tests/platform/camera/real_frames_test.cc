@@ -88,13 +88,11 @@ TEST(CameraRealFrames, Nv12AndYuyvFromJpegPlanesMatchLibjpeg) {
     ASSERT_TRUE(nv12.ok() && yuyv.ok());
     const std::vector<uint8_t> reference_gray = testing::LibjpegDecode(jpeg, 1, false);
     const std::vector<uint8_t> reference_rgb = testing::LibjpegDecode(jpeg, 3, false);
-    gray.Add(nv12->gray, reference_gray);
-    gray.Add(yuyv->gray, reference_gray);
-    nv12_replicated.Add(nv12->rgb, reference_rgb);
-    yuyv_replicated.Add(yuyv->rgb, reference_rgb);
-    nv12_fancy.Add(nv12->rgb, testing::LibjpegDecode(jpeg, 3, true));
-    (*source)->Release(*nv12);
-    (*source)->Release(*yuyv);
+    gray.Add((*nv12)->gray, reference_gray);
+    gray.Add((*yuyv)->gray, reference_gray);
+    nv12_replicated.Add((*nv12)->rgb, reference_rgb);
+    yuyv_replicated.Add((*yuyv)->rgb, reference_rgb);
+    nv12_fancy.Add((*nv12)->rgb, testing::LibjpegDecode(jpeg, 3, true));
   }
   EXPECT_TRUE(IsEndOfStream((*source)->Next().status()));
   std::printf("93 frames 640x480, |ours - libjpeg|: gray max %d mean %.4f; NV12 RGB (libjpeg without fancy "
@@ -149,13 +147,11 @@ TEST(CameraRealFrames, RecordedMjpegMatchesFolderSourceAndTiming) {
       break;
     }
     ASSERT_TRUE(b.ok()) << b.status().ToString();
-    EXPECT_EQ(b->name, std::filesystem::path(paths[static_cast<size_t>(frames)]).filename().string());
+    EXPECT_EQ((*b)->name, std::filesystem::path(paths[static_cast<size_t>(frames)]).filename().string());
     // Recorded: 33333333 ns steps; folder: round(i * 1e9 / 30).
-    EXPECT_NEAR(static_cast<double>(a->timestamp_ns), static_cast<double>(b->timestamp_ns), 100.0);
-    EXPECT_TRUE(testing::SameViews(a->gray, b->gray)) << frames;
-    EXPECT_TRUE(testing::SameViews(a->rgb, b->rgb)) << frames;
-    (*recorded)->Release(*a);
-    (*folder)->Release(*b);
+    EXPECT_NEAR(static_cast<double>((*a)->timestamp_ns), static_cast<double>((*b)->timestamp_ns), 100.0);
+    EXPECT_TRUE(testing::SameViews((*a)->gray, (*b)->gray)) << frames;
+    EXPECT_TRUE(testing::SameViews((*a)->rgb, (*b)->rgb)) << frames;
     ++frames;
   }
   EXPECT_EQ(frames, 93);

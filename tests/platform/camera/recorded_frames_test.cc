@@ -52,29 +52,29 @@ TEST(RecordedFrames, FixtureLayoutsDecodeToLibjpegPixels) {
   ASSERT_TRUE(mjpeg.ok()) << mjpeg.status().ToString();
   ASSERT_TRUE(nv12.ok()) << nv12.status().ToString();
   ASSERT_TRUE(yuyv.ok()) << yuyv.status().ToString();
-  EXPECT_EQ(mjpeg->source_format, PixelFormat::kMjpeg);
-  EXPECT_EQ(nv12->source_format, PixelFormat::kNv12);
-  EXPECT_EQ(yuyv->source_format, PixelFormat::kYuyv);
-  EXPECT_EQ(mjpeg->name, "tag_320x240.frames#0");
-  EXPECT_EQ(yuyv->index, 2);
-  EXPECT_EQ(nv12->timestamp_ns, 33333333);
-  EXPECT_EQ(nv12->width, 320);
-  EXPECT_EQ(nv12->height, 240);
+  EXPECT_EQ((*mjpeg)->source_format, PixelFormat::kMjpeg);
+  EXPECT_EQ((*nv12)->source_format, PixelFormat::kNv12);
+  EXPECT_EQ((*yuyv)->source_format, PixelFormat::kYuyv);
+  EXPECT_EQ((*mjpeg)->name, "tag_320x240.frames#0");
+  EXPECT_EQ((*yuyv)->index, 2);
+  EXPECT_EQ((*nv12)->timestamp_ns, 33333333);
+  EXPECT_EQ((*nv12)->width, 320);
+  EXPECT_EQ((*nv12)->height, 240);
   // NV12's gray is the recorded Y plane itself (zero copy: the recording's 336-byte pitch).
-  EXPECT_EQ(nv12->gray.stride, 336);
-  EXPECT_EQ(mjpeg->gray.stride, 320);
+  EXPECT_EQ((*nv12)->gray.stride, 336);
+  EXPECT_EQ((*mjpeg)->gray.stride, 320);
 
   // All three carry the same Y samples, and NV12 / YUYV the same chroma.
-  EXPECT_TRUE(testing::SameViews(mjpeg->gray, nv12->gray));
-  EXPECT_TRUE(testing::SameViews(yuyv->gray, nv12->gray));
-  EXPECT_TRUE(testing::SameViews(yuyv->rgb, nv12->rgb));
+  EXPECT_TRUE(testing::SameViews((*mjpeg)->gray, (*nv12)->gray));
+  EXPECT_TRUE(testing::SameViews((*yuyv)->gray, (*nv12)->gray));
+  EXPECT_TRUE(testing::SameViews((*yuyv)->rgb, (*nv12)->rgb));
 
   // Against libjpeg's own decode of the same JPEG.
   const std::string jpeg = testing::RecordPayload(testing::ReadFileBytes(kFixture), 0);
-  const Difference gray = Compare(nv12->gray, testing::LibjpegDecode(jpeg, 1, false));
-  const Difference replicated = Compare(nv12->rgb, testing::LibjpegDecode(jpeg, 3, false));
-  const Difference fancy = Compare(mjpeg->rgb, testing::LibjpegDecode(jpeg, 3, true));
-  const Difference raw_vs_fancy = Compare(nv12->rgb, testing::LibjpegDecode(jpeg, 3, true));
+  const Difference gray = Compare((*nv12)->gray, testing::LibjpegDecode(jpeg, 1, false));
+  const Difference replicated = Compare((*nv12)->rgb, testing::LibjpegDecode(jpeg, 3, false));
+  const Difference fancy = Compare((*mjpeg)->rgb, testing::LibjpegDecode(jpeg, 3, true));
+  const Difference raw_vs_fancy = Compare((*nv12)->rgb, testing::LibjpegDecode(jpeg, 3, true));
   std::printf("gray max %d mean %.4f; NV12 RGB vs libjpeg (replicated chroma) max %d mean %.4f; MJPEG RGB vs "
               "libjpeg (fancy upsampling) max %d mean %.4f; NV12 vs fancy max %d mean %.3f\n",
               gray.max, gray.mean, replicated.max, replicated.mean, fancy.max, fancy.mean, raw_vs_fancy.max,
@@ -86,9 +86,6 @@ TEST(RecordedFrames, FixtureLayoutsDecodeToLibjpegPixels) {
   EXPECT_LE(fancy.max, 1);
 
   EXPECT_TRUE(IsEndOfStream((*source)->Next().status()));
-  (*source)->Release(*mjpeg);
-  (*source)->Release(*nv12);
-  (*source)->Release(*yuyv);
 }
 
 TEST(RecordedFrames, HoldingEveryBufferIsAnErrorNotADeadlock) {
@@ -103,11 +100,61 @@ TEST(RecordedFrames, HoldingEveryBufferIsAnErrorNotADeadlock) {
   ASSERT_FALSE(c.ok());
   EXPECT_EQ(c.status().code(), StatusCode::kFailedPrecondition);
   EXPECT_NE(c.status().message().find("all 2 frame buffers are held"), std::string::npos) << c.status().message();
-  (*source)->Release(*a);
+  const int a_buffer = (*a)->buffer;
+  a->reset();
   auto d = (*source)->Next();
   ASSERT_TRUE(d.ok()) << d.status().ToString();
-  EXPECT_EQ(d->index, 2);
-  EXPECT_EQ(d->buffer, a->buffer);
+  EXPECT_EQ((*d)->index, 2);
+  EXPECT_EQ((*d)->buffer, a_buffer);
+}
+
+// A FrameHandle gives its buffer back when it is destroyed, reset or assigned over, and a move
+// passes the buffer on without giving it back.
+TEST(RecordedFrames, FrameHandlesGiveTheirBufferBack) {
+  FrameSourceOptions options;
+  options.buffer_count = 1;
+  auto source = RecordedFrameSource::Open(kFixture, options);
+  ASSERT_TRUE(source.ok());
+  {
+    auto first = (*source)->Next();
+    ASSERT_TRUE(first.ok());
+    EXPECT_EQ((*source)->frames_held(), 1);
+    EXPECT_EQ((*source)->Next().status().code(), StatusCode::kFailedPrecondition);
+  }
+  EXPECT_EQ((*source)->frames_held(), 0);
+  auto second = (*source)->Next();
+  ASSERT_TRUE(second.ok()) << second.status().ToString();
+  EXPECT_EQ((*second)->index, 1);
+  FrameHandle moved = std::move(*second);
+  EXPECT_FALSE(*second);
+  ASSERT_TRUE(moved);
+  EXPECT_EQ(moved->index, 1);
+  EXPECT_EQ((*source)->frames_held(), 1);
+  moved = FrameHandle();
+  EXPECT_FALSE(moved);
+  EXPECT_EQ((*source)->frames_held(), 0);
+  auto third = (*source)->Next();
+  ASSERT_TRUE(third.ok()) << third.status().ToString();
+  EXPECT_EQ((*third)->index, 2);
+}
+
+TEST(RecordedFramesDeathTest, AnEmptyHandleHasNoFrame) {
+  FrameHandle empty;
+  EXPECT_FALSE(empty);
+  EXPECT_DEATH((void)empty->index, "an empty FrameHandle has no frame");
+}
+
+TEST(RecordedFramesDeathTest, DestroyingASourceWhileAFrameIsHeldIsAProgrammerError) {
+  EXPECT_DEATH(
+      {
+        auto source = RecordedFrameSource::Open(kFixture);
+        RECONAR_CHECK(source.ok());
+        auto frame = (*source)->Next();
+        RECONAR_CHECK(frame.ok());
+        FrameHandle held = std::move(*frame);
+        source->reset();
+      },
+      "still held");
 }
 
 TEST(RecordedFrames, WithoutRgbOnlyGray) {
@@ -118,9 +165,8 @@ TEST(RecordedFrames, WithoutRgbOnlyGray) {
   for (int i = 0; i < 3; ++i) {
     auto frame = (*source)->Next();
     ASSERT_TRUE(frame.ok()) << frame.status().ToString();
-    EXPECT_TRUE(frame->rgb.empty());
-    EXPECT_EQ(frame->gray.width, 320);
-    (*source)->Release(*frame);
+    EXPECT_TRUE((*frame)->rgb.empty());
+    EXPECT_EQ((*frame)->gray.width, 320);
   }
 }
 
@@ -131,7 +177,6 @@ Status Drain(RecordedFrameSource* source, int* frames) {
     auto frame = source->Next();
     if (!frame.ok()) return frame.status();
     ++*frames;
-    source->Release(*frame);
   }
 }
 
@@ -191,7 +236,7 @@ TEST(RecordedFrames, DamagedJpegPayloadIsCorruptDataAndSkipped) {
       << first.status().message();
   auto second = (*source)->Next();  // the container is intact: playback goes on
   ASSERT_TRUE(second.ok()) << second.status().ToString();
-  EXPECT_EQ(second->index, 1);
+  EXPECT_EQ((*second)->index, 1);
   std::remove(path.c_str());
 }
 
@@ -261,26 +306,26 @@ TEST(RecordedFrames, WriterRoundTripWithPassthroughAndLimitedRange) {
   ASSERT_TRUE(source.ok());
   auto yuyv_frame = (*source)->Next();
   ASSERT_TRUE(yuyv_frame.ok()) << yuyv_frame.status().ToString();
-  EXPECT_EQ(yuyv_frame->timestamp_ns, -5);
-  EXPECT_EQ(yuyv_frame->gray.at(0, 0), 0);
-  EXPECT_EQ(yuyv_frame->gray.at(1, 0), 255);
-  EXPECT_EQ(yuyv_frame->gray.at(1, 1), 128);
-  EXPECT_EQ(yuyv_frame->rgb.at(3, 0), 255);
+  EXPECT_EQ((*yuyv_frame)->timestamp_ns, -5);
+  EXPECT_EQ((*yuyv_frame)->gray.at(0, 0), 0);
+  EXPECT_EQ((*yuyv_frame)->gray.at(1, 0), 255);
+  EXPECT_EQ((*yuyv_frame)->gray.at(1, 1), 128);
+  EXPECT_EQ((*yuyv_frame)->rgb.at(3, 0), 255);
   // The next frame has another size: its buffers can only be resized once no frame is held.
   EXPECT_EQ((*source)->Next().status().code(), StatusCode::kFailedPrecondition);
-  (*source)->Release(*yuyv_frame);
+  yuyv_frame->reset();
   auto gray_frame = (*source)->Next();
   ASSERT_TRUE(gray_frame.ok()) << gray_frame.status().ToString();
-  EXPECT_EQ(gray_frame->timestamp_ns, 1LL << 40);
-  EXPECT_EQ(gray_frame->gray.stride, 4);  // zero copy
-  EXPECT_EQ(gray_frame->gray.at(2, 1), 6);
-  EXPECT_EQ(gray_frame->rgb.at(8, 1), 6);
-  (*source)->Release(*gray_frame);
+  EXPECT_EQ((*gray_frame)->timestamp_ns, 1LL << 40);
+  EXPECT_EQ((*gray_frame)->gray.stride, 4);  // zero copy
+  EXPECT_EQ((*gray_frame)->gray.at(2, 1), 6);
+  EXPECT_EQ((*gray_frame)->rgb.at(8, 1), 6);
+  gray_frame->reset();
   auto rgb_frame = (*source)->Next();
   ASSERT_TRUE(rgb_frame.ok());
-  EXPECT_EQ(rgb_frame->rgb.stride, 7);  // zero copy
-  EXPECT_EQ(rgb_frame->rgb.at(5, 1), 120);
-  EXPECT_EQ(rgb_frame->gray.at(0, 0), (19595 * 10 + 38470 * 20 + 7471 * 30 + 32768) >> 16);
+  EXPECT_EQ((*rgb_frame)->rgb.stride, 7);  // zero copy
+  EXPECT_EQ((*rgb_frame)->rgb.at(5, 1), 120);
+  EXPECT_EQ((*rgb_frame)->gray.at(0, 0), (19595 * 10 + 38470 * 20 + 7471 * 30 + 32768) >> 16);
   EXPECT_TRUE(IsEndOfStream((*source)->Next().status()));
   std::remove(path.c_str());
 }

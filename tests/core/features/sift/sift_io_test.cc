@@ -54,6 +54,28 @@ TEST(FeatureFile, TruncatedOrForeignFilesAreRefusedByName) {
   EXPECT_EQ(ReadFeatureFile(TempPath("missing.rfeat")).status().code(), StatusCode::kNotFound);
 }
 
+TEST(FeatureFile, HeaderAloneGivesSizeAndCountAndIsCheckedTheSameWay) {
+  const std::string path = TempPath("h.rfeat");
+  for (const int count : {0, 1, 17}) {
+    ASSERT_TRUE(WriteFeatureFile(path, FeatureFile{640, 480, MakeFeatures(count)}).ok());
+    auto header = ReadFeatureFileHeader(path);
+    ASSERT_TRUE(header.ok()) << header.status().ToString();
+    EXPECT_EQ(header->image_width, 640);
+    EXPECT_EQ(header->image_height, 480);
+    EXPECT_EQ(header->count, static_cast<size_t>(count));
+  }
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 10);
+  EXPECT_EQ(ReadFeatureFileHeader(path).status().code(), StatusCode::kCorruptData);
+  EXPECT_EQ(ReadFeatureFileHeader(path).status().message(), ReadFeatureFile(path).status().message());
+  ASSERT_TRUE(WriteFileAtomically(path, std::string("short")).ok());
+  EXPECT_EQ(ReadFeatureFileHeader(path).status().code(), StatusCode::kCorruptData);
+  ASSERT_TRUE(WriteFileAtomically(path, std::string("hello world, not features, but long enough")).ok());
+  EXPECT_EQ(ReadFeatureFileHeader(path).status().code(), StatusCode::kCorruptData);
+  const auto missing = ReadFeatureFileHeader(TempPath("missing.rfeat"));
+  EXPECT_EQ(missing.status().code(), StatusCode::kNotFound);
+  EXPECT_NE(missing.status().message().find("missing.rfeat"), std::string::npos);
+}
+
 TEST(LoweKeyFile, RoundTripsWithRowColumnOrder) {
   const SiftFeatures features = MakeFeatures(4);
   const std::string path = TempPath("c.key");

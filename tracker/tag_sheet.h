@@ -1,5 +1,5 @@
 #pragma once
-// Printable AprilTag sheets for `reconar tags`: tags laid out on paper pages, written as SVG (one
+// Printable AprilTag sheets (`reconar tags`): tags laid out on paper pages, written as SVG (one
 // file per page) or PDF (one file, a page each). Sizes are exact: a tag's size is the edge of its
 // detection border (libapriltag's tag_size, e.g. the black square of tag36h11), so the module
 // edge is size / width_at_border and the whole bitmap, quiet zone included, is total_width modules.
@@ -7,8 +7,9 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "tracker/tag_detector.h"
 
-namespace reconar::tools {
+namespace reconar {
 
 struct SheetTag {
   int id = 0;
@@ -22,7 +23,7 @@ struct TagSheetOptions {
   double page_width_mm = 210.0;  // A4 portrait
   double page_height_mm = 297.0;
   double margin_mm = 10.0;
-  double gap_mm = 8.0;           // between neighbouring bitmaps (their quiet zones add to it)
+  double gap_mm = 8.0;  // between neighbouring bitmaps (their quiet zones add to it)
   std::string family = "tag36h11";
 };
 
@@ -48,4 +49,15 @@ Result<TagSheet> LayoutTagSheet(std::vector<SheetTag> bitmaps, const TagSheetOpt
 std::string RenderSvgPage(const TagSheet& sheet, size_t page);
 std::string RenderPdf(const TagSheet& sheet);
 
-}  // namespace reconar::tools
+// The printable bitmaps of `ids` in `family` (RenderTagBitmap); InvalidArgument naming an id that
+// is not a code of the family.
+Result<std::vector<SheetTag>> RenderSheetTags(TagFamily family, const std::vector<int>& ids);
+
+// Page size by name: a4 (210 x 297 mm), a3, letter, or WIDTHxHEIGHT in mm (e.g. 300x400).
+Status SetPaperSize(const std::string& name, TagSheetOptions* options);
+
+// Writes the sheet atomically: .pdf one file with a page each; .svg one file per page (PATH,
+// then PATH-2.svg, PATH-3.svg, ...). Returns the files written; InvalidArgument for another extension.
+Result<std::vector<std::string>> WriteTagSheet(const TagSheet& sheet, const std::string& path);
+
+}  // namespace reconar

@@ -1,11 +1,14 @@
-#include "tools/tag_sheet.h"
+#include "tracker/tag_sheet.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <sstream>
 
-namespace reconar::tools {
+#include "core/base/atomic_file.h"
+
+namespace reconar {
 namespace {
 
 constexpr double kLabelHeightMm = 6.0;
@@ -56,7 +59,9 @@ std::string Caption(const TagSheet& sheet, const SheetTag& bitmap) {
          " mm";
 }
 
-std::string ScaleBarCaption() { return "this bar must measure " + Number(kScaleBarMm) + " mm: print at 100 %, no fit-to-page"; }
+std::string ScaleBarCaption() {
+  return "this bar must measure " + Number(kScaleBarMm) + " mm: print at 100 %, no fit-to-page";
+}
 
 }  // namespace
 
@@ -78,8 +83,8 @@ Result<TagSheet> LayoutTagSheet(std::vector<SheetTag> bitmaps, const TagSheetOpt
   const int rows = static_cast<int>(std::floor((usable_height + options.gap_mm) / cell_height));
   if (columns < 1 || rows < 1) {
     return InvalidArgument("a " + Number(options.tag_size_mm) + " mm tag with its quiet zone does not fit on a " +
-                           Number(options.page_width_mm) + " x " + Number(options.page_height_mm) +
-                           " mm page with " + Number(options.margin_mm) + " mm margins");
+                           Number(options.page_width_mm) + " x " + Number(options.page_height_mm) + " mm page with " +
+                           Number(options.margin_mm) + " mm margins");
   }
   const size_t per_page = static_cast<size_t>(columns) * rows;
   for (size_t i = 0; i < sheet.bitmaps.size(); ++i) {
@@ -110,8 +115,8 @@ std::string RenderSvgPage(const TagSheet& sheet, size_t page) {
   std::ostringstream svg;
   svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Number(o.page_width_mm) << "mm\" height=\""
-      << Number(o.page_height_mm) << "mm\" viewBox=\"0 0 " << Number(o.page_width_mm) << ' '
-      << Number(o.page_height_mm) << "\" shape-rendering=\"crispEdges\">\n"
+      << Number(o.page_height_mm) << "mm\" viewBox=\"0 0 " << Number(o.page_width_mm) << ' ' << Number(o.page_height_mm)
+      << "\" shape-rendering=\"crispEdges\">\n"
       << "<rect x=\"0\" y=\"0\" width=\"" << Number(o.page_width_mm) << "\" height=\"" << Number(o.page_height_mm)
       << "\" fill=\"#fff\"/>\n";
   for (const PlacedTag& placed : sheet.pages[page].tags) {
@@ -197,4 +202,58 @@ std::string RenderPdf(const TagSheet& sheet) {
   return pdf;
 }
 
-}  // namespace reconar::tools
+Result<std::vector<SheetTag>> RenderSheetTags(TagFamily family, const std::vector<int>& ids) {
+  std::vector<SheetTag> bitmaps;
+  for (int id : ids) {
+    RECONAR_ASSIGN_OR_RETURN(const TagBitmap rendered, RenderTagBitmap(family, id));
+    SheetTag bitmap;
+    bitmap.id = id;
+    bitmap.total_width = rendered.pixels.width();
+    bitmap.width_at_border = rendered.width_at_border;
+    for (int y = 0; y < rendered.pixels.height(); ++y) {
+      for (int x = 0; x < rendered.pixels.width(); ++x) bitmap.black.push_back(rendered.pixels.row(y)[x] < 128);
+    }
+    bitmaps.push_back(std::move(bitmap));
+  }
+  return bitmaps;
+}
+
+Status SetPaperSize(const std::string& name, TagSheetOptions* options) {
+  if (name == "a4") {
+    options->page_width_mm = 210, options->page_height_mm = 297;
+  } else if (name == "a3") {
+    options->page_width_mm = 297, options->page_height_mm = 420;
+  } else if (name == "letter") {
+    options->page_width_mm = 215.9, options->page_height_mm = 279.4;
+  } else {
+    double width = 0, height = 0;
+    char extra = 0;
+    if (std::sscanf(name.c_str(), "%lfx%lf%c", &width, &height, &extra) != 2 || width <= 0 || height <= 0) {
+      return InvalidArgument("paper '" + name + "' is not a4, a3, letter or WIDTHxHEIGHT in mm");
+    }
+    options->page_width_mm = width, options->page_height_mm = height;
+  }
+  return Status::Ok();
+}
+
+Result<std::vector<std::string>> WriteTagSheet(const TagSheet& sheet, const std::string& path) {
+  std::string extension = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  std::vector<std::string> written;
+  if (extension == ".pdf") {
+    RECONAR_RETURN_IF_ERROR(WriteFileAtomically(path, RenderPdf(sheet)));
+    written.push_back(path);
+  } else if (extension == ".svg") {
+    for (size_t page = 0; page < sheet.pages.size(); ++page) {
+      const std::string page_path =
+          page == 0 ? path : path.substr(0, path.size() - 4) + "-" + std::to_string(page + 1) + ".svg";
+      RECONAR_RETURN_IF_ERROR(WriteFileAtomically(page_path, RenderSvgPage(sheet, page)));
+      written.push_back(page_path);
+    }
+  } else {
+    return InvalidArgument(path + ": a tag sheet is written as .svg or .pdf");
+  }
+  return written;
+}
+
+}  // namespace reconar

@@ -1,0 +1,73 @@
+#include "render/ar/ar_project.h"
+
+#include <cmath>
+#include <filesystem>
+#include <system_error>
+
+#include "core/base/json_reader.h"
+#include "core/mesh/mesh_file.h"
+#include "core/pipeline/project.h"
+#include "core/sfm/model_io.h"
+
+namespace reconar {
+
+Result<ArProject> LoadArProject(const std::string& dir) {
+  const Project project(dir);
+  ArProject scene;
+  for (const std::string& path :
+       {project.MeshDir() + "/mesh.ply", project.DensePointsPath(), project.SparseDir() + "/points.ply"}) {
+    scene.model_path = path;
+    std::error_code error;
+    if (std::filesystem::exists(path, error)) break;
+  }
+  RECONAR_ASSIGN_OR_RETURN(const JsonValue tags, ReadJsonFile(project.TagsJsonPath()));
+  const JsonValue* metric = tags.Find("metric");
+  if (metric == nullptr || !metric->is_bool() || !metric->bool_value()) {
+    const JsonValue* reason = tags.Find("reason");
+    return FailedPrecondition(project.TagsJsonPath() + ": the model is not in metres (" +
+                              (reason != nullptr && reason->is_string() ? reason->string() : "no tag registered") +
+                              "); show it with --model and --model-height");
+  }
+  const JsonValue* size = tags.Find("tag_size_m");
+  const JsonValue* family = tags.Find("family");
+  if (size == nullptr || !size->is_number() || family == nullptr || !family->is_string()) {
+    return FileError(StatusCode::kCorruptData, project.TagsJsonPath(), "no tag_size_m or family");
+  }
+  scene.tag_size = size->number();
+  scene.family = family->string();
+  RECONAR_ASSIGN_OR_RETURN(scene.layout, ReadTagLayout(project.TagLayoutPath()));
+  if (auto model = ReadColmapTextModel(project.SparseDir()); model.ok() && !model->cameras.empty()) {
+    scene.photo_intrinsics = model->cameras.front().Intrinsics();
+  }
+  return scene;
+}
+
+Result<CameraIntrinsics> ScaleIntrinsicsToFrame(const CameraIntrinsics& photo, int width, int height) {
+  if (photo.width == width && photo.height == height) return photo;
+  if (photo.width <= 0 || std::abs(static_cast<double>(photo.width) * height -
+                                   static_cast<double>(photo.height) * width) > 0.01 * photo.width * height) {
+    return InvalidArgument("the project's photos are " + std::to_string(photo.width) + "x" +
+                           std::to_string(photo.height) + ", the video " + std::to_string(width) + "x" +
+                           std::to_string(height) + ": pass --intrinsics for this camera");
+  }
+  const double s = static_cast<double>(width) / photo.width;
+  CameraIntrinsics scaled = photo;
+  scaled.width = width;
+  scaled.height = height;
+  scaled.fx *= s;
+  scaled.fy *= s;
+  scaled.cx = (photo.cx + 0.5) * s - 0.5;  // pixel centres at integer coordinates
+  scaled.cy = (photo.cy + 0.5) * s - 0.5;
+  return scaled;
+}
+
+Result<ArModel> LoadArModel(const std::string& path, size_t max_faces) {
+  ArModel model;
+  RECONAR_ASSIGN_OR_RETURN(model.mesh, ReadMeshFile(path));
+  auto simplified = SimplifyToFaceBudget(max_faces, &model.mesh);
+  if (!simplified.ok()) return simplified.status().WithContext(path);
+  if (simplified->simplified) model.simplified = *simplified;
+  return model;
+}
+
+}  // namespace reconar

@@ -1,0 +1,43 @@
+#pragma once
+// Loading an AR scene: a project of `reconar reconstruct --tag-size` for AR (its model, tags.layout,
+// tag size and family, and the photos' camera, scaled to the video), and the model to draw
+// (simplified to a face budget for the handheld).
+#include <optional>
+#include <string>
+
+#include "core/base/status.h"
+#include "core/math/camera_intrinsics.h"
+#include "core/mesh/mesh.h"
+#include "core/mesh/simplify.h"
+#include "core/sfm/tag_layout.h"
+
+namespace reconar {
+
+// What `reconar view --project DIR` brings: the model in metres in the world frame, where each tag
+// sits in it, the tags' size and family, and the photos' camera.
+struct ArProject {
+  std::string model_path;  // the mesh, else the dense points, else the sparse points
+  TagLayout layout;        // world_from_tag of every registered tag (PROJECT/tags.layout)
+  double tag_size = 0.0;   // metres
+  std::string family;
+  std::optional<CameraIntrinsics> photo_intrinsics;  // the first camera of sparse/, if readable
+};
+
+// FailedPrecondition when the project's tags.json says the model is not in metres; file errors of
+// tags.json and tags.layout.
+Result<ArProject> LoadArProject(const std::string& dir);
+
+// The photo camera for video of another size with the same aspect ratio (a phone's video mode);
+// InvalidArgument when the aspect ratios differ by more than 1 %.
+Result<CameraIntrinsics> ScaleIntrinsicsToFrame(const CameraIntrinsics& photo, int width, int height);
+
+struct ArModel {
+  Mesh mesh;
+  std::optional<SimplifyReport> simplified;  // set when the mesh was over the face budget
+};
+
+// The model file (core/mesh/mesh_file.h formats), simplified to at most max_faces triangles
+// (0: as it is).
+Result<ArModel> LoadArModel(const std::string& path, size_t max_faces);
+
+}  // namespace reconar

@@ -1,0 +1,76 @@
+#pragma once
+// ArSession: the AR runtime's loop over a video, joining a FrameSource (platform/camera) and a
+// pose source (tracker/tag_pose_source.h). Open() opens the source, reads the first frame (its size
+// fixes the camera's), scales the project camera to it when asked, and creates the pose source.
+// Each Step() gives the previous frame back, takes the next one and finds its pose:
+//
+//   RECONAR_ASSIGN_OR_RETURN(auto session, ArSession::Open(options));
+//   for (;;) {
+//     RECONAR_ASSIGN_OR_RETURN(const bool more, session->Step());
+//     if (!more) break;
+//     use(session->frame(), session->pose(), session->tags().report());
+//   }
+//
+// `reconar track` prints what Step() found; `reconar view` (render/ar/ar_view.h) draws it. The
+// frame is held (its FrameHandle) until the next Step() or the session's end. Steady-state Step()
+// makes no heap allocation of its own (the source's and the pose source's guarantees).
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "core/base/status.h"
+#include "core/math/camera_intrinsics.h"
+#include "platform/camera/frame_source.h"
+#include "tracker/pose_source.h"
+#include "tracker/tag_pose_source.h"
+
+namespace reconar {
+
+struct ArSessionOptions {
+  std::string source;  // OpenFrameSource specification
+  FrameSourceOptions frames;
+  TagPoseSourceOptions pose;
+  // pose.tracker.intrinsics are the photos' camera: scale them to the video's frame size
+  // (ScaleIntrinsicsToFrame, render/ar/ar_project.h).
+  bool scale_intrinsics_to_video = false;
+  int max_frames = 0;  // Step() ends after this many frames (0: at the end of the stream)
+};
+
+class ArSession {
+ public:
+  // Errors of the source, "SOURCE: no frames" (FailedPrecondition) for an empty stream, errors of
+  // scaling the intrinsics and of TagPoseSource::Create.
+  static Result<std::unique_ptr<ArSession>> Open(const ArSessionOptions& options);
+  ~ArSession();
+
+  // True with the next frame and its pose; false at the end of the stream or after max_frames.
+  // A tracking error names the frame.
+  Result<bool> Step();
+
+  const Frame& frame() const { return *frame_; }
+  const WorldPose& pose() const { return pose_; }
+  const TagPoseSource& tags() const { return *pose_source_; }
+  const CameraIntrinsics& intrinsics() const { return pose_source_->options().tracker.intrinsics; }
+  int width() const { return width_; }  // of the first frame
+  int height() const { return height_; }
+  long frames() const { return frames_; }  // frames stepped through so far
+  // When the current frame had been read (and its tracking began).
+  std::chrono::steady_clock::time_point frame_start() const { return frame_start_; }
+  std::string Describe() const { return source_->Describe(); }
+
+ private:
+  ArSession() = default;
+
+  int max_frames_ = 0;
+  std::unique_ptr<FrameSource> source_;  // outlives frame_ (members are destroyed in reverse order)
+  FrameHandle frame_;
+  bool first_frame_pending_ = false;
+  std::unique_ptr<TagPoseSource> pose_source_;
+  WorldPose pose_;
+  int width_ = 0;
+  int height_ = 0;
+  long frames_ = 0;
+  std::chrono::steady_clock::time_point frame_start_;
+};
+
+}  // namespace reconar

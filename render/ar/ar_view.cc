@@ -1,0 +1,138 @@
+#include "render/ar/ar_view.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <vector>
+
+#include "core/base/atomic_file.h"
+#include "core/io/image_write.h"
+
+namespace reconar {
+namespace {
+
+// The PNG for a frame: its file name with .png, or frameNNNNNN.png for a device or a recording.
+std::string OutputName(const Frame& frame) {
+  std::string name(frame.name);
+  if (name.find('/') != std::string::npos || name.find('#') != std::string::npos || name.empty()) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "frame%06lld", static_cast<long long>(frame.index));
+    return std::string(text) + ".png";
+  }
+  const size_t dot = name.rfind('.');
+  return (dot == std::string::npos ? name : name.substr(0, dot)) + ".png";
+}
+
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const Mesh& model) {
+  const bool to_files = !options.out_dir.empty();
+  if (to_files) RECONAR_RETURN_IF_ERROR(CreateDirectories(options.out_dir));
+  ArSessionOptions session_options = options.session;
+  session_options.frames.want_rgb = true;
+  RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<ArSession> session, ArSession::Open(session_options));
+  EglContextOptions egl_options;
+  egl_options.kind = to_files ? EglContextKind::kSurfaceless : options.window;
+  egl_options.width = session->width();
+  egl_options.height = session->height();
+  auto context = EglContext::Create(egl_options);
+  if (!context.ok()) {
+    Status status = context.status();
+    if (!to_files) status = status.WithContext("no display for the live view (use --out DIR to write PNGs instead)");
+    return status;
+  }
+  if (!to_files && !(*context)->has_surface()) {
+    return FailedPrecondition(
+        "no display for the live view: DISPLAY is not set and there is no DRM device under /dev/dri "
+        "(use --out DIR to write PNGs instead)");
+  }
+  OverlayRendererOptions render_options;
+  render_options.width = session->width();
+  render_options.height = session->height();
+  render_options.samples = options.samples;
+  RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<OverlayRenderer> renderer, OverlayRenderer::Create(render_options));
+  RECONAR_ASSIGN_OR_RETURN(MeshDrawable drawable, MeshDrawable::Upload(model));
+  return std::unique_ptr<ArView>(
+      new ArView(options, std::move(session), std::move(*context), std::move(renderer), std::move(drawable)));
+}
+
+ArView::ArView(const ArViewOptions& options, std::unique_ptr<ArSession> session, std::unique_ptr<EglContext> context,
+               std::unique_ptr<OverlayRenderer> renderer, MeshDrawable model)
+    : options_(options),
+      session_(std::move(session)),
+      context_(std::move(context)),
+      renderer_(std::move(renderer)),
+      model_(std::move(model)) {}
+
+ArView::~ArView() = default;
+
+std::string ArView::Describe(const std::string& model_name) const {
+  return session_->Describe() + "; " + EglContextKindName(context_->kind()) + " " + context_->renderer() + "; model " +
+         model_name + " (" + std::to_string(model_.vertex_count()) + " vertices, " +
+         std::to_string(model_.triangle_count()) + " triangles)";
+}
+
+Status ArView::Draw(bool* drawn_model) {
+  *drawn_model = false;
+  RECONAR_RETURN_IF_ERROR(renderer_->BeginFrame());
+  RECONAR_RETURN_IF_ERROR(renderer_->DrawBackground(session_->frame().rgb, 3));
+  const WorldPose& pose = session_->pose();
+  if (!pose.found) return Status::Ok();
+  const CameraIntrinsics& intrinsics = session_->intrinsics();
+  const Eigen::Matrix4d cam_from_model =
+      options_.placement ? CamFromModel(pose.cam_from_world, *options_.placement) : pose.cam_from_world.Matrix();
+  RECONAR_RETURN_IF_ERROR(renderer_->DrawMesh(model_, intrinsics, cam_from_model, options_.style));
+  *drawn_model = true;
+  if (!options_.draw_axes) return Status::Ok();
+  for (const LayoutTag& tag : pose.markers) {
+    RECONAR_RETURN_IF_ERROR(renderer_->DrawTagAxes(intrinsics, pose.cam_from_world * tag.layout_from_tag, tag.size));
+  }
+  return Status::Ok();
+}
+
+Result<ArViewReport> ArView::Run(const std::function<void(long frames)>& progress) {
+  const bool to_files = !options_.out_dir.empty();
+  std::vector<double> track_ms, render_ms, frame_ms;
+  ArViewReport report;
+  for (;;) {
+    RECONAR_ASSIGN_OR_RETURN(const bool more, session_->Step());
+    if (!more) break;
+    track_ms.push_back(session_->pose().track_ms);
+    const auto render_start = std::chrono::steady_clock::now();
+    bool drawn_model = false;
+    Status drawn = Draw(&drawn_model);
+    if (drawn_model) ++report.frames_with_model;
+    if (drawn.ok()) {
+      if (to_files) {
+        drawn = renderer_->ReadRgb(&rgb_);
+      } else {
+        drawn = renderer_->PresentToDefaultFramebuffer(context_->width(), context_->height());
+        if (drawn.ok()) drawn = context_->SwapBuffers();
+      }
+    }
+    render_ms.push_back(MsSince(render_start));
+    frame_ms.push_back(MsSince(session_->frame_start()));
+    const std::string name = OutputName(session_->frame());
+    if (!drawn.ok()) return drawn.WithContext(name);
+    if (to_files) RECONAR_RETURN_IF_ERROR(WritePng(options_.out_dir + "/" + name, rgb_.view(), 3));
+    ++report.frames;
+    if (progress) progress(report.frames);
+    if (!to_files && context_->PollEvents().should_quit()) break;
+  }
+  report.median_track_ms = Median(track_ms);
+  report.median_render_ms = Median(render_ms);
+  report.median_frame_ms = Median(frame_ms);
+  return report;
+}
+
+}  // namespace reconar

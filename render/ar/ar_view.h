@@ -1,0 +1,73 @@
+#pragma once
+// ArView: the AR overlay of `reconar view`. An ArSession (frames and their poses) drawn by the
+// OverlayRenderer: the video as background, the model at cam_from_world * world_from_model, the
+// axes of the world's tags in view; then shown in a window (X11, or full screen through GBM/KMS)
+// or written as one PNG per frame.
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/base/image.h"
+#include "core/base/status.h"
+#include "core/mesh/mesh.h"
+#include "platform/egl/egl_context.h"
+#include "render/ar/ar_session.h"
+#include "render/mesh_drawable.h"
+#include "render/model_placement.h"
+#include "render/overlay_renderer.h"
+
+namespace reconar {
+
+struct ArViewOptions {
+  ArSessionOptions session;  // frames.want_rgb is forced on
+  // Non-empty: write OUT_DIR/<frame>.png (headless) instead of showing a window.
+  std::string out_dir;
+  EglContextKind window = EglContextKind::kAuto;  // when out_dir is empty
+  // world_from_model: the model's place in the world (a tag's frame); nullopt: the model is already
+  // in the world frame (a project's model, in metres).
+  std::optional<ModelPlacement> placement;
+  MeshStyle style;
+  int samples = 0;  // multisample anti-aliasing (0 = off)
+  bool draw_axes = true;
+};
+
+struct ArViewReport {
+  long frames = 0;
+  long frames_with_model = 0;
+  // Medians over the frames, milliseconds: pose (tracking), drawing (with the readback when
+  // writing PNGs), and both.
+  double median_track_ms = 0.0;
+  double median_render_ms = 0.0;
+  double median_frame_ms = 0.0;
+};
+
+class ArView {
+ public:
+  // Creates out_dir, opens the session, the EGL context (surfaceless for PNGs, else a window; no
+  // display is FailedPrecondition saying to use --out) and the renderer, and uploads the model.
+  static Result<std::unique_ptr<ArView>> Open(const ArViewOptions& options, const Mesh& model);
+  ~ArView();
+
+  // "SOURCE; EGL-ROUTE RENDERER; model MODEL_NAME (N vertices, M triangles)".
+  std::string Describe(const std::string& model_name) const;
+  // Every frame until the stream ends, max_frames, or the window is closed ('q', Escape).
+  // `progress` (if set) is called with the frame count after each frame.
+  Result<ArViewReport> Run(const std::function<void(long frames)>& progress = nullptr);
+
+ private:
+  ArView(const ArViewOptions& options, std::unique_ptr<ArSession> session, std::unique_ptr<EglContext> context,
+         std::unique_ptr<OverlayRenderer> renderer, MeshDrawable model);
+  // The frame, the model and the tags' axes at this frame's pose; true in *drawn_model when the
+  // model was drawn.
+  Status Draw(bool* drawn_model);
+
+  ArViewOptions options_;
+  std::unique_ptr<ArSession> session_;
+  std::unique_ptr<EglContext> context_;
+  std::unique_ptr<OverlayRenderer> renderer_;
+  MeshDrawable model_;
+  Image<uint8_t> rgb_;
+};
+
+}  // namespace reconar

@@ -1,0 +1,44 @@
+#include "core/base/cpu_features.h"
+
+#include <gtest/gtest.h>
+
+namespace reconar {
+namespace {
+
+TEST(CpuFeatures, DetectedOnceAndConsistent) {
+  const CpuFeatures& features = HostCpuFeatures();
+  EXPECT_EQ(&features, &HostCpuFeatures());
+#if defined(__x86_64__)
+  EXPECT_TRUE(features.sse2);  // part of the x86-64 baseline
+  EXPECT_FALSE(features.neon);
+#elif defined(__aarch64__)
+  EXPECT_TRUE(features.neon);
+  EXPECT_FALSE(features.avx2);
+#endif
+  // Every AVX-512 CPU has AVX2 and FMA.
+  if (features.avx512f) {
+    EXPECT_TRUE(features.avx2 && features.fma);
+  }
+}
+
+TEST(CpuFeatures, Names) {
+  EXPECT_EQ(CpuFeatureNames(CpuFeatures{}), "none");
+  CpuFeatures features;
+  features.sse2 = features.avx2 = features.fma = true;
+  EXPECT_EQ(CpuFeatureNames(features), "sse2 avx2 fma");
+}
+
+TEST(CpuFeatures, RegisteredDispatchersAreListedByName) {
+  const size_t before = SelectedSimdKernels().size();
+  RegisterSimdDispatcher({"zz_test", [] { return "scalar"; }});
+  RegisterSimdDispatcher({"aa_test", [] { return "wide"; }});
+  const std::vector<SimdKernelChoice> choices = SelectedSimdKernels();
+  ASSERT_EQ(choices.size(), before + 2);
+  EXPECT_EQ(choices.front().dispatcher, "aa_test");
+  EXPECT_EQ(choices.front().kernel, "wide");
+  EXPECT_EQ(choices.back().dispatcher, "zz_test");
+  EXPECT_EQ(choices.back().kernel, "scalar");
+}
+
+}  // namespace
+}  // namespace reconar

@@ -1,0 +1,79 @@
+#include "tracker/tag_pose_source.h"
+
+#include <algorithm>
+
+namespace reconar {
+
+Status TagPoseSourceOptions::Check() const {
+  RECONAR_RETURN_IF_ERROR(tracker.Check());
+  if (tag_id < -1) return InvalidArgument("tag pose source: tag_id must be >= -1, got " + std::to_string(tag_id));
+  return Status::Ok();
+}
+
+Result<std::unique_ptr<TagPoseSource>> TagPoseSource::Create(const TagPoseSourceOptions& options) {
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<TagTracker> tracker, TagTracker::Create(options.tracker));
+  return std::unique_ptr<TagPoseSource>(new TagPoseSource(options, std::move(tracker)));
+}
+
+TagPoseSource::TagPoseSource(const TagPoseSourceOptions& options, std::unique_ptr<TagTracker> tracker)
+    : options_(options), tracker_(std::move(tracker)), measured_(options.tracker.max_tags) {}
+
+Status TagPoseSource::Track(ImageView<const uint8_t> gray, WorldPose* pose) {
+  RECONAR_RETURN_IF_ERROR(tracker_->Track(gray, &report_));
+  pose->found = false;
+  pose->anchors_used = 0;
+  pose->rms_reprojection_px = 0.0;
+  pose->track_ms = report_.total_ms;
+  if (pose->markers.capacity() < static_cast<size_t>(options_.tracker.max_tags)) {
+    pose->markers.reserve(static_cast<size_t>(options_.tracker.max_tags));
+  }
+  pose->markers.clear();
+  has_board_ = false;
+  if (options_.layout.empty()) {
+    PoseFromOneTag(pose);
+  } else {
+    PoseFromLayout(pose);
+  }
+  return Status::Ok();
+}
+
+void TagPoseSource::PoseFromLayout(WorldPose* pose) {
+  measured_.Clear();
+  for (const TrackedTag& tag : report_.tags) {
+    if (tag.measured) measured_.Add(tag.detection);
+  }
+  auto board = EstimateBoardPose(options_.layout, measured_, options_.tracker.intrinsics, options_.board);
+  if (!board.ok()) return;
+  board_ = *board;
+  has_board_ = true;
+  pose->found = true;
+  pose->cam_from_world = board_.cam_from_layout;
+  pose->anchors_used = board_.tags_used;
+  pose->rms_reprojection_px = board_.rms_reprojection_px;
+  for (const LayoutTag& tag : options_.layout.tags()) {
+    const bool seen = std::any_of(measured_.begin(), measured_.end(),
+                                  [&](const TagDetection& detection) { return detection.id == tag.id; });
+    if (seen && pose->markers.size() < pose->markers.capacity()) pose->markers.push_back(tag);
+  }
+}
+
+void TagPoseSource::PoseFromOneTag(WorldPose* pose) const {
+  const TrackedTag* chosen = nullptr;
+  for (const TrackedTag& tag : report_.tags) {
+    if (tag.state == TagTrackState::kLost || !tag.measured) continue;
+    if (options_.tag_id >= 0 && tag.id != options_.tag_id) continue;
+    if (chosen == nullptr || tag.id < chosen->id) chosen = &tag;
+  }
+  if (chosen == nullptr) return;
+  pose->found = true;
+  pose->cam_from_world = options_.smoothed ? chosen->smoothed_cam_from_tag : chosen->cam_from_tag;
+  pose->anchors_used = 1;
+  pose->rms_reprojection_px = chosen->pose.rms_reprojection_px;
+  LayoutTag marker;
+  marker.id = chosen->id;
+  marker.size = options_.tracker.tag_size;
+  pose->markers.push_back(marker);  // at the world origin (identity layout_from_tag)
+}
+
+}  // namespace reconar
