@@ -40,19 +40,6 @@ struct Target {
   Rigid3 cam_from_target;
 };
 
-Eigen::Matrix3d RotationFromVector(const Eigen::Vector3d& w) {
-  const double angle = w.norm();
-  if (!(angle > 0.0)) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-}
-
-Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m) {
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-  return svd.matrixU() * d * svd.matrixV().transpose();
-}
-
 // ---------------------------------------------------------------------------------------------
 // Input validation and target assembly.
 
@@ -266,18 +253,22 @@ bool ProjectWithJacobians(const Vector6d& k, const Rigid3& pose, const Eigen::Ve
   if (!(c.z() > 0.0)) return false;
   const double inv_z = 1.0 / c.z();
   const Eigen::Vector2d p = c.head<2>() * inv_z;
-  const double r2 = p.squaredNorm();
-  const double d = 1.0 + r2 * (k(kK1) + k(kK2) * r2);
-  const Eigen::Vector2d q = d * p;
-  *pixel = Eigen::Vector2d(k(kFx) * q.x() + k(kCx), k(kFy) * q.y() + k(kCy));
+  RadialCamera camera;
+  camera.focal = k(kFx);
+  camera.aspect = k(kFy) / k(kFx);
+  camera.cx = k(kCx);
+  camera.cy = k(kCy);
+  camera.k1 = k(kK1);
+  camera.k2 = k(kK2);
+  *pixel = camera.PixelFromNormalised(p);
   if (d_intrinsics == nullptr) return pixel->allFinite();
+  const double r2 = p.squaredNorm();
+  const Eigen::Vector2d q = camera.Distortion(r2) * p;
   *d_intrinsics << q.x(), 0.0, 1.0, 0.0, k(kFx) * p.x() * r2, k(kFx) * p.x() * r2 * r2,  //
       0.0, q.y(), 0.0, 1.0, k(kFy) * p.y() * r2, k(kFy) * p.y() * r2 * r2;
   Eigen::Matrix<double, 2, 3> dp_dc;
   dp_dc << inv_z, 0.0, -p.x() * inv_z, 0.0, inv_z, -p.y() * inv_z;
-  const Eigen::Matrix2d dq_dp =
-      d * Eigen::Matrix2d::Identity() + (2.0 * k(kK1) + 4.0 * k(kK2) * r2) * p * p.transpose();
-  const Eigen::Matrix<double, 2, 3> du_dc = Eigen::Vector2d(k(kFx), k(kFy)).asDiagonal() * dq_dp * dp_dc;
+  const Eigen::Matrix<double, 2, 3> du_dc = camera.PixelFromNormalisedJacobian(p) * dp_dc;
   // d(exp(dw) R X) / d dw = -[R X]x, whose column j is e_j x (R X).
   Eigen::Matrix3d dc_dw;
   for (int j = 0; j < 3; ++j) dc_dw.col(j) = Eigen::Vector3d::Unit(j).cross(rotated);
@@ -372,7 +363,7 @@ State Plus(const State& x, const IntrinsicsParameterisation& param, const Eigen:
   State next = x;
   next.intrinsics += param.T * d_intrinsics;
   for (size_t t = 0; t < x.poses.size(); ++t) {
-    next.poses[t].rotation = RotationFromVector(d_poses[t].head<3>()) * x.poses[t].rotation;
+    next.poses[t].rotation = RotationFromAngleAxis(d_poses[t].head<3>()) * x.poses[t].rotation;
     next.poses[t].translation += d_poses[t].tail<3>();
   }
   return next;
@@ -384,31 +375,29 @@ double StateNorm(const State& x, const IntrinsicsParameterisation& param) {
   return std::sqrt(sq);
 }
 
-struct RefinementSummary {
-  int iterations = 0;
-  bool converged = false;
-  bool numeric_failure = false;
-};
-
-// Levenberg-Marquardt with the trust region of core/math/normal_lm.h.
-RefinementSummary Refine(const std::vector<Target>& targets, const IntrinsicsParameterisation& param,
-                         const CalibrationOptions& options, State* x) {
+// Levenberg-Marquardt with the trust region and the termination reasons of core/math/normal_lm.h
+// (NormalLmSolve's loop over the Schur-complement step of this problem's block structure).
+NormalLmSummary Refine(const std::vector<Target>& targets, const IntrinsicsParameterisation& param,
+                       const CalibrationOptions& options, State* x) {
+  using Termination = NormalLmSummary::Termination;
   const NormalLmOptions lm;  // tolerances and radii shared with the other LM solvers
-  RefinementSummary summary;
+  NormalLmSummary summary;
   NormalEquations eq;
   if (!Linearize(targets, param, options.loss, *x, &eq)) {
-    summary.numeric_failure = true;
+    summary.termination = Termination::kNumericFailure;
     return summary;
   }
+  summary.initial_cost = eq.cost;
   LmTrustRegion region(lm.initial_trust_region_radius);
   Eigen::VectorXd d_intrinsics;
   std::vector<Vector6d> d_poses;
   NormalEquations trial;
+  summary.termination = Termination::kMaxIterations;
   while (summary.iterations < options.max_iterations) {
     double max_gradient = eq.g_intrinsics.size() > 0 ? eq.g_intrinsics.cwiseAbs().maxCoeff() : 0.0;
     for (const Vector6d& g : eq.g_pose) max_gradient = std::max(max_gradient, g.cwiseAbs().maxCoeff());
     if (max_gradient <= lm.gradient_tolerance) {
-      summary.converged = true;
+      summary.termination = Termination::kGradientTolerance;
       break;
     }
     ++summary.iterations;
@@ -418,7 +407,7 @@ RefinementSummary Refine(const std::vector<Target>& targets, const IntrinsicsPar
       double step_sq = d_intrinsics.squaredNorm();
       for (const Vector6d& dp : d_poses) step_sq += dp.tail<3>().squaredNorm();
       if (std::sqrt(step_sq) <= lm.parameter_tolerance * (StateNorm(*x, param) + lm.parameter_tolerance)) {
-        summary.converged = true;
+        summary.termination = Termination::kParameterTolerance;
         break;
       }
       const State next = Plus(*x, param, d_intrinsics, d_poses);
@@ -432,7 +421,7 @@ RefinementSummary Refine(const std::vector<Target>& targets, const IntrinsicsPar
           std::swap(eq, trial);
           region.Accept(gain, lm.max_trust_region_radius);
           if (std::abs(change) <= options.function_tolerance * old_cost) {
-            summary.converged = true;
+            summary.termination = Termination::kFunctionTolerance;
             break;
           }
         }
@@ -440,9 +429,13 @@ RefinementSummary Refine(const std::vector<Target>& targets, const IntrinsicsPar
     }
     if (!accepted) {
       region.Reject();
-      if (region.radius() < lm.min_trust_region_radius) break;
+      if (region.radius() < lm.min_trust_region_radius) {
+        summary.termination = Termination::kTrustRegionTooSmall;
+        break;
+      }
     }
   }
+  summary.final_cost = eq.cost;
   return summary;
 }
 
@@ -664,12 +657,13 @@ Result<CalibrationReport> CalibrateIntrinsics(const CalibrationObservations& obs
     x.intrinsics(kCy) = norm.centre.y();
   }
   const IntrinsicsParameterisation param = IntrinsicsParameterisation::From(options);
-  const RefinementSummary summary = Refine(targets, param, options, &x);
-  if (summary.numeric_failure) {
+  const NormalLmSummary summary = Refine(targets, param, options, &x);
+  if (summary.termination == NormalLmSummary::Termination::kNumericFailure) {
     return NumericFailure("calibration: the reprojection error is not finite at the initial estimate");
   }
   report.iterations = summary.iterations;
-  report.converged = summary.converged;
+  report.termination = summary.termination;
+  report.converged = summary.converged();
 
   // Covariance of the free intrinsics: sigma^2 (U - W V^-1 W^T)^-1 at the solution.
   NormalEquations eq;

@@ -36,6 +36,7 @@
 
 #include "core/base/status.h"
 #include "core/math/camera_intrinsics.h"
+#include "core/math/normal_lm.h"
 #include "core/math/rigid3.h"
 #include "core/math/robust_loss.h"
 #include "tracker/tag_detector.h"
@@ -128,6 +129,8 @@ struct CalibrationReport {
   int num_targets = 0;
   int num_corners = 0;
   int iterations = 0;
+  // Why the LM stopped (core/math/normal_lm.h); never kNumericFailure in a returned report.
+  NormalLmSummary::Termination termination = NormalLmSummary::Termination::kMaxIterations;
   bool converged = false;  // LM stopped on a tolerance (not max_iterations or a collapsed trust region)
   bool principal_point_from_closed_form = false;  // false: the closed form fixed it at the centre
   double constraint_ratio = 0.0;  // of the closed form that was used (see min_constraint_ratio)

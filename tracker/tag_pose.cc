@@ -11,13 +11,10 @@
 #include "core/geometry/absolute_pose.h"
 #include "core/geometry/correspondence.h"
 #include "core/geometry/homography_four_point.h"
+#include "core/math/rotation.h"
 
 namespace reconar {
 namespace {
-
-Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& R) {
-  return Eigen::Quaterniond(R).normalized().toRotationMatrix();
-}
 
 // Least-squares translation for a known rotation: (R X_i + t) parallel to (q_i, 1), two linear
 // equations per point.
@@ -67,7 +64,7 @@ void RefineOnNormalized(const Eigen::Vector3d* world_points, const Eigen::Vector
   PoseRefinementOptions options;
   options.loss = LossType::kTrivial;
   options.lm = lm;
-  AbsolutePoseCamera camera;
+  RadialCamera camera;
   camera.focal = focal;
   Eigen::Matrix3d R = cam_from_world->rotation;
   Eigen::Vector3d t = cam_from_world->translation;

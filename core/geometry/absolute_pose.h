@@ -10,8 +10,9 @@
 //    reprojection error of the inliers. EstimateAbsolutePoseUnknownFocal: DLT in RANSAC, P
 //    decomposed by RQ (H&Z sec. 6.2.4) into focal and pose, then the same refinement.
 // Conventions: cam_from_world pose X_cam = R X + t (COLMAP: x right, y down, z forward); the
-// camera maps a point in front of it (X_cam.z > 0) to the pixel f * d(r^2) * p + c with
-// p = X_cam.xy / X_cam.z, r^2 = |p|^2 and d = 1 + k1 r^2 + k2 r^4. "Normalised" coordinates are p.
+// camera is RadialCamera (core/math/radial_camera.h): a point in front of it (X_cam.z > 0) maps to
+// the pixel diag(f, a f) d(r^2) p + c with p = X_cam.xy / X_cam.z, r^2 = |p|^2 and
+// d = 1 + k1 r^2 + k2 r^4. "Normalised" coordinates are p.
 #include <array>
 #include <limits>
 #include <string>
@@ -22,6 +23,8 @@
 #include "core/base/status.h"
 #include "core/geometry/ransac_options.h"
 #include "core/math/normal_lm.h"
+#include "core/math/radial_camera.h"
+#include "core/math/rigid3.h"
 #include "core/math/robust_loss.h"
 
 namespace reconar {
@@ -88,27 +91,17 @@ bool NearestPose(const Matrix34d& P, Eigen::Matrix3d* R, Eigen::Vector3d* t);
 // positive diagonal and K(2, 2) = 1, R a rotation. False when det(P(:, 0:3)) <= 0 or not finite.
 bool DecomposeProjection(const Matrix34d& P, Eigen::Matrix3d* K, Eigen::Matrix3d* R, Eigen::Vector3d* t);
 
-// Pinhole camera with two radial distortion coefficients (see the header comment).
-struct AbsolutePoseCamera {
-  double focal = 1.0;  // pixels
-  double cx = 0.0;     // principal point, pixels
-  double cy = 0.0;
-  double k1 = 0.0;
-  double k2 = 0.0;
+// The camera is RadialCamera (core/math/radial_camera.h). InvalidArgument unless focal and aspect
+// are positive and every value is finite.
+Status CheckCamera(const RadialCamera& camera);
 
-  // InvalidArgument unless focal > 0 and every value is finite.
-  Status Check() const;
-  // f * d(|p|^2) * p + c.
-  Eigen::Vector2d Distort(const Eigen::Vector2d& normalised) const;
-  // The normalised point p whose pixel is `pixel`: |p| solves |q| = |p| d(|p|^2) for
-  // q = (pixel - c) / f by Newton's method from |p| = |q|. False when it does not converge to a
-  // point where the distortion is still monotonic (d(r^2) r increasing), i.e. beyond the valid image.
-  bool Undistort(const Eigen::Vector2d& pixel, Eigen::Vector2d* normalised) const;
-};
+// InvalidArgument naming `function` when the two vectors differ in length.
+Status CheckPoseInputSizes(const std::vector<Eigen::Vector2d>& points_px,
+                           const std::vector<Eigen::Vector3d>& world_points, const char* function);
 
 // Squared pixel error of X under the camera and cam_from_world (R, t); the largest double when
 // X is not in front of the camera.
-double SquaredPixelError(const AbsolutePoseCamera& camera, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+double SquaredPixelError(const RadialCamera& camera, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                          const Eigen::Vector3d& world_point, const Eigen::Vector2d& pixel);
 
 struct PoseRefinementOptions {
@@ -130,7 +123,7 @@ struct PoseRefinementOptions {
 // the caller validates the input (see RefineAbsolutePose below).
 NormalLmSummary RefineAbsolutePoseInPlace(const Eigen::Vector2d* points_px, const Eigen::Vector3d* world_points,
                                           const int* indices, int count, const PoseRefinementOptions& options,
-                                          AbsolutePoseCamera* camera, Eigen::Matrix3d* R, Eigen::Vector3d* t);
+                                          RadialCamera* camera, Eigen::Matrix3d* R, Eigen::Vector3d* t);
 
 // RefineAbsolutePoseInPlace on validated input. InvalidArgument when the vectors differ in
 // length, an index is out of range, fewer than 4 indices are given (7 parameters need more than
@@ -139,7 +132,7 @@ NormalLmSummary RefineAbsolutePoseInPlace(const Eigen::Vector2d* points_px, cons
 Result<NormalLmSummary> RefineAbsolutePose(const std::vector<Eigen::Vector2d>& points_px,
                                            const std::vector<Eigen::Vector3d>& world_points,
                                            const std::vector<int>& indices, const PoseRefinementOptions& options,
-                                           AbsolutePoseCamera* camera, Eigen::Matrix3d* R, Eigen::Vector3d* t);
+                                           RadialCamera* camera, Eigen::Matrix3d* R, Eigen::Vector3d* t);
 
 struct AbsolutePoseOptions {
   // Inlier threshold on the pixel reprojection error; RANSAC uses max_error_px / focal in
@@ -171,8 +164,7 @@ struct AbsolutePoseResult {
   };
   Outcome outcome = Outcome::kNoModel;
   std::string reason;  // why it failed (empty on success)
-  Eigen::Matrix3d cam_from_world_rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
+  Rigid3 cam_from_world;
   double focal = 0.0;                // the camera's focal, or the estimate (unknown-focal path, refine_focal)
   std::vector<int> inliers;          // indices into the input with pixel error < max_error_px, ascending
   int num_inliers = 0;
@@ -193,7 +185,7 @@ const char* AbsolutePoseOutcomeName(AbsolutePoseResult::Outcome outcome);
 // from the local optimisation; it is made a pose by NearestPose before the refinement.
 Result<AbsolutePoseResult> EstimateAbsolutePose(const std::vector<Eigen::Vector2d>& points_px,
                                                 const std::vector<Eigen::Vector3d>& world_points,
-                                                const AbsolutePoseCamera& camera,
+                                                const RadialCamera& camera,
                                                 const AbsolutePoseOptions& options);
 
 // The same for an unknown focal length: camera.focal is only a prior that scales the coordinates
@@ -203,7 +195,7 @@ Result<AbsolutePoseResult> EstimateAbsolutePose(const std::vector<Eigen::Vector2
 // with the pose when options.refine.
 Result<AbsolutePoseResult> EstimateAbsolutePoseUnknownFocal(const std::vector<Eigen::Vector2d>& points_px,
                                                             const std::vector<Eigen::Vector3d>& world_points,
-                                                            const AbsolutePoseCamera& camera,
+                                                            const RadialCamera& camera,
                                                             const AbsolutePoseOptions& options);
 
 }  // namespace reconar

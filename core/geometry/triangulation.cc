@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
@@ -35,6 +37,44 @@ double TriangulationAngle(const Eigen::Vector3d& c1, const Eigen::Vector3d& c2, 
   if (!(norms > 0.0)) return 0.0;
   // atan2(|a x b|, a . b) is accurate for small angles, unlike acos of the normalised dot product.
   return std::atan2(ray1.cross(ray2).norm(), ray1.dot(ray2));
+}
+
+bool TriangulateMultiView(const std::vector<TriangulationView>& views, Eigen::Vector3d* point) {
+  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+  for (const TriangulationView& view : views) {
+    Eigen::Matrix<double, 3, 4> P;
+    P << view.cam_from_world.rotation, view.cam_from_world.translation;
+    const Eigen::RowVector4d r1 = view.normalised.x() * P.row(2) - P.row(0);
+    const Eigen::RowVector4d r2 = view.normalised.y() * P.row(2) - P.row(1);
+    normal += r1.transpose() * r1 + r2.transpose() * r2;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(normal);
+  const Eigen::Vector4d X = eigen.eigenvectors().col(0);
+  if (!(std::abs(X.w()) > 1e-12 * X.head<3>().norm())) return false;
+  Eigen::Vector3d x = X.head<3>() / X.w();
+  for (int iteration = 0; iteration < 5; ++iteration) {
+    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
+    for (const TriangulationView& view : views) {
+      const double f = view.focal;
+      const Eigen::Vector3d c = view.cam_from_world * x;
+      if (!(c.z() > 0.0)) return false;
+      const double iz = 1.0 / c.z();
+      const Eigen::Vector2d r = f * (c.head<2>() * iz - view.normalised);
+      Eigen::Matrix<double, 2, 3> dp;
+      dp << iz, 0.0, -c.x() * iz * iz, 0.0, iz, -c.y() * iz * iz;
+      const Eigen::Matrix<double, 2, 3> J = f * dp * view.cam_from_world.rotation;
+      jtj += J.transpose() * J;
+      jtr += J.transpose() * r;
+    }
+    const Eigen::Vector3d dx = jtj.ldlt().solve(-jtr);
+    if (!dx.allFinite()) break;
+    x += dx;
+    if (dx.norm() < 1e-12 * (1.0 + x.norm())) break;
+  }
+  if (!x.allFinite()) return false;
+  *point = x;
+  return true;
 }
 
 }  // namespace reconar

@@ -1,7 +1,12 @@
 #pragma once
-// Two-view triangulation: the linear (homogeneous DLT) method of Hartley & Zisserman, sec. 12.2,
-// and the triangulation angle used to reject low-parallax points.
+// Triangulation: the linear (homogeneous DLT) method of Hartley & Zisserman, sec. 12.2, for two
+// views and for N views (then refined by Gauss-Newton), and the triangulation angle used to
+// reject low-parallax points.
+#include <vector>
+
 #include <Eigen/Core>
+
+#include "core/math/rigid3.h"
 
 namespace reconar {
 
@@ -14,6 +19,21 @@ using Matrix34d = Eigen::Matrix<double, 3, 4>;
 // at infinity (parallel rays) or is not finite; *point is then unchanged.
 bool TriangulatePoint(const Matrix34d& P1, const Matrix34d& P2, const Eigen::Vector2d& x1,
                       const Eigen::Vector2d& x2, Eigen::Vector3d* point);
+
+// One view of a point for TriangulateMultiView: the camera's pose, the undistorted normalised image
+// point (RadialCamera::Undistort) and the camera's focal, which scales the residuals to pixels.
+struct TriangulationView {
+  Rigid3 cam_from_world;
+  Eigen::Vector2d normalised = Eigen::Vector2d::Zero();
+  double focal = 1.0;
+};
+
+// The point seen by all `views` (two or more): the eigenvector of the smallest eigenvalue of the
+// normal matrix of the stacked DLT equations (H&Z sec. 12.2), then up to 5 Gauss-Newton steps on
+// sum |focal (hnormalized(R X + t) - normalised)|^2. False when the linear solution lies at
+// infinity, the point falls behind a view during the refinement, or it is not finite; *point is
+// then unchanged.
+bool TriangulateMultiView(const std::vector<TriangulationView>& views, Eigen::Vector3d* point);
 
 // Angle in radians at `point` between the rays to the projection centres c1 and c2; 0 when the
 // point coincides with a centre.

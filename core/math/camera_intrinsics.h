@@ -1,10 +1,15 @@
 #pragma once
-// Pinhole intrinsics with optional radial distortion (k1, k2), as live cameras use them: the
-// tracker's pose estimation, `reconar calibrate`'s output and the renderer's projection.
+// The intrinsics record of a live camera (fx, fy, cx, cy, k1, k2 and the image size), as the
+// tracker, `reconar calibrate`'s files and the renderer take it. The model is RadialCamera
+// (core/math/radial_camera.h); Camera() converts.
 // Pixel convention (DESIGN.md): the centre of the top-left pixel is (0, 0), x right, y down.
 // A camera point X (z forward) maps to p = X.xy / X.z, d = 1 + k1 |p|^2 + k2 |p|^4,
 // u = fx d p.x + cx, v = fy d p.y + cy.
+#include <limits>
+
 #include <Eigen/Core>
+
+#include "core/math/radial_camera.h"
 
 namespace reconar {
 
@@ -20,25 +25,26 @@ struct CameraIntrinsics {
 
   bool valid() const { return fx > 0.0 && fy > 0.0; }
 
-  Eigen::Vector2d Distort(const Eigen::Vector2d& normalized) const {
-    const double r2 = normalized.squaredNorm();
-    return normalized * (1.0 + r2 * (k1 + k2 * r2));
+  // The one camera model with these parameters (focal = fx, aspect = fy / fx).
+  RadialCamera Camera() const {
+    RadialCamera camera;
+    camera.focal = fx;
+    camera.aspect = fy / fx;
+    camera.cx = cx;
+    camera.cy = cy;
+    camera.k1 = k1;
+    camera.k2 = k2;
+    return camera;
   }
-  Eigen::Vector2d Project(const Eigen::Vector3d& cam_point) const {
-    const Eigen::Vector2d p = Distort(cam_point.head<2>() / cam_point.z());
-    return Eigen::Vector2d(fx * p.x() + cx, fy * p.y() + cy);
-  }
-  // Normalised coordinates of a pixel; inverts the distortion by fixed-point iteration
-  // (converges for the mild k1, k2 of real lenses).
+  Eigen::Vector2d Project(const Eigen::Vector3d& cam_point) const { return Camera().Project(cam_point); }
+  // Normalised coordinates of a pixel (RadialCamera::Undistort); NaN when the pixel lies beyond
+  // the region where the distortion is invertible.
   Eigen::Vector2d Unproject(const Eigen::Vector2d& pixel) const {
-    const Eigen::Vector2d distorted((pixel.x() - cx) / fx, (pixel.y() - cy) / fy);
-    Eigen::Vector2d p = distorted;
-    if (k1 == 0.0 && k2 == 0.0) return p;
-    for (int i = 0; i < 20; ++i) {
-      const double r2 = p.squaredNorm();
-      p = distorted / (1.0 + r2 * (k1 + k2 * r2));
+    Eigen::Vector2d normalised;
+    if (!Camera().Undistort(pixel, &normalised)) {
+      return Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
     }
-    return p;
+    return normalised;
   }
 };
 

@@ -4,6 +4,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "core/math/rotation.h"
+
 namespace reconar {
 
 struct Rigid3 {
@@ -43,11 +45,6 @@ inline Rigid3 CamFromWorldLookingAt(const Eigen::Vector3d& center, const Eigen::
   cam_from_world.rotation.row(2) = z.transpose();
   cam_from_world.translation = -(cam_from_world.rotation * center);
   return cam_from_world;
-}
-
-// Angle of the rotation between a and b, in radians; accurate for small angles too.
-inline double RotationAngle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return Eigen::AngleAxisd(Eigen::Quaterniond(a.transpose() * b).normalized()).angle();
 }
 
 }  // namespace reconar

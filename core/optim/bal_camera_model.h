@@ -10,6 +10,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "core/math/rotation.h"
+
 namespace reconar {
 
 // Rodrigues coefficients a = sin t / t, b = (1 - cos t) / t^2, c = (t - sin t) / t^3, using
@@ -27,12 +29,6 @@ inline void RodriguesCoefficients(double theta2, double* a, double* b, double* c
     *b = (1.0 - std::cos(theta)) / theta2;
     *c = (theta - s) / (theta2 * theta);
   }
-}
-
-inline Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
 }
 
 // Projects `point` (3 doubles) with `camera` (9 doubles) into predicted[2]. When jac_camera

@@ -1,11 +1,13 @@
 #pragma once
-// The SfM camera: Bundler's radial model with a principal point and a pixel aspect ratio,
-// cam_from_world pose (COLMAP's RADIAL model when a = 1, OPENCV's with p1 = p2 = 0 otherwise):
+// The bundle adjuster's view of the one camera model (RadialCamera, core/math/radial_camera.h)
+// over a flat 12-double parameter block, with analytic Jacobians, cam_from_world pose:
 //   P = R(w) X + t,  p = P.xy / P.z,  d = 1 + k1 |p|^2 + k2 |p|^4,
 //   u = f d p.x + cx,  v = a f d p.y + cy.
 // Parameters: w (3), t (3), f, k1, k2, cx, cy, a. It is the BAL model with the camera looking
 // down +z instead of -z: p = -p_bal, so the Jacobians are the BAL ones negated (the v row scaled
-// by a), plus the identity for c and d v / d a = f d p.y.
+// by a), plus the identity for c and d v / d a = f d p.y. Its pixels agree with
+// RadialCamera::Project to rounding (tests/core/optim/radial_camera_model_test.cc); the BAL form
+// is kept because the adjuster's results depend on its exact floating-point operations.
 #include "core/optim/bal_camera_model.h"
 
 namespace reconar {

@@ -11,6 +11,8 @@
 #include "core/geometry/essential_five_point.h"
 #include "core/geometry/ransac.h"
 #include "core/geometry/relative_pose.h"
+#include "core/geometry/triangulation.h"
+#include "core/math/rotation.h"
 #include "core/optim/bundle_adjuster.h"
 
 namespace reconar {
@@ -21,17 +23,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-Eigen::Vector3d AngleAxisFromRotation(const Eigen::Matrix3d& R) {
-  const Eigen::AngleAxisd aa(R);
-  return aa.angle() * aa.axis();
-}
-
-Eigen::Matrix3d RotationFromAngleAxis(const Eigen::Vector3d& w) {
-  const double angle = w.norm();
-  if (angle < 1e-16) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
 }
 
 class Mapper {
@@ -356,12 +347,7 @@ class Mapper {
       keypoint_of.push_back(static_cast<int>(kp));
     }
     SfmCamera camera = GuessCamera(image);
-    AbsolutePoseCamera pose_camera;
-    pose_camera.focal = camera.focal;
-    pose_camera.cx = camera.cx;
-    pose_camera.cy = camera.cy;
-    pose_camera.k1 = camera.k1;
-    pose_camera.k2 = camera.k2;
+    const RadialCamera& pose_camera = camera;  // with its aspect ratio
     // Until three images confirm a camera's focal, the model is shaped by a prior the data has not
     // checked: register with the focal free, under a looser bound, falling back to the DLT for an
     // unknown focal; a global adjustment with the focal free follows (RegisterNextImage).
@@ -393,8 +379,8 @@ class Mapper {
       rec_.cameras[static_cast<size_t>(camera_id)] = camera;
       needs_global_adjustment_ = true;
     }
-    img.pose.cam_from_world_rotation = result->cam_from_world_rotation;
-    img.pose.cam_from_world_translation = result->cam_from_world_translation;
+    img.pose.cam_from_world_rotation = result->cam_from_world.rotation;
+    img.pose.cam_from_world_translation = result->cam_from_world.translation;
     img.registered = true;
     for (int index : result->inliers) {
       const int kp = keypoint_of[static_cast<size_t>(index)];
@@ -446,53 +432,19 @@ class Mapper {
     point_of_track_[static_cast<size_t>(track_of_point_[static_cast<size_t>(point_id)])] = -1;
   }
 
-  // Linear triangulation from all given views (normalised coordinates), refined by Gauss-Newton
-  // on the pixel reprojection error. False when the views do not determine a point.
+  // TriangulateMultiView (core/geometry/triangulation.h) of the undistorted keypoints. False when
+  // the views do not determine a point or a keypoint cannot be undistorted.
   bool Triangulate(const std::vector<TrackElement>& views, Eigen::Vector3d* position) const {
-    Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
-    std::vector<Eigen::Vector2d> normalised(views.size());
+    std::vector<TriangulationView> observations(views.size());
     for (size_t v = 0; v < views.size(); ++v) {
       const SfmImage& img = rec_.images[static_cast<size_t>(views[v].image_id)];
       const SfmCamera& cam = rec_.cameras[static_cast<size_t>(img.camera_id)];
-      AbsolutePoseCamera undistorter{cam.focal, cam.cx, cam.cy, cam.k1, cam.k2};
-      const Eigen::Vector2d& x = img.keypoints[static_cast<size_t>(views[v].keypoint_id)];
-      if (!undistorter.Undistort(Eigen::Vector2d(x.x(), cam.cy + (x.y() - cam.cy) / cam.aspect), &normalised[v])) {
-        return false;
-      }
-      Eigen::Matrix<double, 3, 4> P;
-      P << img.pose.cam_from_world_rotation, img.pose.cam_from_world_translation;
-      const Eigen::RowVector4d r1 = normalised[v].x() * P.row(2) - P.row(0);
-      const Eigen::RowVector4d r2 = normalised[v].y() * P.row(2) - P.row(1);
-      normal += r1.transpose() * r1 + r2.transpose() * r2;
+      TriangulationView& view = observations[v];
+      if (!cam.Undistort(img.keypoints[static_cast<size_t>(views[v].keypoint_id)], &view.normalised)) return false;
+      view.cam_from_world = Rigid3{img.pose.cam_from_world_rotation, img.pose.cam_from_world_translation};
+      view.focal = cam.focal;
     }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(normal);
-    const Eigen::Vector4d X = eigen.eigenvectors().col(0);
-    if (!(std::abs(X.w()) > 1e-12 * X.head<3>().norm())) return false;
-    Eigen::Vector3d x = X.head<3>() / X.w();
-    for (int iteration = 0; iteration < 5; ++iteration) {
-      Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
-      Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
-      for (size_t v = 0; v < views.size(); ++v) {
-        const SfmImage& img = rec_.images[static_cast<size_t>(views[v].image_id)];
-        const double f = rec_.cameras[static_cast<size_t>(img.camera_id)].focal;
-        const Eigen::Vector3d c = img.pose.CamFromWorld(x);
-        if (!(c.z() > 0.0)) return false;
-        const double iz = 1.0 / c.z();
-        const Eigen::Vector2d r = f * (c.head<2>() * iz - normalised[v]);
-        Eigen::Matrix<double, 2, 3> dp;
-        dp << iz, 0.0, -c.x() * iz * iz, 0.0, iz, -c.y() * iz * iz;
-        const Eigen::Matrix<double, 2, 3> J = f * dp * img.pose.cam_from_world_rotation;
-        jtj += J.transpose() * J;
-        jtr += J.transpose() * r;
-      }
-      const Eigen::Vector3d dx = jtj.ldlt().solve(-jtr);
-      if (!dx.allFinite()) break;
-      x += dx;
-      if (dx.norm() < 1e-12 * (1.0 + x.norm())) break;
-    }
-    if (!x.allFinite()) return false;
-    *position = x;
-    return true;
+    return TriangulateMultiView(observations, position);
   }
 
   // Triangulates track t from its registered views (all of them, else the best pair of them);

@@ -6,10 +6,8 @@
 //  - Pixel coordinates have the centre of the top-left pixel at (0, 0), x right, y down (the
 //    SIFT convention). COLMAP's files put that centre at (0.5, 0.5); model_io converts.
 //  - A pose is cam_from_world: X_cam = R X_world + t, camera looking down +z, y down.
-//  - The camera model is Bundler's radial model (paper eq. 9) with a principal point and a pixel
-//    aspect ratio a: p = X_cam.xy / X_cam.z, d = 1 + k1 |p|^2 + k2 |p|^4,
-//    u = f d p.x + cx, v = a f d p.y + cy. With a = 1 it is COLMAP's RADIAL model, otherwise
-//    COLMAP's OPENCV model with fx = f, fy = a f and no tangential distortion.
+//  - The camera model is RadialCamera (core/math/radial_camera.h): Bundler's radial model with a
+//    principal point and a pixel aspect ratio (COLMAP's RADIAL model when aspect = 1, OPENCV's otherwise).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
@@ -18,26 +16,15 @@
 #include <vector>
 
 #include "core/math/camera_intrinsics.h"
+#include "core/math/radial_camera.h"
 
 namespace reconar {
 
-struct SfmCamera {
+// A camera of the model: the one camera model (focal, cx, cy, k1, k2, aspect; Project, Undistort)
+// and the size of its images.
+struct SfmCamera : RadialCamera {
   int width = 0;
   int height = 0;
-  double focal = 0.0;  // pixels
-  double cx = 0.0;     // principal point, pixels
-  double cy = 0.0;
-  double k1 = 0.0;
-  double k2 = 0.0;
-  double aspect = 1.0;  // fy / fx
-
-  // Pixel of a point in camera coordinates (z > 0 assumed).
-  Eigen::Vector2d Project(const Eigen::Vector3d& cam_point) const {
-    const Eigen::Vector2d p = cam_point.head<2>() / cam_point.z();
-    const double r2 = p.squaredNorm();
-    const double d = 1.0 + r2 * (k1 + k2 * r2);
-    return Eigen::Vector2d(focal * d * p.x() + cx, aspect * focal * d * p.y() + cy);
-  }
 
   // The same camera as the tracker and renderer take it (the models agree: fy = aspect * focal).
   CameraIntrinsics Intrinsics() const {

@@ -10,24 +10,13 @@
 #include <utility>
 
 #include "core/base/json_writer.h"
+#include "core/geometry/triangulation.h"
 #include "core/sfm/tag_layout.h"
 
 namespace reconar {
 namespace {
 
 using Observation = std::pair<int, Eigen::Vector2d>;  // (image id, pixel)
-
-// Normalised, undistorted coordinates of a pixel (the inverse of SfmCamera::Project by fixed point).
-Eigen::Vector2d NormalisedCoordinates(const SfmCamera& camera, const Eigen::Vector2d& pixel) {
-  const Eigen::Vector2d distorted((pixel.x() - camera.cx) / camera.focal,
-                                  (pixel.y() - camera.cy) / (camera.aspect * camera.focal));
-  Eigen::Vector2d p = distorted;
-  for (int iteration = 0; iteration < 20; ++iteration) {
-    const double r2 = p.squaredNorm();
-    p = distorted / (1.0 + r2 * (camera.k1 + camera.k2 * r2));
-  }
-  return p;
-}
 
 double ReprojectionError(const Reconstruction& rec, const Observation& obs, const Eigen::Vector3d& point) {
   const SfmImage& image = rec.images[static_cast<size_t>(obs.first)];
@@ -36,46 +25,19 @@ double ReprojectionError(const Reconstruction& rec, const Observation& obs, cons
   return (rec.cameras[static_cast<size_t>(image.camera_id)].Project(cam) - obs.second).norm();
 }
 
-// Multi-view DLT on normalised coordinates (Hartley & Zisserman sec. 12.2), then Gauss-Newton on
-// the pixel reprojection error.
+// TriangulateMultiView (core/geometry/triangulation.h) of the undistorted corner pixels.
 std::optional<Eigen::Vector3d> TriangulateViews(const Reconstruction& rec, const std::vector<Observation>& views) {
-  Eigen::MatrixXd system(2 * views.size(), 4);
+  std::vector<TriangulationView> observations(views.size());
   for (size_t v = 0; v < views.size(); ++v) {
     const SfmImage& image = rec.images[static_cast<size_t>(views[v].first)];
-    Eigen::Matrix<double, 3, 4> P;
-    P << image.pose.cam_from_world_rotation, image.pose.cam_from_world_translation;
-    const Eigen::Vector2d x = NormalisedCoordinates(rec.cameras[static_cast<size_t>(image.camera_id)], views[v].second);
-    system.row(static_cast<Eigen::Index>(2 * v)) = x.x() * P.row(2) - P.row(0);
-    system.row(static_cast<Eigen::Index>(2 * v + 1)) = x.y() * P.row(2) - P.row(1);
+    const SfmCamera& camera = rec.cameras[static_cast<size_t>(image.camera_id)];
+    TriangulationView& view = observations[v];
+    if (!camera.Undistort(views[v].second, &view.normalised)) return std::nullopt;
+    view.cam_from_world = Rigid3{image.pose.cam_from_world_rotation, image.pose.cam_from_world_translation};
+    view.focal = camera.focal;
   }
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(system, Eigen::ComputeFullV);
-  const Eigen::Vector4d h = svd.matrixV().col(3);
-  if (!(std::abs(h.w()) > 1e-12)) return std::nullopt;
-  Eigen::Vector3d point = h.head<3>() / h.w();
-  for (int iteration = 0; iteration < 10; ++iteration) {
-    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
-    for (const Observation& view : views) {
-      const SfmImage& image = rec.images[static_cast<size_t>(view.first)];
-      const SfmCamera& camera = rec.cameras[static_cast<size_t>(image.camera_id)];
-      const Eigen::Vector3d cam = image.pose.CamFromWorld(point);
-      if (!(cam.z() > 0.0)) return std::nullopt;
-      const Eigen::Vector2d residual = camera.Project(cam) - view.second;
-      Eigen::Matrix<double, 2, 3> jacobian;
-      for (int axis = 0; axis < 3; ++axis) {
-        Eigen::Vector3d step = Eigen::Vector3d::Zero();
-        step[axis] = 1e-6 * std::max(1.0, point.norm());
-        jacobian.col(axis) = (camera.Project(image.pose.CamFromWorld(point + step)) - camera.Project(cam)) / step[axis];
-      }
-      normal += jacobian.transpose() * jacobian;
-      gradient += jacobian.transpose() * residual;
-    }
-    const Eigen::Vector3d delta = normal.ldlt().solve(-gradient);
-    if (!delta.allFinite()) return std::nullopt;
-    point += delta;
-    if (delta.norm() < 1e-12 * std::max(1.0, point.norm())) break;
-  }
-  if (!point.allFinite()) return std::nullopt;
+  Eigen::Vector3d point;
+  if (!TriangulateMultiView(observations, &point)) return std::nullopt;
   return point;
 }
 

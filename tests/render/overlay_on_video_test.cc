@@ -56,11 +56,11 @@ std::vector<Eigen::Vector3d> TagCorners() {
 
 Result<Rigid3> CamFromTagFromCorners(const std::vector<Eigen::Vector2d>& corners) {
   const CameraIntrinsics intrinsics = testing::ArVideoCamera();
-  AbsolutePoseCamera camera;
+  RadialCamera camera;
   camera.focal = 0.5 * (intrinsics.fx + intrinsics.fy);
   camera.cx = intrinsics.cx;
   camera.cy = intrinsics.cy;
-  // AbsolutePoseCamera has one focal; the pixels are rescaled so fy's axis matches it.
+  // RadialCamera has one focal; the pixels are rescaled so fy's axis matches it.
   std::vector<Eigen::Vector2d> pixels = corners;
   for (Eigen::Vector2d& pixel : pixels) {
     pixel.x() = (pixel.x() - intrinsics.cx) * camera.focal / intrinsics.fx + intrinsics.cx;
@@ -71,10 +71,7 @@ Result<Rigid3> CamFromTagFromCorners(const std::vector<Eigen::Vector2d>& corners
   options.max_error_px = 3.0;
   RECONAR_ASSIGN_OR_RETURN(AbsolutePoseResult pose, EstimateAbsolutePose(pixels, TagCorners(), camera, options));
   if (!pose.success()) return FailedPrecondition("pose from corners: " + pose.reason);
-  Rigid3 cam_from_tag;
-  cam_from_tag.rotation = pose.cam_from_world_rotation;
-  cam_from_tag.translation = pose.cam_from_world_translation;
-  return cam_from_tag;
+  return pose.cam_from_world;  // the tag's corners are the world points: cam_from_tag
 }
 
 std::string TempPath(const std::string& name) {

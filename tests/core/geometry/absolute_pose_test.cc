@@ -43,7 +43,7 @@ struct SceneOptions {
 // A random camera looking at random points at depths 3..8 that project into the image; outliers
 // are uniformly random pixels at least 20 px from the true projection.
 struct Scene {
-  AbsolutePoseCamera camera;
+  RadialCamera camera;
   Eigen::Matrix3d R;
   Eigen::Vector3d t;
   std::vector<Eigen::Vector2d> pixels;
@@ -57,7 +57,7 @@ struct Scene {
 Scene MakeScene(const SceneOptions& options) {
   SplitMix64 rng(options.seed);
   Scene scene;
-  scene.camera = AbsolutePoseCamera{options.focal, 0.5 * options.width + 3.0, 0.5 * options.height - 2.0, options.k1,
+  scene.camera = RadialCamera{options.focal, 0.5 * options.width + 3.0, 0.5 * options.height - 2.0, options.k1,
                                     options.k2};
   scene.R = RandomRotation(&rng);
   const Eigen::Vector3d centre(rng.Uniform(-2, 2), rng.Uniform(-2, 2), rng.Uniform(-2, 2));
@@ -67,7 +67,7 @@ Scene MakeScene(const SceneOptions& options) {
     const Eigen::Vector2d p(rng.Uniform(-half_w, half_w), rng.Uniform(-half_h, half_h));
     const Eigen::Vector3d X_cam = rng.Uniform(3.0, 8.0) * p.homogeneous();
     scene.world.push_back(scene.R.transpose() * (X_cam - scene.t));
-    scene.exact_pixels.push_back(scene.camera.Distort(p));
+    scene.exact_pixels.push_back(scene.camera.PixelFromNormalised(p));
     scene.pixels.push_back(scene.exact_pixels.back() +
                            options.noise_px * Eigen::Vector2d(rng.Gaussian(), rng.Gaussian()));
     scene.is_inlier.push_back(1);
@@ -89,7 +89,7 @@ Scene MakeScene(const SceneOptions& options) {
 std::vector<PoseCorrespondence> NormalisedCorrespondences(const Scene& scene, bool exact) {
   std::vector<PoseCorrespondence> result;
   for (size_t i = 0; i < scene.world.size(); ++i) {
-    Eigen::Vector2d p;
+    Eigen::Vector2d p = Eigen::Vector2d::Zero();
     EXPECT_TRUE(scene.camera.Undistort(exact ? scene.exact_pixels[i] : scene.pixels[i], &p));
     result.push_back(PoseCorrespondence{p, scene.world[i]});
   }
@@ -109,12 +109,12 @@ double PoseErrorMahalanobis(const Scene& scene, double sigma_px, const Eigen::Ma
                             double focal, bool with_focal) {
   const int n = with_focal ? 7 : 6;
   const auto project = [&](const Eigen::VectorXd& x, const Eigen::Vector3d& X) {
-    AbsolutePoseCamera camera = scene.camera;
+    RadialCamera camera = scene.camera;
     camera.focal *= std::exp(with_focal ? x(6) : 0.0);
     const Eigen::Matrix3d R_x = Eigen::AngleAxisd(x.head<3>().norm(), x.head<3>().normalized()).toRotationMatrix();
     const Eigen::Vector3d Xc = (x.head<3>().norm() > 0 ? R_x : Eigen::Matrix3d::Identity()) * scene.R * X +
                                scene.t + x.segment<3>(3);
-    return camera.Distort(Xc.head<2>() / Xc.z());
+    return camera.PixelFromNormalised(Xc.head<2>() / Xc.z());
   };
   Eigen::MatrixXd JtJ = Eigen::MatrixXd::Zero(n, n);
   for (size_t i = 0; i < scene.world.size(); ++i) {
@@ -358,21 +358,6 @@ TEST(NearestPose, ProjectsScaledPoseOntoRotation) {
   EXPECT_FALSE(NearestPose(-Pose(R, t), &R_out, &t_out));
 }
 
-TEST(AbsolutePoseCamera, UndistortInvertsDistort) {
-  const AbsolutePoseCamera camera{900.0, 500.0, 400.0, -0.15, 0.04};
-  SplitMix64 rng(8);
-  for (int i = 0; i < 1000; ++i) {
-    const Eigen::Vector2d p(rng.Uniform(-0.7, 0.7), rng.Uniform(-0.5, 0.5));
-    Eigen::Vector2d back;
-    ASSERT_TRUE(camera.Undistort(camera.Distort(p), &back));
-    EXPECT_LT((back - p).norm(), 1e-12);
-  }
-  // Far outside the monotonic range of r d(r^2) there is no inverse.
-  const AbsolutePoseCamera strong{900.0, 500.0, 400.0, -0.5, 0.0};
-  Eigen::Vector2d p;
-  EXPECT_FALSE(strong.Undistort(Eigen::Vector2d(500.0 + 900.0 * 2.0, 400.0), &p));
-}
-
 // ---------------------------------------------------------------------------------------------
 // Registration
 
@@ -400,10 +385,10 @@ TEST(EstimateAbsolutePose, RecoversPoseFromNoisyDataWithOutliers) {
       for (int i : result->inliers) EXPECT_TRUE(scene.is_inlier[i]) << i;
       EXPECT_NEAR(result->mean_inlier_error_px, 0.5 * std::sqrt(kPi / 2), 0.1);  // Rayleigh mean
       // The ML estimate is within the Cramer-Rao ellipsoid: chi^2_6 has its 99.9 % quantile at 22.5.
-      EXPECT_LT(PoseErrorMahalanobis(scene, options.noise_px, result->cam_from_world_rotation,
-                                     result->cam_from_world_translation, result->focal, false),
+      EXPECT_LT(PoseErrorMahalanobis(scene, options.noise_px, result->cam_from_world.rotation,
+                                     result->cam_from_world.translation, result->focal, false),
                 22.5);
-      EXPECT_LT(RotationDifference(result->cam_from_world_rotation, scene.R).norm(), 1e-3);
+      EXPECT_LT(RotationDifference(result->cam_from_world.rotation, scene.R).norm(), 1e-3);
       EXPECT_EQ(result->focal, scene.camera.focal);
     }
   }
@@ -421,8 +406,8 @@ TEST(EstimateAbsolutePose, WithoutRefinementTheRansacPoseIsClose) {
   ASSERT_TRUE(result.ok());
   ASSERT_TRUE(result->success()) << result->reason;
   EXPECT_FALSE(result->refined);
-  EXPECT_LT(RotationDifference(result->cam_from_world_rotation, scene.R).norm(), 5e-3);
-  EXPECT_LT((result->cam_from_world_translation - scene.t).norm(), 5e-3 * (1 + scene.t.norm()));
+  EXPECT_LT(RotationDifference(result->cam_from_world.rotation, scene.R).norm(), 5e-3);
+  EXPECT_LT((result->cam_from_world.translation - scene.t).norm(), 5e-3 * (1 + scene.t.norm()));
   EXPECT_GE(result->num_inliers, scene.num_inliers() * 0.97);
 }
 
@@ -434,8 +419,8 @@ TEST(EstimateAbsolutePose, DeterministicForAFixedSeed) {
   const auto a = EstimateAbsolutePose(scene.pixels, scene.world, scene.camera, AbsolutePoseOptions());
   const auto b = EstimateAbsolutePose(scene.pixels, scene.world, scene.camera, AbsolutePoseOptions());
   ASSERT_TRUE(a.ok() && b.ok());
-  EXPECT_EQ(a->cam_from_world_rotation, b->cam_from_world_rotation);
-  EXPECT_EQ(a->cam_from_world_translation, b->cam_from_world_translation);
+  EXPECT_EQ(a->cam_from_world.rotation, b->cam_from_world.rotation);
+  EXPECT_EQ(a->cam_from_world.translation, b->cam_from_world.translation);
   EXPECT_EQ(a->inliers, b->inliers);
 }
 
@@ -459,13 +444,13 @@ TEST(EstimateAbsolutePose, FewerThanFourPointsIsAClearFailure) {
 }
 
 TEST(EstimateAbsolutePose, CollinearWorldPointsGiveNoModel) {
-  const AbsolutePoseCamera camera{800.0, 512.0, 384.0};
+  const RadialCamera camera{800.0, 512.0, 384.0};
   std::vector<Eigen::Vector2d> pixels;
   std::vector<Eigen::Vector3d> world;
   for (int i = 0; i < 30; ++i) {
     const Eigen::Vector3d X(-1.5 + 0.1 * i, 0.3 - 0.05 * i, 5.0 + 0.02 * i);
     world.push_back(X);
-    pixels.push_back(camera.Distort(X.hnormalized()));
+    pixels.push_back(camera.PixelFromNormalised(X.hnormalized()));
   }
   const Result<AbsolutePoseResult> result = EstimateAbsolutePose(pixels, world, camera, AbsolutePoseOptions());
   ASSERT_TRUE(result.ok());
@@ -473,16 +458,40 @@ TEST(EstimateAbsolutePose, CollinearWorldPointsGiveNoModel) {
   EXPECT_NE(result->reason.find("degenerate"), std::string::npos) << result->reason;
 }
 
+// A camera with a pixel aspect ratio (fy = a f): its exact projections give the exact pose.
+TEST(EstimateAbsolutePose, HonoursTheAspectRatio) {
+  RadialCamera camera{800.0, 512.0, 384.0, -0.1, 0.02};
+  camera.aspect = 1.05;
+  SplitMix64 rng(12);
+  const Eigen::Matrix3d R = RandomRotation(&rng, 0.5);
+  const Eigen::Vector3d t(0.2, -0.1, 0.3);
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> world;
+  for (int i = 0; i < 60; ++i) {
+    const Eigen::Vector2d p(rng.Uniform(-0.5, 0.5), rng.Uniform(-0.4, 0.4));
+    const Eigen::Vector3d X_cam = rng.Uniform(3.0, 8.0) * p.homogeneous();
+    world.push_back(R.transpose() * (X_cam - t));
+    pixels.push_back(camera.PixelFromNormalised(p));
+  }
+  const Result<AbsolutePoseResult> result = EstimateAbsolutePose(pixels, world, camera, AbsolutePoseOptions());
+  ASSERT_TRUE(result.ok());
+  ASSERT_TRUE(result->success()) << result->reason;
+  EXPECT_EQ(result->num_inliers, 60);
+  EXPECT_LT((result->cam_from_world.rotation - R).norm(), 1e-8);
+  EXPECT_LT((result->cam_from_world.translation - t).norm(), 1e-8);
+  EXPECT_LT(result->mean_inlier_error_px, 1e-6);
+}
+
 TEST(EstimateAbsolutePose, PointsBehindTheCameraGiveNoPose) {
   // Observations of points behind the camera: the mirrored structure is no rigid motion of them.
-  const AbsolutePoseCamera camera{800.0, 512.0, 384.0};
+  const RadialCamera camera{800.0, 512.0, 384.0};
   SplitMix64 rng(11);
   std::vector<Eigen::Vector2d> pixels;
   std::vector<Eigen::Vector3d> world;
   for (int i = 0; i < 100; ++i) {
     const Eigen::Vector2d p(rng.Uniform(-0.6, 0.6), rng.Uniform(-0.45, 0.45));
     world.push_back(-rng.Uniform(3.0, 8.0) * p.homogeneous());
-    pixels.push_back(camera.Distort(p));
+    pixels.push_back(camera.PixelFromNormalised(p));
   }
   const Result<AbsolutePoseResult> result = EstimateAbsolutePose(pixels, world, camera, AbsolutePoseOptions());
   ASSERT_TRUE(result.ok());
@@ -507,7 +516,7 @@ TEST(EstimateAbsolutePose, NonFiniteCorrespondencesAreNeverInliers) {
 }
 
 TEST(EstimateAbsolutePose, InvalidInputIsAnError) {
-  const AbsolutePoseCamera camera{800.0, 512.0, 384.0};
+  const RadialCamera camera{800.0, 512.0, 384.0};
   const std::vector<Eigen::Vector2d> pixels(5, Eigen::Vector2d(1, 2));
   const std::vector<Eigen::Vector3d> world(4, Eigen::Vector3d(1, 2, 3));
   EXPECT_EQ(EstimateAbsolutePose(pixels, world, camera, AbsolutePoseOptions()).status().code(),
@@ -516,7 +525,7 @@ TEST(EstimateAbsolutePose, InvalidInputIsAnError) {
   options.min_inliers = 3;
   const std::vector<Eigen::Vector3d> five(5, Eigen::Vector3d(1, 2, 3));
   EXPECT_EQ(EstimateAbsolutePose(pixels, five, camera, options).status().code(), StatusCode::kInvalidArgument);
-  const AbsolutePoseCamera bad{0.0, 512.0, 384.0};
+  const RadialCamera bad{0.0, 512.0, 384.0};
   EXPECT_EQ(EstimateAbsolutePose(pixels, five, bad, AbsolutePoseOptions()).status().code(),
             StatusCode::kInvalidArgument);
   options = AbsolutePoseOptions();
@@ -540,7 +549,7 @@ TEST(EstimateAbsolutePoseUnknownFocal, RecoversFocalWithinOnePercent) {
     options.focal = 1100.0;
     options.seed = seed;
     const Scene scene = MakeScene(options);
-    AbsolutePoseCamera prior = scene.camera;
+    RadialCamera prior = scene.camera;
     prior.focal = 800.0;
     for (bool refine : {false, true}) {
       AbsolutePoseOptions pose_options;
@@ -550,11 +559,11 @@ TEST(EstimateAbsolutePoseUnknownFocal, RecoversFocalWithinOnePercent) {
       ASSERT_TRUE(result.ok());
       ASSERT_TRUE(result->success()) << result->reason;
       EXPECT_NEAR(result->focal, options.focal, 0.01 * options.focal) << "refine " << refine;
-      EXPECT_LT(RotationDifference(result->cam_from_world_rotation, scene.R).norm(), 1e-2);
+      EXPECT_LT(RotationDifference(result->cam_from_world.rotation, scene.R).norm(), 1e-2);
       if (refine) {
         EXPECT_EQ(result->num_inliers, scene.num_inliers());
-        EXPECT_LT(PoseErrorMahalanobis(scene, options.noise_px, result->cam_from_world_rotation,
-                                       result->cam_from_world_translation, result->focal, true),
+        EXPECT_LT(PoseErrorMahalanobis(scene, options.noise_px, result->cam_from_world.rotation,
+                                       result->cam_from_world.translation, result->focal, true),
                   24.3);  // chi^2_7, 99.9 %
       }
     }
@@ -562,14 +571,14 @@ TEST(EstimateAbsolutePoseUnknownFocal, RecoversFocalWithinOnePercent) {
 }
 
 TEST(EstimateAbsolutePoseUnknownFocal, CoplanarPointsGiveNoModel) {
-  const AbsolutePoseCamera camera{800.0, 512.0, 384.0};
+  const RadialCamera camera{800.0, 512.0, 384.0};
   SplitMix64 rng(12);
   std::vector<Eigen::Vector2d> pixels;
   std::vector<Eigen::Vector3d> world;
   for (int i = 0; i < 50; ++i) {
     const Eigen::Vector3d X(rng.Uniform(-2, 2), rng.Uniform(-2, 2), 0.0);
     world.push_back(X);
-    pixels.push_back(camera.Distort((X + Eigen::Vector3d(0, 0, 6)).hnormalized()));
+    pixels.push_back(camera.PixelFromNormalised((X + Eigen::Vector3d(0, 0, 6)).hnormalized()));
   }
   const auto result = EstimateAbsolutePoseUnknownFocal(pixels, world, camera, AbsolutePoseOptions());
   ASSERT_TRUE(result.ok());
@@ -587,7 +596,7 @@ TEST(EstimateAbsolutePoseUnknownFocal, CoplanarPointsGiveNoModel) {
 struct Perturbed {
   Eigen::Matrix3d R;
   Eigen::Vector3d t;
-  AbsolutePoseCamera camera;
+  RadialCamera camera;
 };
 
 Perturbed Perturb(const Scene& scene, double angle, double shift, double focal_factor) {

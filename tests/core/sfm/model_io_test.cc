@@ -43,6 +43,14 @@ std::vector<std::string> DataLines(const std::string& text) {
   return lines;
 }
 
+SfmCamera Camera(int width, int height, const RadialCamera& model) {
+  SfmCamera camera;
+  static_cast<RadialCamera&>(camera) = model;
+  camera.width = width;
+  camera.height = height;
+  return camera;
+}
+
 // Four images of 40 points, keypoints at the exact projections, plus one keypoint without a
 // point per image. Image 2 is unregistered; point 5 is deleted; point 7 is seen only by image 2.
 // The second camera has non-square pixels unless `second_aspect` says otherwise.
@@ -50,8 +58,8 @@ Reconstruction SyntheticScene(double second_aspect = 1.0017) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   Reconstruction reconstruction;
-  reconstruction.cameras.push_back({640, 480, 500.25, 319.5, 239.5, -0.05, 0.01});
-  reconstruction.cameras.push_back({800, 600, 610.125, 399.5, 299.5, 0.02, -0.003, second_aspect});
+  reconstruction.cameras.push_back(Camera(640, 480, {500.25, 319.5, 239.5, -0.05, 0.01}));
+  reconstruction.cameras.push_back(Camera(800, 600, {610.125, 399.5, 299.5, 0.02, -0.003, second_aspect}));
   for (int p = 0; p < 40; ++p) {
     SfmPoint point;
     point.position = Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
@@ -176,7 +184,7 @@ TEST(ModelIoTest, ColmapWritesOnlyRegisteredImagesAndExportedPoints) {
 
 TEST(ModelIoTest, ColmapHeadersAndPixelConvention) {
   Reconstruction model;
-  model.cameras.push_back({640, 480, 500.0, 319.5, 239.5, 0.0, 0.0});
+  model.cameras.push_back(Camera(640, 480, {500.0, 319.5, 239.5}));
   SfmImage image;
   image.name = "a.png";
   image.camera_id = 0;
