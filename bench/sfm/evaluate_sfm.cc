@@ -118,7 +118,7 @@ int Run(int argc, char** argv) {
     for (const TrackElement& element : point.track) {
       const SfmImage& image = model->images[element.image_id];
       const SfmCamera& camera = model->cameras[image.camera_id];
-      const Eigen::Vector2d projected = camera.Project(image.pose.CamFromWorld(point.position));
+      const Eigen::Vector2d projected = camera.Project(image.cam_from_world * point.position);
       reprojection_sum += (projected - image.keypoints[element.keypoint_id]).norm();
       ++num_observations;
     }
@@ -136,7 +136,7 @@ int Run(int argc, char** argv) {
     if (gt != ground_truth.end()) {
       const GroundTruthCamera& camera = gt->second;
       result.gt_focal = 0.5 * (camera.K(0, 0) + camera.K(1, 1));
-      estimated.push_back({image.pose.cam_from_world_rotation, image.pose.Center()});
+      estimated.push_back({image.cam_from_world.rotation, image.Center()});
       expected.push_back(testing::PoseOf(camera));
       matched.push_back(images.size());
     }

@@ -31,6 +31,11 @@ struct Rigid3 {
   }
 };
 
+// The projection centre of a camera in world coordinates, -R^T t (world_from_cam's translation).
+inline Eigen::Vector3d CameraCenterInWorld(const Rigid3& cam_from_world) {
+  return -cam_from_world.rotation.transpose() * cam_from_world.translation;
+}
+
 // cam_from_world of a camera at `center` looking at `target` (+z), its image y axis pointing down
 // along -up (x = z cross up; any x orthogonal to z when up is parallel to the view).
 inline Rigid3 CamFromWorldLookingAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target,

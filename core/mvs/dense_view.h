@@ -20,24 +20,24 @@ struct DenseView {
   Image<uint8_t> gray;          // width x height x 1, same pixels as rgb
   double fx = 0.0, fy = 0.0;    // pixels, at this level
   double cx = 0.0, cy = 0.0;
-  SfmPose pose;                 // cam_from_world
+  Rigid3 cam_from_world;
 
   int width() const { return gray.width(); }
   int height() const { return gray.height(); }
-  Eigen::Vector3d Center() const { return pose.Center(); }
+  Eigen::Vector3d Center() const { return CameraCenterInWorld(cam_from_world); }
   // The viewing ray direction of the optical axis in world coordinates.
-  Eigen::Vector3d OpticalAxis() const { return pose.cam_from_world_rotation.row(2).transpose(); }
+  Eigen::Vector3d OpticalAxis() const { return cam_from_world.rotation.row(2).transpose(); }
   Eigen::Vector2d Project(const Eigen::Vector3d& world_point) const {
-    const Eigen::Vector3d cam = pose.CamFromWorld(world_point);
+    const Eigen::Vector3d cam = cam_from_world * world_point;
     return Eigen::Vector2d(fx * cam.x() / cam.z() + cx, fy * cam.y() / cam.z() + cy);
   }
-  double Depth(const Eigen::Vector3d& world_point) const { return pose.CamFromWorld(world_point).z(); }
+  double Depth(const Eigen::Vector3d& world_point) const { return (cam_from_world * world_point).z(); }
   // 3x4 projection matrix K [R | t].
   Eigen::Matrix<double, 3, 4> ProjectionMatrix() const {
     Eigen::Matrix3d k;
     k << fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0;
     Eigen::Matrix<double, 3, 4> rt;
-    rt << pose.cam_from_world_rotation, pose.cam_from_world_translation;
+    rt << cam_from_world.rotation, cam_from_world.translation;
     return k * rt;
   }
 };

@@ -45,7 +45,7 @@ Image<uint8_t> AreaAverageDown(const Image<uint8_t>& image, int level) {
   return out;
 }
 
-Result<DenseView> UndistortView(const Image<uint8_t>& rgb, const SfmCamera& camera, const SfmPose& pose, int level) {
+Result<DenseView> UndistortView(const Image<uint8_t>& rgb, const SfmCamera& camera, const Rigid3& pose, int level) {
   if (level < 0 || level > kMaxDenseLevel) {
     return InvalidArgument("undistort: level must be 0.." + std::to_string(kMaxDenseLevel) + ", got " +
                            std::to_string(level));
@@ -66,7 +66,7 @@ Result<DenseView> UndistortView(const Image<uint8_t>& rgb, const SfmCamera& came
 
   DenseView view;
   view.level = level;
-  view.pose = pose;
+  view.cam_from_world = pose;
   view.fx = scaled.focal;
   view.fy = scaled.aspect * scaled.focal;
   view.cx = scaled.cx;

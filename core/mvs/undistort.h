@@ -28,6 +28,6 @@ Image<uint8_t> AreaAverageDown(const Image<uint8_t>& image, int level);
 // `rgb` is the decoded photo (3 channels, camera.width x camera.height). The result has name ""
 // and image_id -1 for the caller to fill. InvalidArgument when the sizes disagree, the image is
 // not RGB, the level is outside 0..kMaxDenseLevel or the camera has no positive focal.
-Result<DenseView> UndistortView(const Image<uint8_t>& rgb, const SfmCamera& camera, const SfmPose& pose, int level);
+Result<DenseView> UndistortView(const Image<uint8_t>& rgb, const SfmCamera& camera, const Rigid3& pose, int level);
 
 }  // namespace reconar

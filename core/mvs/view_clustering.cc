@@ -106,9 +106,9 @@ ViewClustering ClusterByCameras(const Reconstruction& rec, const std::vector<int
   const int n = static_cast<int>(registered.size());
   std::vector<Eigen::Vector3d> centres, axes;
   for (int id : registered) {
-    const SfmPose& pose = rec.images[static_cast<size_t>(id)].pose;
-    centres.push_back(pose.Center());
-    axes.push_back(pose.cam_from_world_rotation.row(2).transpose());
+    const Rigid3& pose = rec.images[static_cast<size_t>(id)].cam_from_world;
+    centres.push_back(CameraCenterInWorld(pose));
+    axes.push_back(pose.rotation.row(2).transpose());
   }
   std::vector<double> nearest;
   for (int a = 0; a < n; ++a) {
@@ -225,7 +225,7 @@ Result<ViewClustering> ClusterViews(const Reconstruction& rec, const ViewCluster
       const int local = local_of[static_cast<size_t>(element.image_id)];
       if (local < 0) continue;
       const SfmImage& image = rec.images[static_cast<size_t>(element.image_id)];
-      const double depth = image.pose.CamFromWorld(point.position).z();
+      const double depth = (image.cam_from_world * point.position).z();
       if (!(depth > 0.0)) continue;
       seen.emplace_back(local, rec.cameras[static_cast<size_t>(image.camera_id)].focal / depth);
     }

@@ -75,7 +75,7 @@ Status LoadClusterViews(const std::vector<int>& cluster, const Reconstruction& m
     if (!decoded.ok()) {
       errors[k] = decoded.status();
     } else {
-      auto view = UndistortView(decoded->rgb, model.cameras[static_cast<size_t>(image.camera_id)], image.pose, level);
+      auto view = UndistortView(decoded->rgb, model.cameras[static_cast<size_t>(image.camera_id)], image.cam_from_world, level);
       if (!view.ok()) {
         errors[k] = view.status().WithContext(path);
       } else {

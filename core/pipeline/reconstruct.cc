@@ -200,7 +200,7 @@ Eigen::Vector3d UpFromCameras(const Project& project) {
   Eigen::Vector3d up = Eigen::Vector3d::Zero();
   if (auto model = ReadColmapTextModel(project.SparseDir()); model.ok()) {
     for (const SfmImage& image : model->images) {
-      if (image.registered) up -= image.pose.cam_from_world_rotation.row(1).transpose();
+      if (image.registered) up -= image.cam_from_world.rotation.row(1).transpose();
     }
   }
   return up.norm() > 1e-9 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d(-Eigen::Vector3d::UnitY());

@@ -211,9 +211,9 @@ class Mapper {
 
     SfmImage& ia = rec_.images[static_cast<size_t>(a)];
     SfmImage& ib = rec_.images[static_cast<size_t>(b)];
-    ia.pose = SfmPose();
-    ib.pose.cam_from_world_rotation = pose->R;
-    ib.pose.cam_from_world_translation = pose->t;
+    ia.cam_from_world = Rigid3();
+    ib.cam_from_world.rotation = pose->R;
+    ib.cam_from_world.translation = pose->t;
     ia.registered = ib.registered = true;
     TriangulateImage(b);
     std::string reason = CheckInitialModel(pair_name);
@@ -379,8 +379,8 @@ class Mapper {
       rec_.cameras[static_cast<size_t>(camera_id)] = camera;
       needs_global_adjustment_ = true;
     }
-    img.pose.cam_from_world_rotation = result->cam_from_world.rotation;
-    img.pose.cam_from_world_translation = result->cam_from_world.translation;
+    img.cam_from_world.rotation = result->cam_from_world.rotation;
+    img.cam_from_world.translation = result->cam_from_world.translation;
     img.registered = true;
     for (int index : result->inliers) {
       const int kp = keypoint_of[static_cast<size_t>(index)];
@@ -395,7 +395,7 @@ class Mapper {
 
   double SquaredError(const Eigen::Vector3d& position, int image, int kp) const {
     const SfmImage& img = rec_.images[static_cast<size_t>(image)];
-    const Eigen::Vector3d cam = img.pose.CamFromWorld(position);
+    const Eigen::Vector3d cam = img.cam_from_world * position;
     if (!(cam.z() > 0.0)) return std::numeric_limits<double>::infinity();
     const Eigen::Vector2d predicted = rec_.cameras[static_cast<size_t>(img.camera_id)].Project(cam);
     return (predicted - img.keypoints[static_cast<size_t>(kp)]).squaredNorm();
@@ -406,10 +406,10 @@ class Mapper {
     double best_cos = 1.0;
     for (size_t i = 0; i < n; ++i) {
       const Eigen::Vector3d ri =
-          (rec_.images[static_cast<size_t>(point.track[i].image_id)].pose.Center() - point.position).normalized();
+          (rec_.images[static_cast<size_t>(point.track[i].image_id)].Center() - point.position).normalized();
       for (size_t j = i + 1; j < n; ++j) {
         const Eigen::Vector3d rj =
-            (rec_.images[static_cast<size_t>(point.track[j].image_id)].pose.Center() - point.position).normalized();
+            (rec_.images[static_cast<size_t>(point.track[j].image_id)].Center() - point.position).normalized();
         best_cos = std::min(best_cos, ri.dot(rj));
       }
     }
@@ -441,7 +441,7 @@ class Mapper {
       const SfmCamera& cam = rec_.cameras[static_cast<size_t>(img.camera_id)];
       TriangulationView& view = observations[v];
       if (!cam.Undistort(img.keypoints[static_cast<size_t>(views[v].keypoint_id)], &view.normalised)) return false;
-      view.cam_from_world = Rigid3{img.pose.cam_from_world_rotation, img.pose.cam_from_world_translation};
+      view.cam_from_world = Rigid3{img.cam_from_world.rotation, img.cam_from_world.translation};
       view.focal = cam.focal;
     }
     return TriangulateMultiView(observations, position);
@@ -658,8 +658,8 @@ class Mapper {
     for (int image : image_of_slot) {
       const SfmImage& img = rec_.images[static_cast<size_t>(image)];
       const SfmCamera& cam = rec_.cameras[static_cast<size_t>(img.camera_id)];
-      const Eigen::Vector3d w = AngleAxisFromRotation(img.pose.cam_from_world_rotation);
-      const Eigen::Vector3d& t = img.pose.cam_from_world_translation;
+      const Eigen::Vector3d w = AngleAxisFromRotation(img.cam_from_world.rotation);
+      const Eigen::Vector3d& t = img.cam_from_world.translation;
       const double block[12] = {w.x(), w.y(), w.z(), t.x(), t.y(), t.z(), cam.focal, cam.k1, cam.k2, cam.cx, cam.cy, cam.aspect};
       problem.cameras.insert(problem.cameras.end(), block, block + 12);
     }
@@ -705,8 +705,8 @@ class Mapper {
       SfmImage& img = rec_.images[static_cast<size_t>(image_of_slot[slot])];
       SfmCamera& cam = rec_.cameras[static_cast<size_t>(img.camera_id)];
       const double* block = problem.camera(static_cast<int>(slot));
-      img.pose.cam_from_world_rotation = RotationFromAngleAxis(Eigen::Vector3d(block[0], block[1], block[2]));
-      img.pose.cam_from_world_translation = Eigen::Vector3d(block[3], block[4], block[5]);
+      img.cam_from_world.rotation = RotationFromAngleAxis(Eigen::Vector3d(block[0], block[1], block[2]));
+      img.cam_from_world.translation = Eigen::Vector3d(block[3], block[4], block[5]);
       cam.focal = block[6];
       cam.k1 = block[7];
       cam.k2 = block[8];
@@ -733,18 +733,18 @@ class Mapper {
 
   struct Snapshot {
     std::vector<SfmCamera> cameras;
-    std::vector<SfmPose> poses;
+    std::vector<Rigid3> poses;
     std::vector<Eigen::Vector3d> points;
   };
   Snapshot Save() const {
     Snapshot snapshot{rec_.cameras, {}, {}};
-    for (const SfmImage& image : rec_.images) snapshot.poses.push_back(image.pose);
+    for (const SfmImage& image : rec_.images) snapshot.poses.push_back(image.cam_from_world);
     for (const SfmPoint& point : rec_.points) snapshot.points.push_back(point.position);
     return snapshot;
   }
   void Restore(const Snapshot& snapshot) {
     rec_.cameras = snapshot.cameras;
-    for (size_t i = 0; i < rec_.images.size(); ++i) rec_.images[i].pose = snapshot.poses[i];
+    for (size_t i = 0; i < rec_.images.size(); ++i) rec_.images[i].cam_from_world = snapshot.poses[i];
     for (size_t p = 0; p < rec_.points.size(); ++p) rec_.points[p].position = snapshot.points[p];
   }
 

@@ -238,10 +238,10 @@ Status WriteColmapImages(const Reconstruction& reconstruction, const std::string
     for (size_t i = 0; i < reconstruction.images.size(); ++i) {
       const SfmImage& image = reconstruction.images[i];
       if (!image.registered) continue;
-      Eigen::Quaterniond q(image.pose.cam_from_world_rotation);
+      Eigen::Quaterniond q(image.cam_from_world.rotation);
       q.normalize();
       if (q.w() < 0) q.coeffs() = -q.coeffs();
-      const Eigen::Vector3d& t = image.pose.cam_from_world_translation;
+      const Eigen::Vector3d& t = image.cam_from_world.translation;
       line = std::to_string(i + 1);
       AppendNumbers(&line, {q.w(), q.x(), q.y(), q.z(), t.x(), t.y(), t.z()});
       line += " " + std::to_string(image.camera_id + 1) + " " + image.name + "\n";
@@ -387,9 +387,9 @@ Result<std::vector<WithId<ColmapImage>>> ReadColmapImages(const std::string& pat
     for (int i = 0; i < 4; ++i) RECONAR_RETURN_IF_ERROR(in.Read(1 + i, "quaternion", &q[i]));
     const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
     if (!(rotation.norm() > 1e-6)) return in.Error("quaternion of zero length");
-    image.pose.cam_from_world_rotation = rotation.normalized().toRotationMatrix();
+    image.cam_from_world.rotation = rotation.normalized().toRotationMatrix();
     for (int i = 0; i < 3; ++i) {
-      RECONAR_RETURN_IF_ERROR(in.Read(5 + i, "translation", &image.pose.cam_from_world_translation[i]));
+      RECONAR_RETURN_IF_ERROR(in.Read(5 + i, "translation", &image.cam_from_world.translation[i]));
     }
     RECONAR_RETURN_IF_ERROR(in.ReadId(8, "CAMERA_ID", &entry.value.camera_id));
     image.name = std::string(in.field(9));
@@ -582,8 +582,8 @@ Status WriteBundlerModel(const Reconstruction& reconstruction, const std::string
         continue;
       }
       const SfmCamera& camera = reconstruction.cameras[image.camera_id];
-      const Eigen::Matrix3d R = flip * image.pose.cam_from_world_rotation;
-      const Eigen::Vector3d t = flip * image.pose.cam_from_world_translation;
+      const Eigen::Matrix3d R = flip * image.cam_from_world.rotation;
+      const Eigen::Vector3d t = flip * image.cam_from_world.translation;
       text.clear();
       AppendNumbers(&text, {camera.focal, camera.k1, camera.k2});
       for (int r = 0; r < 3; ++r) {

@@ -17,6 +17,7 @@
 
 #include "core/math/camera_intrinsics.h"
 #include "core/math/radial_camera.h"
+#include "core/math/rigid3.h"
 
 namespace reconar {
 
@@ -41,24 +42,14 @@ struct SfmCamera : RadialCamera {
   }
 };
 
-struct SfmPose {
-  Eigen::Matrix3d cam_from_world_rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
-
-  Eigen::Vector3d CamFromWorld(const Eigen::Vector3d& world_point) const {
-    return cam_from_world_rotation * world_point + cam_from_world_translation;
-  }
-  // The projection centre in world coordinates: -R^T t.
-  Eigen::Vector3d Center() const {
-    return -cam_from_world_rotation.transpose() * cam_from_world_translation;
-  }
-};
-
 struct SfmImage {
   std::string name;    // file name, unique within the project (images.txt of the feature stage)
   int camera_id = -1;  // index into Reconstruction::cameras
   bool registered = false;
-  SfmPose pose;        // meaningful when registered
+  Rigid3 cam_from_world;  // meaningful when registered
+
+  // The projection centre in world coordinates.
+  Eigen::Vector3d Center() const { return CameraCenterInWorld(cam_from_world); }
   std::vector<Eigen::Vector2d> keypoints;  // pixels
   std::vector<int> point3d_ids;            // per keypoint: index into Reconstruction::points, or -1
 };

@@ -20,7 +20,7 @@ using Observation = std::pair<int, Eigen::Vector2d>;  // (image id, pixel)
 
 double ReprojectionError(const Reconstruction& rec, const Observation& obs, const Eigen::Vector3d& point) {
   const SfmImage& image = rec.images[static_cast<size_t>(obs.first)];
-  const Eigen::Vector3d cam = image.pose.CamFromWorld(point);
+  const Eigen::Vector3d cam = image.cam_from_world * point;
   if (!(cam.z() > 0.0)) return std::numeric_limits<double>::infinity();
   return (rec.cameras[static_cast<size_t>(image.camera_id)].Project(cam) - obs.second).norm();
 }
@@ -33,7 +33,7 @@ std::optional<Eigen::Vector3d> TriangulateViews(const Reconstruction& rec, const
     const SfmCamera& camera = rec.cameras[static_cast<size_t>(image.camera_id)];
     TriangulationView& view = observations[v];
     if (!camera.Undistort(views[v].second, &view.normalised)) return std::nullopt;
-    view.cam_from_world = Rigid3{image.pose.cam_from_world_rotation, image.pose.cam_from_world_translation};
+    view.cam_from_world = Rigid3{image.cam_from_world.rotation, image.cam_from_world.translation};
     view.focal = camera.focal;
   }
   Eigen::Vector3d point;
@@ -91,10 +91,10 @@ void ApplyToModel(const Sim3& world_from_model, Reconstruction* rec) {
   for (SfmImage& image : rec->images) {
     if (!image.registered) continue;
     // X_cam' = s X_cam = s R_c X_model + s t_c with X_model = R^T (X_world - t) / s.
-    SfmPose& pose = image.pose;
-    pose.cam_from_world_rotation = pose.cam_from_world_rotation * model_from_world_rotation;
-    pose.cam_from_world_translation = world_from_model.scale * pose.cam_from_world_translation -
-                                      pose.cam_from_world_rotation * world_from_model.translation;
+    Rigid3& pose = image.cam_from_world;
+    pose.rotation = pose.rotation * model_from_world_rotation;
+    pose.translation = world_from_model.scale * pose.translation -
+                                      pose.rotation * world_from_model.translation;
   }
 }
 

@@ -98,19 +98,19 @@ void ToGl(const Eigen::Matrix4d& m, float out[16]) {
   std::copy(f.data(), f.data() + 16, out);  // column major, as GL wants
 }
 
-Eigen::Matrix4d CamFromWorld(const SfmPose& pose) {
+Eigen::Matrix4d CamFromWorld(const Rigid3& pose) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.topLeftCorner<3, 3>() = pose.cam_from_world_rotation;
-  m.topRightCorner<3, 1>() = pose.cam_from_world_translation;
+  m.topLeftCorner<3, 3>() = pose.rotation;
+  m.topRightCorner<3, 1>() = pose.translation;
   return m;
 }
 
 // A camera at `center` looking at `target`, image y pointing down the world's -y (world y is up).
-SfmPose LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target) {
+Rigid3 LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target) {
   const Rigid3 cam_from_world = CamFromWorldLookingAt(center, target, Eigen::Vector3d::UnitY());
-  SfmPose pose;
-  pose.cam_from_world_rotation = cam_from_world.rotation;
-  pose.cam_from_world_translation = cam_from_world.translation;
+  Rigid3 pose;
+  pose.rotation = cam_from_world.rotation;
+  pose.translation = cam_from_world.translation;
   return pose;
 }
 
@@ -170,7 +170,7 @@ Reconstruction MakeBunnyCameras(const Mesh& bunny, const BunnySceneOptions& opti
       image.name = ViewName(static_cast<int>(model.images.size()));
       image.camera_id = 0;
       image.registered = true;
-      image.pose = LookAt(target + options.distance_m * direction, target);
+      image.cam_from_world = LookAt(target + options.distance_m * direction, target);
       model.images.push_back(std::move(image));
     }
   }
@@ -194,7 +194,7 @@ struct BunnyRenderer::Gl {
   OffscreenTarget depth_target;  // width x height
   Image<uint8_t> readback;
 
-  Status Draw(const SfmCamera& camera, const SfmPose& pose, OffscreenTarget* target, int mode_value) {
+  Status Draw(const SfmCamera& camera, const Rigid3& pose, OffscreenTarget* target, int mode_value) {
     const CameraIntrinsics intrinsics = IntrinsicsForTarget(camera.Intrinsics(), target->width(), target->height());
     DepthRange depth;
     depth.near_m = 0.02;
@@ -277,7 +277,7 @@ Result<std::unique_ptr<BunnyRenderer>> BunnyRenderer::Create(const Mesh& bunny, 
   return std::unique_ptr<BunnyRenderer>(new BunnyRenderer(std::move(gl)));
 }
 
-Status BunnyRenderer::RenderColor(const SfmCamera& camera, const SfmPose& pose, Image<uint8_t>* rgb) {
+Status BunnyRenderer::RenderColor(const SfmCamera& camera, const Rigid3& pose, Image<uint8_t>* rgb) {
   RECONAR_RETURN_IF_ERROR(gl_->Draw(camera, pose, &gl_->color_target, 0));
   const int s = gl_->options.supersampling;
   const int width = gl_->options.width;
@@ -301,7 +301,7 @@ Status BunnyRenderer::RenderColor(const SfmCamera& camera, const SfmPose& pose, 
   return Status::Ok();
 }
 
-Status BunnyRenderer::RenderDepth(const SfmCamera& camera, const SfmPose& pose, Image<float>* depth) {
+Status BunnyRenderer::RenderDepth(const SfmCamera& camera, const Rigid3& pose, Image<float>* depth) {
   RECONAR_RETURN_IF_ERROR(gl_->Draw(camera, pose, &gl_->depth_target, 1));
   const int width = gl_->options.width;
   const int height = gl_->options.height;
@@ -319,7 +319,7 @@ Status BunnyRenderer::RenderDepth(const SfmCamera& camera, const SfmPose& pose, 
   return Status::Ok();
 }
 
-Status BunnyRenderer::RenderCoverage(const SfmCamera& camera, const SfmPose& pose, Image<float>* coverage) {
+Status BunnyRenderer::RenderCoverage(const SfmCamera& camera, const Rigid3& pose, Image<float>* coverage) {
   RECONAR_RETURN_IF_ERROR(gl_->Draw(camera, pose, &gl_->color_target, 1));
   const int s = gl_->options.supersampling;
   const int width = gl_->options.width;
@@ -366,7 +366,7 @@ Result<BunnySceneReport> WriteBunnyProject(const Mesh& bunny, const BunnyProject
   Image<uint8_t> rgb;
   Image<float> depth;
   for (const SfmImage& image : model.images) {
-    RECONAR_RETURN_IF_ERROR(renderer->RenderColor(camera, image.pose, &rgb));
+    RECONAR_RETURN_IF_ERROR(renderer->RenderColor(camera, image.cam_from_world, &rgb));
     const std::string path = images_dir + "/" + image.name;
     RECONAR_RETURN_IF_ERROR(WritePng(path, rgb.view(), 3));
     ProjectImage entry;
@@ -378,17 +378,17 @@ Result<BunnySceneReport> WriteBunnyProject(const Mesh& bunny, const BunnyProject
     entry.focal_source = "ground-truth";
     list.push_back(entry);
 
-    RECONAR_RETURN_IF_ERROR(renderer->RenderDepth(camera, image.pose, &depth));
+    RECONAR_RETURN_IF_ERROR(renderer->RenderDepth(camera, image.cam_from_world, &depth));
     int64_t foreground = 0;
     for (int y = 0; y < depth.height(); ++y) {
       for (int x = 0; x < depth.width(); ++x) foreground += depth.row(y)[x] > 0.0f ? 1 : 0;
     }
     report.mean_foreground_fraction += static_cast<double>(foreground) / (depth.width() * depth.height());
 
-    const Eigen::Vector3d center = image.pose.Center();
+    const Eigen::Vector3d center = image.Center();
     for (size_t i = 0; i < mesh.positions.size(); ++i) {
       const Eigen::Vector3d world = mesh.positions[i].cast<double>();
-      const Eigen::Vector3d cam = image.pose.CamFromWorld(world);
+      const Eigen::Vector3d cam = image.cam_from_world * world;
       if (cam.z() <= 0.0) continue;
       const Eigen::Vector2d pixel = camera.Project(cam);
       const int x = static_cast<int>(std::lround(pixel.x()));

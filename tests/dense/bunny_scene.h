@@ -7,7 +7,7 @@
 // Conventions: pixel (0, 0) is the centre of the top-left pixel, x right, y down; poses are
 // cam_from_world with the camera looking down +z (core/sfm/reconstruction.h). The renderer's clip
 // transform (render/camera_projection.h) follows the same pixel convention, so a bunny vertex X
-// lands where SfmCamera::Project(pose.CamFromWorld(X)) says.
+// lands where SfmCamera::Project(pose * X) says.
 //
 // Appearance (view independent, so the scene is Lambertian, as PMVS assumes): the albedo is
 // multi-octave 3D value noise of the model-space position, squashed to high contrast, finest cell
@@ -60,12 +60,12 @@ class BunnyRenderer {
   ~BunnyRenderer();
 
   // The textured, shaded image, RGB, width x height of the options.
-  Status RenderColor(const SfmCamera& camera, const SfmPose& pose, Image<uint8_t>* rgb);
+  Status RenderColor(const SfmCamera& camera, const Rigid3& pose, Image<uint8_t>* rgb);
   // Camera-frame depth z of the surface seen through each pixel centre (one sample per pixel), in
   // metres, 0 where the pixel sees the background. Exact to 0.1 um (24-bit fixed point to 2 m).
-  Status RenderDepth(const SfmCamera& camera, const SfmPose& pose, Image<float>* depth);
+  Status RenderDepth(const SfmCamera& camera, const Rigid3& pose, Image<float>* depth);
   // Share of each pixel's supersampling^2 samples (those RenderColor averages) that see the bunny.
-  Status RenderCoverage(const SfmCamera& camera, const SfmPose& pose, Image<float>* coverage);
+  Status RenderCoverage(const SfmCamera& camera, const Rigid3& pose, Image<float>* coverage);
 
  private:
   struct Gl;

@@ -54,12 +54,12 @@ TEST_F(BunnySceneTest, CamerasLookAtTheBunnyFromTwoRings) {
   ASSERT_EQ(model.images.size(), 40u);
   const Eigen::Vector3d target = BoundingBoxCenter(*bunny_);
   for (const SfmImage& image : model.images) {
-    EXPECT_NEAR((image.pose.Center() - target).norm(), options.distance_m, 1e-12);
-    const Eigen::Vector2d pixel = model.cameras[0].Project(image.pose.CamFromWorld(target));
+    EXPECT_NEAR((image.Center() - target).norm(), options.distance_m, 1e-12);
+    const Eigen::Vector2d pixel = model.cameras[0].Project(image.cam_from_world * target);
     EXPECT_NEAR(pixel.x(), 319.5, 1e-9);
     EXPECT_NEAR(pixel.y(), 239.5, 1e-9);
     // Image "up" (-y of the camera) points to the world's +y: the bunny stands upright.
-    EXPECT_LT(image.pose.cam_from_world_rotation.row(1).dot(Eigen::Vector3d::UnitY()), -0.5);
+    EXPECT_LT(image.cam_from_world.rotation.row(1).dot(Eigen::Vector3d::UnitY()), -0.5);
   }
 }
 
@@ -100,7 +100,7 @@ TEST_F(BunnySceneTest, SilhouetteIsBoundedByProjectedVerticesAtPixelCentres) {
   for (size_t i = 0; i < model->images.size(); ++i) {
     const SfmImage& image = model->images[i];
     EXPECT_EQ(image.name, (*list)[i].name);
-    ASSERT_TRUE((*renderer)->RenderDepth(camera, image.pose, &depth).ok());
+    ASSERT_TRUE((*renderer)->RenderDepth(camera, image.cam_from_world, &depth).ok());
     int c_min = depth.width(), c_max = -1, r_min = depth.height(), r_max = -1;
     for (int y = 0; y < depth.height(); ++y) {
       for (int x = 0; x < depth.width(); ++x) {
@@ -113,7 +113,7 @@ TEST_F(BunnySceneTest, SilhouetteIsBoundedByProjectedVerticesAtPixelCentres) {
     }
     double u_min = INFINITY, u_max = -INFINITY, v_min = INFINITY, v_max = -INFINITY;
     for (const Eigen::Vector3f& p : bunny_->positions) {
-      const Eigen::Vector2d pixel = camera.Project(image.pose.CamFromWorld(p.cast<double>()));
+      const Eigen::Vector2d pixel = camera.Project(image.cam_from_world * (p.cast<double>()));
       u_min = std::min(u_min, pixel.x());
       u_max = std::max(u_max, pixel.x());
       v_min = std::min(v_min, pixel.y());
@@ -151,7 +151,7 @@ TEST_F(BunnySceneTest, SupersampledColourSitsOnTheDepthSilhouette) {
   Image<float> depth;
   Image<float> coverage;
   for (int index : {0, 7, 23, 31}) {
-    const SfmPose& pose = model.images[index].pose;
+    const Rigid3& pose = model.images[index].cam_from_world;
     ASSERT_TRUE((*renderer)->RenderColor(model.cameras[0], pose, &rgb).ok());
     ASSERT_TRUE((*renderer)->RenderDepth(model.cameras[0], pose, &depth).ok());
     ASSERT_TRUE((*renderer)->RenderCoverage(model.cameras[0], pose, &coverage).ok());

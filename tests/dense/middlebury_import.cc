@@ -52,8 +52,8 @@ Result<MiddleburyImportReport> ImportMiddleburyProject(const std::string& par_pa
     image.name = name;
     image.camera_id = camera_id;
     image.registered = true;
-    image.pose.cam_from_world_rotation = truth.cam_from_world_rotation;
-    image.pose.cam_from_world_translation = truth.cam_from_world_translation;
+    image.cam_from_world.rotation = truth.cam_from_world_rotation;
+    image.cam_from_world.translation = truth.cam_from_world_translation;
     model.images.push_back(image);
 
     ProjectImage entry;

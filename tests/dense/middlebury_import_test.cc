@@ -76,7 +76,7 @@ TEST(MiddleburyImportTest, CamerasRoundTripThroughTheColmapReader) {
     const Eigen::Vector3d& t = i == 0 ? t0 : t1;
     const Eigen::Vector3d h = k * (r * world + t);
     const Eigen::Vector2d expected = h.head<2>() / h.z();
-    const Eigen::Vector2d got = camera.Project(model->images[i].pose.CamFromWorld(world));
+    const Eigen::Vector2d got = camera.Project(model->images[i].cam_from_world * world);
     EXPECT_LT((got - expected).norm(), 1e-6) << i;
   }
   EXPECT_EQ(model->images[0].name, "a.png");

@@ -41,14 +41,14 @@ TEST(TempleRingImportTest, BoundingBoxProjectsIntoEveryView) {
 
   const Box3 box = TempleRingBoundingBox();
   for (const SfmImage& image : model->images) {
-    const Eigen::Vector2d center = camera.Project(image.pose.CamFromWorld(0.5 * (box.min + box.max)));
+    const Eigen::Vector2d center = camera.Project(image.cam_from_world * (0.5 * (box.min + box.max)));
     EXPECT_NEAR(center.x(), 320.0, 80.0) << image.name;
     EXPECT_NEAR(center.y(), 240.0, 80.0) << image.name;
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY), hi = -lo;
     for (int corner = 0; corner < 8; ++corner) {
       const Eigen::Vector3d world((corner & 1) ? box.max.x() : box.min.x(), (corner & 2) ? box.max.y() : box.min.y(),
                                   (corner & 4) ? box.max.z() : box.min.z());
-      const Eigen::Vector3d cam = image.pose.CamFromWorld(world);
+      const Eigen::Vector3d cam = image.cam_from_world * world;
       ASSERT_GT(cam.z(), 0.3) << image.name;
       const Eigen::Vector2d pixel = camera.Project(cam);
       lo = lo.cwiseMin(pixel);

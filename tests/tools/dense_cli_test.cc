@@ -114,7 +114,7 @@ TEST(DenseCli, TempleThroughSfmLiesInTheObjectBox) {
   std::vector<Eigen::Vector3d> from, to;
   for (const SfmImage& image : model->images) {
     if (!image.registered || truth->count(image.name) == 0) continue;
-    from.push_back(image.pose.Center());
+    from.push_back(image.Center());
     to.push_back(truth->at(image.name).Centre());
   }
   // Our SfM registers only 3 of these 16 wide-baseline views today (the dense stage then runs on

@@ -148,8 +148,8 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
     for (int e = 0; e < 9; ++e)
       cam_from_world.rotation(e / 3, e % 3) = (*pose->Find("R"))[static_cast<size_t>(e)].number();
     for (int e = 0; e < 3; ++e) cam_from_world.translation[e] = (*pose->Find("t"))[static_cast<size_t>(e)].number();
-    const double distance = (cam_from_world.Inverse().translation - image->pose.Center()).norm();
-    const double degrees = RotationAngle(cam_from_world.rotation, image->pose.cam_from_world_rotation) * 180.0 / M_PI;
+    const double distance = (cam_from_world.Inverse().translation - image->Center()).norm();
+    const double degrees = RotationAngle(cam_from_world.rotation, image->cam_from_world.rotation) * 180.0 / M_PI;
     std::printf("%s from %d tags: camera %.3f m and %.2f deg from the SfM camera\n", name.c_str(),
                 static_cast<int>(*frame->Find("layout_tags")->AsInteger()), distance, degrees);
     // A few centimetres at 1-4 m: what the single photo's tag corners (0.1-0.2 px) can fix.

@@ -57,7 +57,7 @@ Score RunAndScore(const std::string& dataset, const fs::path& project) {
       ADD_FAILURE() << image.name << " has no ground truth";
       continue;
     }
-    estimated.push_back({image.pose.cam_from_world_rotation, image.pose.Center()});
+    estimated.push_back({image.cam_from_world.rotation, image.Center()});
     reference.push_back(testing::PoseOf(gt->second));
     const SfmCamera& camera = model->cameras[static_cast<size_t>(image.camera_id)];
     score.focals_x.push_back(camera.focal);

@@ -38,7 +38,7 @@ Status CheckViews(const std::vector<const DenseView*>& views, int min_views) {
       return InvalidArgument(name + ": the rgb image does not match the grey one");
     }
     if (!(v->fx > 0.0 && v->fy > 0.0) || !std::isfinite(v->cx) || !std::isfinite(v->cy) ||
-        !v->pose.cam_from_world_rotation.allFinite() || !v->pose.cam_from_world_translation.allFinite()) {
+        !v->cam_from_world.rotation.allFinite() || !v->cam_from_world.translation.allFinite()) {
       return InvalidArgument(name + ": invalid intrinsics or pose");
     }
   }

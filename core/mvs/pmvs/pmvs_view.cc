@@ -8,7 +8,7 @@ PmvsView::PmvsView(const DenseView& view)
       height(view.gray.height()),
       gray(view.gray.data(), view.gray.data() + static_cast<size_t>(view.gray.width()) * view.gray.height()),
       projection(view.ProjectionMatrix()),
-      world_from_cam_rotation(view.pose.cam_from_world_rotation.transpose()),
+      world_from_cam_rotation(view.cam_from_world.rotation.transpose()),
       center(view.Center()),
       optical_axis(view.OpticalAxis().normalized()),
       fx(view.fx),

@@ -43,8 +43,8 @@ TEST(MergePoints, PixelFootprintIsDepthOverFocalInTheClosestView) {
     view->fx = view->fy = 200.0;
     view->cx = view->cy = 49.5;
   }
-  near.pose.cam_from_world_translation = Eigen::Vector3d(0, 0, 2);
-  far.pose.cam_from_world_translation = Eigen::Vector3d(0, 0, 8);
+  near.cam_from_world.translation = Eigen::Vector3d(0, 0, 2);
+  far.cam_from_world.translation = Eigen::Vector3d(0, 0, 8);
   EXPECT_FLOAT_EQ(PixelFootprint({&far, &near}, Eigen::Vector3f::Zero()), 2.0f / 200.0f);
   EXPECT_EQ(PixelFootprint({&far, &near}, Eigen::Vector3f(0, 0, -10)), 0.0f);  // behind both
 }

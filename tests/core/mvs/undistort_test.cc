@@ -23,11 +23,11 @@ SfmCamera DistortedCamera() {
   return camera;
 }
 
-SfmPose SomePose() {
-  SfmPose pose;
-  pose.cam_from_world_rotation =
+Rigid3 SomePose() {
+  Rigid3 pose;
+  pose.rotation =
       Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1.0, -0.1).normalized()).toRotationMatrix();
-  pose.cam_from_world_translation = Eigen::Vector3d(0.1, -0.2, 4.0);
+  pose.translation = Eigen::Vector3d(0.1, -0.2, 4.0);
   return pose;
 }
 
@@ -92,7 +92,7 @@ TEST(Undistort, AreaAverageDownIsTheBlockMean) {
 
 TEST(Undistort, PointsLandOnTheSameContent) {
   const SfmCamera camera = DistortedCamera();
-  const SfmPose pose = SomePose();
+  const Rigid3 pose = SomePose();
   const Image<uint8_t> photo = PatternImage(camera.width, camera.height);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -106,8 +106,8 @@ TEST(Undistort, PointsLandOnTheSameContent) {
     while (n < 300) {
       // A world point whose distorted projection lies well inside the photo.
       const Eigen::Vector3d cam(1.2 * uniform(random), 0.9 * uniform(random), 4.0 + uniform(random));
-      const Eigen::Vector3d world = pose.cam_from_world_rotation.transpose() * (cam - pose.cam_from_world_translation);
-      const Eigen::Vector2d distorted = camera.Project(pose.CamFromWorld(world));
+      const Eigen::Vector3d world = pose.rotation.transpose() * (cam - pose.translation);
+      const Eigen::Vector2d distorted = camera.Project(pose * world);
       if (distorted.x() < 8 || distorted.y() < 8 || distorted.x() > 631 || distorted.y() > 471) continue;
       const Eigen::Vector2d undistorted = view->Project(world);
       ASSERT_GT(undistorted.x(), 0.0);
@@ -157,7 +157,7 @@ TEST(Undistort, CheckerboardRoundTrip) {
       for (int c = 0; c < 3; ++c) photo.row(v)[3 * u + c] = value;
     }
   }
-  auto view = UndistortView(photo, camera, SfmPose(), 0);
+  auto view = UndistortView(photo, camera, Rigid3(), 0);
   ASSERT_TRUE(view.ok()) << view.status().ToString();
   int compared = 0, wrong = 0;
   for (int v = 0; v < view->height(); ++v) {
@@ -180,14 +180,14 @@ TEST(Undistort, CheckerboardRoundTrip) {
 TEST(Undistort, RejectsInconsistentInput) {
   const SfmCamera camera = DistortedCamera();
   const Image<uint8_t> photo(640, 480, 3);
-  EXPECT_EQ(UndistortView(Image<uint8_t>(320, 240, 3), camera, SfmPose(), 0).status().code(),
+  EXPECT_EQ(UndistortView(Image<uint8_t>(320, 240, 3), camera, Rigid3(), 0).status().code(),
             StatusCode::kInvalidArgument);
-  EXPECT_EQ(UndistortView(Image<uint8_t>(640, 480, 1), camera, SfmPose(), 0).status().code(),
+  EXPECT_EQ(UndistortView(Image<uint8_t>(640, 480, 1), camera, Rigid3(), 0).status().code(),
             StatusCode::kInvalidArgument);
-  EXPECT_EQ(UndistortView(photo, camera, SfmPose(), 3).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(UndistortView(photo, camera, Rigid3(), 3).status().code(), StatusCode::kInvalidArgument);
   SfmCamera no_focal = camera;
   no_focal.focal = 0.0;
-  EXPECT_EQ(UndistortView(photo, no_focal, SfmPose(), 0).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(UndistortView(photo, no_focal, Rigid3(), 0).status().code(), StatusCode::kInvalidArgument);
 }
 
 }  // namespace

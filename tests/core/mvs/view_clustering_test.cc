@@ -22,11 +22,11 @@ struct SceneOptions {
 };
 
 // Camera looking at `target` from `centre`, y down (world z up).
-SfmPose LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
+Rigid3 LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
   const Rigid3 cam_from_world = CamFromWorldLookingAt(centre, target, Eigen::Vector3d::UnitZ());
-  SfmPose pose;
-  pose.cam_from_world_rotation = cam_from_world.rotation;
-  pose.cam_from_world_translation = cam_from_world.translation;
+  Rigid3 pose;
+  pose.rotation = cam_from_world.rotation;
+  pose.translation = cam_from_world.translation;
   return pose;
 }
 
@@ -50,7 +50,7 @@ void AddScene(const SceneOptions& options, Reconstruction* rec) {
       image.camera_id = 0;
       image.registered = true;
       const Eigen::Vector3d centre = options.centre + radius * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.3);
-      image.pose = LookAt(centre, options.centre);
+      image.cam_from_world = LookAt(centre, options.centre);
       rec->images.push_back(image);
     }
   }
@@ -64,9 +64,9 @@ void AddScene(const SceneOptions& options, Reconstruction* rec) {
     point.position = options.centre + normal + Eigen::Vector3d(0, 0, height);
     for (size_t i = first_image; i < rec->images.size(); ++i) {
       SfmImage& image = rec->images[i];
-      const Eigen::Vector3d to_camera = (image.pose.Center() - point.position).normalized();
+      const Eigen::Vector3d to_camera = (image.Center() - point.position).normalized();
       if (to_camera.dot(normal) < std::cos(M_PI / 3)) continue;
-      const Eigen::Vector3d cam = image.pose.CamFromWorld(point.position);
+      const Eigen::Vector3d cam = image.cam_from_world * point.position;
       const Eigen::Vector2d pixel = camera.Project(cam);
       if (cam.z() <= 0 || pixel.x() < 0 || pixel.y() < 0 || pixel.x() > 639 || pixel.y() > 479) continue;
       point.track.push_back({static_cast<int>(i), static_cast<int>(image.keypoints.size())});

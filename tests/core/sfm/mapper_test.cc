@@ -57,7 +57,7 @@ SfmCamera TrueCamera() {
 
 struct Scene {
   SfmCamera camera;
-  std::vector<SfmPose> poses;
+  std::vector<Rigid3> poses;
   std::vector<Eigen::Vector3d> points;
   std::vector<MapperImage> images;
   std::vector<MapperPair> pairs;
@@ -92,14 +92,14 @@ Scene MakeScene(const SceneOptions& o) {
     const Eigen::Vector3d forward = (target - centre).normalized();
     const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
     const Eigen::Vector3d down = forward.cross(right);
-    SfmPose pose;
-    pose.cam_from_world_rotation.row(0) = right.transpose();
-    pose.cam_from_world_rotation.row(1) = down.transpose();
-    pose.cam_from_world_rotation.row(2) = forward.transpose();
+    Rigid3 pose;
+    pose.rotation.row(0) = right.transpose();
+    pose.rotation.row(1) = down.transpose();
+    pose.rotation.row(2) = forward.transpose();
     const double roll = o.max_roll_deg * M_PI / 180.0 * uniform(rng);
-    pose.cam_from_world_rotation = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                                   pose.cam_from_world_rotation;
-    pose.cam_from_world_translation = -pose.cam_from_world_rotation * centre;
+    pose.rotation = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                                   pose.rotation;
+    pose.translation = -pose.rotation * centre;
     scene.poses.push_back(pose);
   }
 
@@ -125,11 +125,11 @@ Scene MakeScene(const SceneOptions& o) {
     std::vector<int> seen;
     for (int p = 0; p < o.num_points; ++p) {
       const Eigen::Vector3d& X = scene.points[static_cast<size_t>(p)];
-      const SfmPose& pose = scene.poses[static_cast<size_t>(i)];
-      const Eigen::Vector3d to_camera = (pose.Center() - X).normalized();
+      const Rigid3& pose = scene.poses[static_cast<size_t>(i)];
+      const Eigen::Vector3d to_camera = (CameraCenterInWorld(pose) - X).normalized();
       const bool detected = unit(rng) < o.detection_rate;
       if (normals[static_cast<size_t>(p)].dot(to_camera) < cos_visible || !detected) continue;
-      const Eigen::Vector3d c = pose.CamFromWorld(X);
+      const Eigen::Vector3d c = pose * X;
       if (c.z() < 0.1) continue;
       const Eigen::Vector2d x = cam.Project(c);
       if (x.x() < 2.0 || x.y() < 2.0 || x.x() > cam.width - 3.0 || x.y() > cam.height - 3.0) continue;
@@ -137,7 +137,7 @@ Scene MakeScene(const SceneOptions& o) {
     }
     std::shuffle(seen.begin(), seen.end(), rng);
     for (int p : seen) {
-      const Eigen::Vector2d x = cam.Project(scene.poses[static_cast<size_t>(i)].CamFromWorld(scene.points[static_cast<size_t>(p)]));
+      const Eigen::Vector2d x = cam.Project(scene.poses[static_cast<size_t>(i)] * (scene.points[static_cast<size_t>(p)]));
       keypoint_of_point[static_cast<size_t>(i)][static_cast<size_t>(p)] = static_cast<int>(image.keypoints.size());
       image.keypoints.push_back(x + o.noise_px * Eigen::Vector2d(gauss(rng), gauss(rng)));
       scene.point_of_keypoint[static_cast<size_t>(i)].push_back(p);
@@ -311,8 +311,8 @@ void ExpectRingReconstructed(const SceneOptions& scene_options, const MapperOpti
   // or a wrongly registered camera (errors of the order of the radius).
   std::vector<testing::CameraPose> estimated, truth;
   for (size_t i = 0; i < n; ++i) {
-    estimated.push_back({model.images[i].pose.cam_from_world_rotation, model.images[i].pose.Center()});
-    truth.push_back({scene.poses[i].cam_from_world_rotation, scene.poses[i].Center()});
+    estimated.push_back({model.images[i].cam_from_world.rotation, model.images[i].Center()});
+    truth.push_back({scene.poses[i].rotation, CameraCenterInWorld(scene.poses[i])});
   }
   Result<testing::CameraPoseErrors> errors = testing::CameraCenterErrors(estimated, truth);
   ASSERT_TRUE(errors.ok()) << errors.status().ToString();
@@ -355,7 +355,7 @@ void ExpectRingReconstructed(const SceneOptions& scene_options, const MapperOpti
       for (const TrackElement& e : point.track) {
         const Eigen::Vector2d& x = model.images[static_cast<size_t>(e.image_id)].keypoints[static_cast<size_t>(e.keypoint_id)];
         const bool far = majority->first < 0 ||
-                         (scene.camera.Project(scene.poses[static_cast<size_t>(e.image_id)].CamFromWorld(
+                         (scene.camera.Project(scene.poses[static_cast<size_t>(e.image_id)] * (
                               scene.points[static_cast<size_t>(majority->first)])) - x).norm() > 8.0;
         wrong_multiview_observations += far ? 1 : 0;
       }
@@ -488,8 +488,8 @@ TEST(IncrementalMapperTest, TwoRunsGiveIdenticalModels) {
   for (size_t i = 0; i < a.images.size(); ++i) {
     EXPECT_EQ(a.images[i].registered, b.images[i].registered);
     EXPECT_EQ(a.images[i].camera_id, b.images[i].camera_id);
-    EXPECT_TRUE(a.images[i].pose.cam_from_world_rotation == b.images[i].pose.cam_from_world_rotation) << i;
-    EXPECT_TRUE(a.images[i].pose.cam_from_world_translation == b.images[i].pose.cam_from_world_translation) << i;
+    EXPECT_TRUE(a.images[i].cam_from_world.rotation == b.images[i].cam_from_world.rotation) << i;
+    EXPECT_TRUE(a.images[i].cam_from_world.translation == b.images[i].cam_from_world.translation) << i;
     EXPECT_EQ(a.images[i].point3d_ids, b.images[i].point3d_ids) << i;
   }
   ASSERT_EQ(a.points.size(), b.points.size());

@@ -73,12 +73,12 @@ Reconstruction SyntheticScene(double second_aspect = 1.0017) {
     image.camera_id = i % 2;
     image.registered = i != 2;
     const Eigen::Vector3d axis = Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng)).normalized();
-    image.pose.cam_from_world_rotation = Eigen::AngleAxisd(0.3 * uniform(rng), axis).toRotationMatrix();
-    image.pose.cam_from_world_translation = Eigen::Vector3d(0.5 * uniform(rng), 0.5 * uniform(rng), 6.0);
+    image.cam_from_world.rotation = Eigen::AngleAxisd(0.3 * uniform(rng), axis).toRotationMatrix();
+    image.cam_from_world.translation = Eigen::Vector3d(0.5 * uniform(rng), 0.5 * uniform(rng), 6.0);
     const SfmCamera& camera = reconstruction.cameras[image.camera_id];
     for (int p = 0; p < 40; ++p) {
       if (p == 7 && i != 2) continue;
-      image.keypoints.push_back(camera.Project(image.pose.CamFromWorld(reconstruction.points[p].position)));
+      image.keypoints.push_back(camera.Project(image.cam_from_world * (reconstruction.points[p].position)));
       image.point3d_ids.push_back(p);
       reconstruction.points[p].track.push_back({i, static_cast<int>(image.keypoints.size()) - 1});
     }
@@ -119,8 +119,8 @@ TEST(ModelIoTest, ColmapRoundTripIsExactWhenEverythingIsExported) {
     EXPECT_EQ(a.name, b.name);
     EXPECT_EQ(a.camera_id, b.camera_id);
     EXPECT_TRUE(a.registered);
-    EXPECT_LT((a.pose.cam_from_world_rotation - b.pose.cam_from_world_rotation).cwiseAbs().maxCoeff(), 1e-15);
-    EXPECT_EQ(a.pose.cam_from_world_translation, b.pose.cam_from_world_translation);
+    EXPECT_LT((a.cam_from_world.rotation - b.cam_from_world.rotation).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_EQ(a.cam_from_world.translation, b.cam_from_world.translation);
     ASSERT_EQ(a.keypoints.size(), b.keypoints.size());
     for (size_t k = 0; k < a.keypoints.size(); ++k) {
       EXPECT_LT((a.keypoints[k] - b.keypoints[k]).cwiseAbs().maxCoeff(), 1e-12);
@@ -350,7 +350,7 @@ TEST(ModelIoTest, BundlerProjectionMatchesSfmCamera) {
 
       const SfmImage& image = model.images[camera_index];
       const SfmCamera& camera = model.cameras[image.camera_id];
-      const Eigen::Vector2d pixel = camera.Project(image.pose.CamFromWorld(X));
+      const Eigen::Vector2d pixel = camera.Project(image.cam_from_world * X);
       const Eigen::Vector2d from_bundler(projected.x() + 0.5 * (camera.width - 1),
                                          0.5 * (camera.height - 1) - projected.y());
       EXPECT_LT((from_bundler - pixel).norm(), 1e-9);

@@ -62,9 +62,9 @@ Scene MakeScene(double tag2_scale = 1.0) {
     image.name = "view" + std::to_string(c);
     image.camera_id = 0;
     image.registered = true;
-    image.pose.cam_from_world_rotation = cam_from_world.rotation * m.rotation.transpose();
-    image.pose.cam_from_world_translation =
-        m.scale * cam_from_world.translation - image.pose.cam_from_world_rotation * m.translation;
+    image.cam_from_world.rotation = cam_from_world.rotation * m.rotation.transpose();
+    image.cam_from_world.translation =
+        m.scale * cam_from_world.translation - image.cam_from_world.rotation * m.translation;
     std::vector<TagObservation> seen;
     for (int id = 0; id < 3; ++id) {
       TagObservation tag;
@@ -72,7 +72,7 @@ Scene MakeScene(double tag2_scale = 1.0) {
       for (int k = 0; k < 4; ++k) {
         const double size = id == 2 ? tag2_scale * kTagSize : kTagSize;
         const Eigen::Vector3d model_point = m.Apply(TagCorner(scene.world_from_tag[static_cast<size_t>(id)], k, size));
-        tag.corners[static_cast<size_t>(k)] = camera.Project(image.pose.CamFromWorld(model_point));
+        tag.corners[static_cast<size_t>(k)] = camera.Project(image.cam_from_world * model_point);
       }
       seen.push_back(tag);
     }
@@ -109,7 +109,7 @@ TEST(TagRegistrationTest, RecoversMetresAndTheWorldTagFrame) {
   EXPECT_LT(report->edge_max_abs_error_m, 1e-7);
   // The cameras moved with the model.
   for (size_t c = 0; c < scene.model.images.size(); ++c) {
-    EXPECT_LT((scene.model.images[c].pose.Center() - scene.camera_centres_world[c]).norm(), 1e-7);
+    EXPECT_LT((scene.model.images[c].Center() - scene.camera_centres_world[c]).norm(), 1e-7);
   }
 }
 
@@ -152,7 +152,7 @@ TEST(TagRegistrationTest, AnyCompleteTagCanBeTheWorldAndOthersAreRefused) {
 
 TEST(TagRegistrationTest, WithoutATagInTwoViewsTheModelStaysAsItWas) {
   Scene scene = MakeScene();
-  const Eigen::Vector3d centre = scene.model.images[0].pose.Center();
+  const Eigen::Vector3d centre = scene.model.images[0].Center();
   for (size_t c = 1; c < scene.observations.size(); ++c) scene.observations[c].clear();
   TagRegistrationOptions options;
   options.tag_size_m = kTagSize;
@@ -160,7 +160,7 @@ TEST(TagRegistrationTest, WithoutATagInTwoViewsTheModelStaysAsItWas) {
   ASSERT_TRUE(report.ok());
   EXPECT_FALSE(report->metric);
   EXPECT_NE(report->reason.find("3 tag(s) seen"), std::string::npos) << report->reason;
-  EXPECT_LT((scene.model.images[0].pose.Center() - centre).norm(), 1e-12);
+  EXPECT_LT((scene.model.images[0].Center() - centre).norm(), 1e-12);
   options.tag_size_m = 0.0;
   EXPECT_EQ(RegisterToTags(scene.observations, {}, options, &scene.model).status().code(),
             StatusCode::kInvalidArgument);

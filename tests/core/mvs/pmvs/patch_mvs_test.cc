@@ -73,7 +73,7 @@ Evaluation Evaluate(const TexturedBoxScene& scene, const TexturedBoxSceneOptions
     for (int cy = 0; cy < rows; ++cy) {
       for (int cx = 0; cx < cols; ++cx) {
         const double u = (cx + 0.5) * cell_size - 0.5, v = (cy + 0.5) * cell_size - 0.5;
-        const Eigen::Vector3d ray = (view.pose.cam_from_world_rotation.transpose() *
+        const Eigen::Vector3d ray = (view.cam_from_world.rotation.transpose() *
                                      Eigen::Vector3d((u - view.cx) / view.fx, (v - view.cy) / view.fy, 1.0))
                                         .normalized();
         const testing::SceneHit hit = scene.Intersect(view.Center(), ray);
@@ -211,7 +211,7 @@ TEST(PatchMvsTest, Textureless3ViewsFailCleanly) {
     views[i].fx = views[i].fy = 80.0;
     views[i].cx = 39.5;
     views[i].cy = 29.5;
-    views[i].pose.cam_from_world_translation = Eigen::Vector3d(0.1 * i, 0.0, 2.0);
+    views[i].cam_from_world.translation = Eigen::Vector3d(0.1 * i, 0.0, 2.0);
     pointers.push_back(&views[i]);
   }
   Result<OrientedPoints> result = RunPatchMvs(pointers, PatchMvsOptions());

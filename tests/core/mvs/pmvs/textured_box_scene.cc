@@ -59,8 +59,8 @@ TexturedBoxScene::TexturedBoxScene(const TexturedBoxSceneOptions& options) : opt
     rotation.row(0) = right.transpose();
     rotation.row(1) = down.transpose();
     rotation.row(2) = forward.transpose();
-    view.pose.cam_from_world_rotation = rotation;
-    view.pose.cam_from_world_translation = -rotation * center;
+    view.cam_from_world.rotation = rotation;
+    view.cam_from_world.translation = -rotation * center;
     view.gray = Image<uint8_t>(options.width, options.height, 1);
     view.rgb = Image<uint8_t>(options.width, options.height, 3);
     for (int y = 0; y < options.height; ++y) {
