@@ -72,7 +72,7 @@ Result<TagDetectionsFile> DetectTagsInPhotos(const std::vector<std::string>& pat
           }
           TagObservation tag;
           tag.tag_id = d.id;
-          for (size_t k = 0; k < 4; ++k) tag.corners[k] = ToIntrinsicsPixel(d.corners[k]);
+          for (size_t k = 0; k < 4; ++k) tag.corners[k] = d.corners[k];
           out.tags.push_back(tag);
         }
         std::sort(out.tags.begin(), out.tags.end(),

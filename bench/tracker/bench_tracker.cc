@@ -12,8 +12,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -33,12 +31,12 @@ using reconar::bench::Median;
 
 struct Frame {
   Image<uint8_t> gray;
-  Eigen::Vector2d corners[4];  // reference, libapriltag pixel convention
+  Eigen::Vector2d corners[4];  // reference, the program's pixel convention (ReadArVideoFrames)
 };
 
-double MeanCornerError(const double (*p)[2], const Eigen::Vector2d (&ref)[4]) {
+double MeanCornerError(const Eigen::Vector2d (&corners)[4], const Eigen::Vector2d (&ref)[4]) {
   double sum = 0.0;
-  for (int k = 0; k < 4; ++k) sum += (Eigen::Vector2d(p[k][0], p[k][1]) - ref[k]).norm();
+  for (int k = 0; k < 4; ++k) sum += (corners[k] - ref[k]).norm();
   return sum / 4;
 }
 
@@ -65,7 +63,10 @@ RunResult RunPlain(const std::vector<Frame>& frames) {
       zarray_get(detections, i, &det);
       if (det->id != 12) continue;
       ++result.found;
-      error_sum += MeanCornerError(det->p, frame.corners);
+      // libapriltag's pixel convention to ours, as TagDetector converts.
+      Eigen::Vector2d corners[4];
+      for (int k = 0; k < 4; ++k) corners[k] = Eigen::Vector2d(det->p[k][0], det->p[k][1]) - Eigen::Vector2d(0.5, 0.5);
+      error_sum += MeanCornerError(corners, frame.corners);
     }
     apriltag_detections_destroy(detections);
   }
@@ -101,12 +102,7 @@ RunResult RunTracker(const std::vector<Frame>& frames, const reconar::CameraIntr
     for (const reconar::TrackedTag& t : report.tags) {
       if (t.id != 12 || !t.measured) continue;
       ++result.found;
-      double p[4][2];
-      for (int k = 0; k < 4; ++k) {
-        p[k][0] = t.detection.corners[k].x();
-        p[k][1] = t.detection.corners[k].y();
-      }
-      error_sum += MeanCornerError(p, frame.corners);
+      error_sum += MeanCornerError(t.detection.corners, frame.corners);
     }
     using Search = reconar::TagTrackerFrameReport::Search;
     breakdown->region_frames += report.search == Search::kRegions;
@@ -125,21 +121,16 @@ RunResult RunTracker(const std::vector<Frame>& frames, const reconar::CameraIntr
 
 int main(int argc, char** argv) {
   const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
-  const std::string dir = std::string(RECONAR_SHARED_DATA_DIR) + "/apriltag_ar_video_id12/";
-  std::ifstream list(dir + "corners.txt");
-  if (!list) {
-    std::fprintf(stderr, "%scorners.txt: cannot open\n", dir.c_str());
+  const std::vector<reconar::testing::ArVideoFrame> reference = reconar::testing::ReadArVideoFrames();
+  if (reference.empty()) {
+    std::fprintf(stderr, "%s/corners.txt: cannot open\n", reconar::testing::ArVideoDir().c_str());
     return 2;
   }
   std::vector<Frame> frames;
-  for (std::string line; std::getline(list, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    std::string name;
+  for (const reconar::testing::ArVideoFrame& entry : reference) {
     Frame frame;
-    fields >> name;
-    for (Eigen::Vector2d& c : frame.corners) fields >> c.x() >> c.y();
-    auto decoded = reconar::ReadImage(dir + "frames/" + name);
+    std::copy(entry.corners, entry.corners + 4, frame.corners);
+    auto decoded = reconar::ReadImage(reconar::testing::ArVideoDir() + "/frames/" + entry.name);
     if (!decoded.ok()) {
       std::fprintf(stderr, "%s\n", decoded.status().ToString().c_str());
       return 2;
@@ -165,7 +156,10 @@ int main(int argc, char** argv) {
       for (const Frame& f : frames) {
         Frame scaled;
         scaled.gray = reconar::bench::ResizeBilinear(f.gray, width, height);
-        for (int k = 0; k < 4; ++k) scaled.corners[k] = Eigen::Vector2d(f.corners[k].x() * sx, f.corners[k].y() * sy);
+        // Pixel edges map to pixel edges: u' = (u + 0.5) * sx - 0.5 (pixel centres on integers).
+        for (int k = 0; k < 4; ++k) {
+          scaled.corners[k] = Eigen::Vector2d((f.corners[k].x() + 0.5) * sx - 0.5, (f.corners[k].y() + 0.5) * sy - 0.5);
+        }
         sized.push_back(std::move(scaled));
       }
       sized_camera.width = width;
