@@ -5,6 +5,7 @@
 
 #include "core/base/build_info.h"
 #include "core/base/cpu_features.h"
+#include "core/pipeline/simd_kernels.h"
 #include "tools/commands.h"
 
 namespace {
@@ -34,7 +35,7 @@ constexpr char kUsage[] =
 int PrintVersion() {
   std::printf("reconar %s (%s)\ncpu: %s\n", reconar::ReconarVersion(), reconar::ReconarBuildType(),
               reconar::CpuFeatureNames(reconar::HostCpuFeatures()).c_str());
-  for (const reconar::SimdKernelChoice& choice : reconar::SelectedSimdKernels()) {
+  for (const reconar::SimdKernelChoice& choice : reconar::SimdKernelReport()) {
     std::printf("kernel %s: %s\n", choice.dispatcher.c_str(), choice.kernel.c_str());
   }
   return 0;
