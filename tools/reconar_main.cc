@@ -25,6 +25,7 @@ constexpr char kUsage[] =
     "  export IN.{ply,glb,obj} OUT.{ply,obj,glb,wrl}       convert a mesh or point cloud between formats\n"
     "  bundle-adjust --bal FILE [--json]                   solve a BAL bundle adjustment problem\n"
     "  tags --ids LIST --size METRES --out FILE.{svg,pdf}  printable AprilTag sheet\n"
+    "  tags IMAGES_DIR|IMAGE... [--json]                   the AprilTags in photos\n"
     "  track SOURCE --intrinsics K --tag-size M [--json]   6-DoF tag tracking, one line per frame\n"
     "  view --model M (--camera DEV | --frames DIR) ...    AR overlay: live window or PNGs (--out)\n"
     "  calibrate IMAGES... --tag-size M --out FILE         camera intrinsics from photos of tags\n"
