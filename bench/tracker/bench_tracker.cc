@@ -3,9 +3,10 @@
 //   (a) plain full-frame libapriltag with apriltag_detector_create() defaults (tag36h11, 1 thread),
 //   (b) our TagTracker with its defaults (1 thread; a fresh tracker per run, so its first frame is
 //       a full-frame search).
-// At 640x480 (as recorded) and at 1280x720 (the frames upscaled bilinearly, corners and K scaled
-// with them). Reports median ms/frame over the runs, the ratio (b)/(a), and each side's mean corner
-// error against corners.txt (upstream libapriltag, decimate 1).
+// At 640x480 (as recorded) and at 1280x960 (the frames upscaled bilinearly, corners scaled with
+// them, K by ScaleIntrinsicsToFrame as the AR runtime scales a photo camera to its video). Reports
+// median ms/frame over the runs, the ratio (b)/(a), and each side's mean corner error against
+// corners.txt (upstream libapriltag, decimate 1).
 //   bench_tracker [repeats=5]
 #include <algorithm>
 #include <chrono>
@@ -20,6 +21,7 @@
 
 #include "bench/common/bench_images.h"
 #include "core/io/image_io.h"
+#include "render/ar/ar_project.h"
 #include "tests/support/ar_video.h"
 #include "tracker/tag_tracker.h"
 
@@ -142,8 +144,12 @@ int main(int argc, char** argv) {
 
   for (const int width : {640, 1280}) {
     std::vector<Frame> sized;
-    reconar::CameraIntrinsics sized_camera = camera;
-    const int height = width == 640 ? 480 : 720;
+    const int height = width * 3 / 4;
+    const auto sized_camera = reconar::ScaleIntrinsicsToFrame(camera, width, height);
+    if (!sized_camera.ok()) {
+      std::fprintf(stderr, "%s\n", sized_camera.status().ToString().c_str());
+      return 2;
+    }
     const double sx = width / 640.0, sy = height / 480.0;
     if (width == 640) {
       for (const Frame& f : frames) {
@@ -162,19 +168,13 @@ int main(int argc, char** argv) {
         }
         sized.push_back(std::move(scaled));
       }
-      sized_camera.width = width;
-      sized_camera.height = height;
-      sized_camera.fx *= sx;
-      sized_camera.fy *= sy;
-      sized_camera.cx = (camera.cx + 0.5) * sx - 0.5;
-      sized_camera.cy = (camera.cy + 0.5) * sy - 0.5;
     }
     std::vector<double> plain_ms, tracker_ms, ratios;
     RunResult plain, tracked;
     TrackerBreakdown breakdown;
     for (int r = 0; r < repeats; ++r) {
       plain = RunPlain(sized);
-      tracked = RunTracker(sized, sized_camera, &breakdown);
+      tracked = RunTracker(sized, *sized_camera, &breakdown);
       plain_ms.push_back(plain.ms_per_frame);
       tracker_ms.push_back(tracked.ms_per_frame);
       ratios.push_back(tracked.ms_per_frame / plain.ms_per_frame);
