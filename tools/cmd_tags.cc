@@ -1,9 +1,13 @@
-// reconar tags: a printable sheet of AprilTags whose detection border measures exactly --size.
+// reconar tags: a printable sheet of AprilTags whose detection border measures exactly --size, or
+// the tags found in photos (as the tags stage of `reconar reconstruct` finds them).
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "core/base/json_writer.h"
+#include "core/pipeline/project.h"
 #include "tools/commands.h"
+#include "tracker/photo_tags.h"
 #include "tracker/tag_detector.h"
 #include "tracker/tag_sheet.h"
 
@@ -12,6 +16,7 @@ namespace {
 
 constexpr char kHelp[] =
     "usage: reconar tags --ids LIST --size METRES --out FILE.{svg,pdf} [options]\n"
+    "       reconar tags IMAGES_DIR|IMAGE... [--family F] [--threads N] [--json]\n"
     "\n"
     "Writes a printable sheet of AprilTags. The tag size is the edge of the detection border (the\n"
     "black square of tag36h11: what `--tag-size` means in `reconar track`). Print at 100 %\n"
@@ -22,7 +27,18 @@ constexpr char kHelp[] =
     "  --size METRES     tag edge, e.g. 0.16\n"
     "  --paper NAME      a4 (default), a3, letter, or WIDTHxHEIGHT in mm (e.g. 300x400)\n"
     "  --margin MM       page margin (default 10)\n"
-    "  --out FILE        .svg or .pdf\n";
+    "  --out FILE        .svg or .pdf\n"
+    "  --json            print {\"family\", \"ids\", \"size_mm\", \"files\"} on stdout\n"
+    "\n"
+    "With photos instead, prints the tags found in each (searched as `reconar reconstruct` does),\n"
+    "one line per photo, or with --json one JSON object per photo:\n"
+    "  {\"image\": NAME, \"width\": W, \"height\": H, \"tags\": [{\"id\": N, \"family\": F,\n"
+    "   \"hamming\": BITS, \"decision_margin\": M, \"corners\": [[x,y] x4], \"center\": [x,y]}]}\n"
+    "Corners are in libapriltag's order (bottom-left, bottom-right, top-right, top-left of the\n"
+    "upright tag), in pixels of the upright photo with the centre of the top-left pixel at (0, 0)\n"
+    "(the convention of intrinsics files). An id printed twice in a photo is listed twice here;\n"
+    "`reconar reconstruct` drops both.\n"
+    "  --threads N       worker threads (default: one per core)\n";
 
 Result<std::vector<int>> ParseIds(const std::string& text) {
   std::vector<int> ids;
@@ -47,28 +63,73 @@ Result<std::vector<int>> ParseIds(const std::string& text) {
   return ids;
 }
 
+std::string PhotoJson(const PhotoDetections& photo, const char* family) {
+  JsonWriter json;
+  json.BeginObject().Key("image").String(photo.image_name).Key("width").Int(photo.width);
+  json.Key("height").Int(photo.height).Key("tags").BeginArray();
+  for (const TagDetection& tag : photo.detections) {
+    json.BeginObject().Key("id").Int(tag.id).Key("family").String(family).Key("hamming").Int(tag.hamming);
+    json.Key("decision_margin").Double(tag.decision_margin).Key("corners").BeginArray();
+    for (const Eigen::Vector2d& corner : tag.corners) {
+      json.BeginArray().Double(corner.x()).Double(corner.y()).EndArray();
+    }
+    json.EndArray().Key("center").BeginArray().Double(tag.center.x()).Double(tag.center.y()).EndArray();
+    json.EndObject();
+  }
+  json.EndArray().EndObject();
+  return json.str();
+}
+
+// reconar tags IMAGES...: the tags in each photo.
+int RunDetect(const Args& args, TagFamily family) {
+  auto paths = CollectImagePaths(args.positionals());
+  if (!paths.ok()) return Fail(paths.status());
+  PhotoTagOptions options;
+  options.family = family;
+  auto threads = args.GetThreads();
+  if (!threads.ok()) return Fail(threads.status());
+  options.num_threads = *threads;
+  options.show_progress = false;
+  auto photos = DetectAllTagsInPhotos(*paths, options);
+  if (!photos.ok()) return Fail(photos.status());
+  for (const PhotoDetections& photo : *photos) {
+    if (args.Has("json")) {
+      std::printf("%s\n", PhotoJson(photo, TagFamilyName(family)).c_str());
+      continue;
+    }
+    std::printf("%s %dx%d: %zu tag(s)", photo.image_name.c_str(), photo.width, photo.height, photo.detections.size());
+    for (const TagDetection& tag : photo.detections) std::printf(" %d", tag.id);
+    std::printf("\n");
+  }
+  return 0;
+}
+
 }  // namespace
 
 int RunTags(int argc, char** argv, int first) {
-  Args args({"family", "ids", "size", "paper", "margin", "out"}, {});
+  Args args({"family", "ids", "size", "paper", "margin", "out", "threads"}, {"json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
     std::fputs(kHelp, stdout);
     return 0;
   }
-  if (!args.positionals().empty() || !args.Has("ids") || !args.Has("size") || !args.Has("out")) {
+  const bool sheet = args.Has("ids") || args.Has("size") || args.Has("out");
+  if (args.positionals().empty() == !sheet || (sheet && (!args.Has("ids") || !args.Has("size") || !args.Has("out")))) {
     std::fputs(kHelp, stderr);
     return 2;
   }
+  const std::string family_name = args.Get("family", "tag36h11");
+  auto family = ParseTagFamily(family_name);
+  if (!family.ok()) return Fail(family.status());
+  if (!sheet) return RunDetect(args, *family);
+
   const std::string out = args.Get("out");
   const std::string extension = LowercaseExtension(out);
   if (extension != ".svg" && extension != ".pdf") {
     return Fail(InvalidArgument("--out: '" + out + "' must end in .svg or .pdf"));
   }
   TagSheetOptions options;
-  options.family = args.Get("family", "tag36h11");
-  auto family = ParseTagFamily(options.family);
-  if (!family.ok()) return Fail(family.status());
+  options.family = family_name;
   auto size = args.GetDouble("size", 0.0, 1e-4, 10.0);
   if (!size.ok()) return Fail(size.status());
   options.tag_size_mm = *size * 1000.0;
@@ -81,14 +142,23 @@ int RunTags(int argc, char** argv, int first) {
 
   auto bitmaps = RenderSheetTags(*family, *ids);
   if (!bitmaps.ok()) return Fail(bitmaps.status().WithContext("--ids"));
-  auto sheet = LayoutTagSheet(std::move(*bitmaps), options);
-  if (!sheet.ok()) return Fail(sheet.status());
-  auto written = WriteTagSheet(*sheet, out);
+  auto sheet_layout = LayoutTagSheet(std::move(*bitmaps), options);
+  if (!sheet_layout.ok()) return Fail(sheet_layout.status());
+  auto written = WriteTagSheet(*sheet_layout, out);
   if (!written.ok()) return Fail(written.status());
   std::fprintf(stderr, "reconar tags: %zu %s tag(s) of %.1f mm on %zu page(s):", ids->size(), options.family.c_str(),
-               options.tag_size_mm, sheet->pages.size());
+               options.tag_size_mm, sheet_layout->pages.size());
   for (const std::string& path : *written) std::fprintf(stderr, " %s", path.c_str());
   std::fputc('\n', stderr);
+  if (args.Has("json")) {
+    JsonWriter json;
+    json.BeginObject().Key("family").String(options.family).Key("ids").BeginArray();
+    for (const int id : *ids) json.Int(id);
+    json.EndArray().Key("size_mm").Double(options.tag_size_mm).Key("files").BeginArray();
+    for (const std::string& path : *written) json.String(path);
+    json.EndArray().EndObject();
+    std::printf("%s\n", json.str().c_str());
+  }
   return 0;
 }
 

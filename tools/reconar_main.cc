@@ -5,6 +5,7 @@
 
 #include "core/base/build_info.h"
 #include "core/base/cpu_features.h"
+#include "core/pipeline/simd_kernels.h"
 #include "tools/commands.h"
 
 namespace {
@@ -24,6 +25,7 @@ constexpr char kUsage[] =
     "  export IN.{ply,glb,obj} OUT.{ply,obj,glb,wrl}       convert a mesh or point cloud between formats\n"
     "  bundle-adjust --bal FILE [--json]                   solve a BAL bundle adjustment problem\n"
     "  tags --ids LIST --size METRES --out FILE.{svg,pdf}  printable AprilTag sheet\n"
+    "  tags IMAGES_DIR|IMAGE... [--json]                   the AprilTags in photos\n"
     "  track SOURCE --intrinsics K --tag-size M [--json]   6-DoF tag tracking, one line per frame\n"
     "  view --model M (--camera DEV | --frames DIR) ...    AR overlay: live window or PNGs (--out)\n"
     "  calibrate IMAGES... --tag-size M --out FILE         camera intrinsics from photos of tags\n"
@@ -34,7 +36,7 @@ constexpr char kUsage[] =
 int PrintVersion() {
   std::printf("reconar %s (%s)\ncpu: %s\n", reconar::ReconarVersion(), reconar::ReconarBuildType(),
               reconar::CpuFeatureNames(reconar::HostCpuFeatures()).c_str());
-  for (const reconar::SimdKernelChoice& choice : reconar::SelectedSimdKernels()) {
+  for (const reconar::SimdKernelChoice& choice : reconar::SimdKernelReport()) {
     std::printf("kernel %s: %s\n", choice.dispatcher.c_str(), choice.kernel.c_str());
   }
   return 0;

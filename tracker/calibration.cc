@@ -51,9 +51,6 @@ Status CheckObservations(const CalibrationObservations& observations) {
   if (tag_outside_layout && (!(observations.tag_size > 0.0) || !std::isfinite(observations.tag_size))) {
     return InvalidArgument("calibration: tag_size must be a positive number of metres");
   }
-  if (!std::isfinite(observations.corner_offset_px)) {
-    return InvalidArgument("calibration: corner_offset_px must be finite");
-  }
   const CalibrationImage* first = nullptr;
   for (const CalibrationImage& image : observations.images) {
     if (image.width <= 0 || image.height <= 0) {
@@ -85,7 +82,6 @@ double TagSize(const CalibrationObservations& observations, int tag_id) {
 }
 
 std::vector<Target> AssembleTargets(const CalibrationObservations& observations) {
-  const Eigen::Vector2d offset = Eigen::Vector2d::Constant(observations.corner_offset_px);
   std::vector<Target> targets;
   for (int i = 0; i < static_cast<int>(observations.images.size()); ++i) {
     Target board;
@@ -99,7 +95,7 @@ std::vector<Target> AssembleTargets(const CalibrationObservations& observations)
       Target& target = in_layout != nullptr ? board : single;
       for (int k = 0; k < 4; ++k) {
         target.object.push_back(in_layout != nullptr ? in_layout->layout_from_tag * tag_corners[k] : tag_corners[k]);
-        target.pixels.push_back(tag.corners[k] + offset);
+        target.pixels.push_back(tag.corners[k]);
       }
       if (!single.object.empty()) targets.push_back(std::move(single));
     }
@@ -539,7 +535,6 @@ Result<CalibrationReport> CalibrateIntrinsics(const CalibrationObservations& obs
   norm.scale = std::max(width, height);
 
   // 1. A homography per tag instance (board views are built from tags, so each of their tags is planar).
-  const Eigen::Vector2d offset = Eigen::Vector2d::Constant(observations.corner_offset_px);
   struct TagView {
     int image;
     int tag_id;
@@ -551,7 +546,7 @@ Result<CalibrationReport> CalibrateIntrinsics(const CalibrationObservations& obs
     for (const TagCorners& tag : observations.images[i].tags) {
       const std::array<Eigen::Vector3d, 4> tag_corners = TagCornersInTagFrame(TagSize(observations, tag.tag_id));
       std::array<Correspondence, 4> samples;
-      for (int k = 0; k < 4; ++k) samples[k] = {tag_corners[k].head<2>(), norm.Apply(tag.corners[k] + offset)};
+      for (int k = 0; k < 4; ++k) samples[k] = {tag_corners[k].head<2>(), norm.Apply(tag.corners[k])};
       std::array<Eigen::Matrix3d, 1> models;
       if (HomographyFourPoint::Estimate(samples.data(), 4, &models) != 1) continue;
       const Eigen::Vector2d d1 = tag.corners[2] - tag.corners[0], d2 = tag.corners[3] - tag.corners[1];

@@ -23,11 +23,9 @@
 //    libapriltag's corners p[0..3] are (-s/2,-s/2,0), (s/2,-s/2,0), (s/2,s/2,0), (-s/2,s/2,0)
 //    (bottom-left, bottom-right, top-right, top-left of the upright tag), s = tag edge (black border).
 //  - Camera frame: x right, y down, z forward (COLMAP); poses are cam_from_target.
-//  - Pixels: the result is in CameraIntrinsics' convention (core/math/camera_intrinsics.h: the centre
-//    of the top-left pixel is (0, 0)). libapriltag 3.3 reports corners with the centre of the top-left
-//    pixel at (0.5, 0.5) (measured here on supersampled synthetic renders: mean offset +0.51 px in x,
-//    +0.52 px in y), so CalibrationObservations::corner_offset_px defaults to -0.5, which is added to
-//    every corner before use. Set it to 0 for corners already in the (0, 0)-centre convention.
+//  - Pixels: corners and the result are in CameraIntrinsics' convention (core/math/camera_intrinsics.h:
+//    the centre of the top-left pixel is (0, 0)), the convention TagDetection corners come in
+//    (tracker/tag_detector.h converts libapriltag's (0.5, 0.5) once, at detection).
 #include <array>
 #include <string>
 #include <vector>
@@ -44,13 +42,9 @@
 
 namespace reconar {
 
-// Add to a libapriltag corner to get the CameraIntrinsics pixel convention (see the header comment;
-// the same shift as ToIntrinsicsPixel in tracker/tag_pose.h).
-inline constexpr double kApriltagToCentreConventionPx = -0.5;
-
 struct TagCorners {
   int tag_id = 0;
-  std::array<Eigen::Vector2d, 4> corners;  // libapriltag order p[0..3], pixels
+  std::array<Eigen::Vector2d, 4> corners;  // libapriltag order p[0..3], pixels (our convention)
 };
 
 struct CalibrationImage {
@@ -60,13 +54,12 @@ struct CalibrationImage {
   std::vector<TagCorners> tags;
 };
 
-// The detections of one image as calibration input (corners kept in libapriltag's convention).
+// The detections of one image as calibration input.
 CalibrationImage MakeCalibrationImage(std::string name, int width, int height, const TagDetectionList& detections);
 
 struct CalibrationObservations {
   std::vector<CalibrationImage> images;
   double tag_size = 0.0;  // s, metres, of tags not in the layout (scales the reported poses only)
-  double corner_offset_px = kApriltagToCentreConventionPx;
   // Optional rigid layout (tracker/tag_layout.h; tags may lie on several planes and have their own
   // sizes). When non-empty, the layout tags seen in an image share one board pose (target frame =
   // the layout frame); tags not in it are planar targets of their own (size tag_size). When empty,

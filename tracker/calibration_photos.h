@@ -1,7 +1,6 @@
 #pragma once
 // The tags in photos taken for calibration (`reconar calibrate`): each photo decoded (core/io),
-// turned grey and searched with one TagDetector, as a CalibrationImage (tracker/calibration.h;
-// corners in libapriltag's convention, CalibrationObservations::corner_offset_px converts).
+// turned grey and searched with one TagDetector, as a CalibrationImage (tracker/calibration.h).
 #include <string>
 #include <vector>
 

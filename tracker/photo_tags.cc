@@ -8,7 +8,6 @@
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/io/image_io.h"
-#include "tracker/tag_pose.h"
 
 namespace reconar {
 namespace {
@@ -25,10 +24,9 @@ Status PhotoTagOptions::Check() const {
   return Status::Ok();
 }
 
-Result<TagDetectionsFile> DetectTagsInPhotos(const std::vector<std::string>& paths, const PhotoTagOptions& options,
-                                             PhotoTagReport* report) {
+Result<std::vector<PhotoDetections>> DetectAllTagsInPhotos(const std::vector<std::string>& paths,
+                                                           const PhotoTagOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
-  const auto start = std::chrono::steady_clock::now();
   ThreadPool pool(ThreadPool::ResolveThreadCount(options.num_threads));
   // One detector per worker and decimation (libapriltag's detector is not reentrant).
   std::vector<std::unique_ptr<TagDetector>> full(static_cast<size_t>(pool.num_threads()));
@@ -41,21 +39,20 @@ Result<TagDetectionsFile> DetectTagsInPhotos(const std::vector<std::string>& pat
     detector.quad_decimate = 2.0f;
     RECONAR_ASSIGN_OR_RETURN(decimated[static_cast<size_t>(w)], TagDetector::Create(detector));
   }
-  TagDetectionsFile file;
-  file.family = TagFamilyName(options.family);
-  file.images.resize(paths.size());
+  std::vector<PhotoDetections> photos(paths.size());
   std::vector<Status> errors(paths.size());
-  std::vector<int> duplicates(paths.size(), 0);
   std::unique_ptr<Progress> progress;
   if (options.show_progress) progress = std::make_unique<Progress>("tags", paths.size());
   pool.ParallelFor(0, paths.size(), [&](size_t i, int worker) {
-    ImageTagObservations& out = file.images[i];
+    PhotoDetections& out = photos[i];
     out.image_name = FileName(paths[i]);
     auto decoded = ReadImage(paths[i]);
     if (!decoded.ok()) {
       errors[i] = decoded.status();
     } else {
       const Image<uint8_t> gray = ToGray8(decoded->rgb);
+      out.width = gray.width();
+      out.height = gray.height();
       const bool small = std::max(gray.width(), gray.height()) <= options.full_resolution_max_side;
       TagDetector& detector = small ? *full[static_cast<size_t>(worker)] : *decimated[static_cast<size_t>(worker)];
       TagDetectionList list(256);
@@ -63,26 +60,42 @@ Result<TagDetectionsFile> DetectTagsInPhotos(const std::vector<std::string>& pat
       if (!status.ok()) {
         errors[i] = status.WithContext(paths[i]);
       } else {
-        std::map<int, int> count;
-        for (const TagDetection& d : list) ++count[d.id];
-        for (const TagDetection& d : list) {
-          if (count[d.id] != 1) {
-            ++duplicates[i];
-            continue;
-          }
-          TagObservation tag;
-          tag.tag_id = d.id;
-          for (size_t k = 0; k < 4; ++k) tag.corners[k] = ToIntrinsicsPixel(d.corners[k]);
-          out.tags.push_back(tag);
-        }
-        std::sort(out.tags.begin(), out.tags.end(),
-                  [](const TagObservation& a, const TagObservation& b) { return a.tag_id < b.tag_id; });
+        out.detections.assign(list.begin(), list.end());
       }
     }
     if (progress) progress->Advance();
   });
   if (progress) progress->Finish();
   for (const Status& status : errors) RECONAR_RETURN_IF_ERROR(status);
+  return photos;
+}
+
+Result<TagDetectionsFile> DetectTagsInPhotos(const std::vector<std::string>& paths, const PhotoTagOptions& options,
+                                             PhotoTagReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<PhotoDetections> photos, DetectAllTagsInPhotos(paths, options));
+  TagDetectionsFile file;
+  file.family = TagFamilyName(options.family);
+  file.images.resize(paths.size());
+  std::vector<int> duplicates(paths.size(), 0);
+  for (size_t i = 0; i < photos.size(); ++i) {
+    ImageTagObservations& out = file.images[i];
+    out.image_name = photos[i].image_name;
+    std::map<int, int> count;
+    for (const TagDetection& d : photos[i].detections) ++count[d.id];
+    for (const TagDetection& d : photos[i].detections) {
+      if (count[d.id] != 1) {
+        ++duplicates[i];
+        continue;
+      }
+      TagObservation tag;
+      tag.tag_id = d.id;
+      for (size_t k = 0; k < 4; ++k) tag.corners[k] = d.corners[k];
+      out.tags.push_back(tag);
+    }
+    std::sort(out.tags.begin(), out.tags.end(),
+              [](const TagObservation& a, const TagObservation& b) { return a.tag_id < b.tag_id; });
+  }
   if (report != nullptr) {
     *report = PhotoTagReport();
     report->photos = static_cast<int>(paths.size());

@@ -31,8 +31,24 @@ struct PhotoTagReport {
   double seconds = 0.0;
 };
 
-// One entry per path, named by the file name (as features/images.txt names the photos). Errors
-// name the photo that could not be read.
+// Every detection in one photo, duplicates kept.
+struct PhotoDetections {
+  std::string image_name;  // the file name
+  int width = 0;           // the upright photo's size, pixels
+  int height = 0;
+  // TagDetector's output: id, hamming, decision margin, corners in libapriltag's order and the
+  // program's pixel convention (centre of the top-left pixel at (0, 0)).
+  std::vector<TagDetection> detections;
+};
+
+// Each photo decoded, turned grey and searched as the tags stage does (one entry per path, in
+// order; what `reconar tags PHOTO...` prints). Errors name the photo that could not be read.
+Result<std::vector<PhotoDetections>> DetectAllTagsInPhotos(const std::vector<std::string>& paths,
+                                                           const PhotoTagOptions& options);
+
+// The tags stage's observations: DetectAllTagsInPhotos without the ids seen twice in a photo,
+// sorted by id. One entry per path, named by the file name (as features/images.txt names the
+// photos). Errors name the photo that could not be read.
 Result<TagDetectionsFile> DetectTagsInPhotos(const std::vector<std::string>& paths, const PhotoTagOptions& options,
                                              PhotoTagReport* report = nullptr);
 

@@ -165,6 +165,11 @@ Status TagDetector::DetectView(ImageView<const uint8_t> view, int x_offset, int 
   zarray_t* found = apriltag_detector_detect(impl_->detector, &wrapped);
   if (found == nullptr) return Internal("libapriltag returned no detection array");
   const Eigen::Vector2d offset(x_offset, y_offset);
+  // libapriltag's pixel (i, j) covers [i, i+1] x [j, j+1] of the view it was given (decimation is
+  // undone inside libapriltag: corners and H are in that view's full-resolution pixels). The view
+  // starts at (x_offset, y_offset) of the frame, and our convention puts pixel centres on
+  // integers, hence + offset - 0.5 (subtracting 0.5 is exact for any coordinate in [0.25, 2^52)).
+  const Eigen::Vector2d to_centre(0.5, 0.5);
   const int count = zarray_size(found);
   for (int i = 0; i < count; ++i) {
     apriltag_detection_t* det = nullptr;
@@ -173,16 +178,16 @@ Status TagDetector::DetectView(ImageView<const uint8_t> view, int x_offset, int 
     out.id = det->id;
     out.hamming = det->hamming;
     out.decision_margin = det->decision_margin;
-    for (int k = 0; k < 4; ++k) out.corners[k] = Eigen::Vector2d(det->p[k][0], det->p[k][1]) + offset;
-    out.center = Eigen::Vector2d(det->c[0], det->c[1]) + offset;
+    for (int k = 0; k < 4; ++k) out.corners[k] = (Eigen::Vector2d(det->p[k][0], det->p[k][1]) + offset) - to_centre;
+    out.center = (Eigen::Vector2d(det->c[0], det->c[1]) + offset) - to_centre;
     Eigen::Matrix3d H;
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) H(r, c) = MATD_EL(det->H, r, c);
     }
-    // Full frame = translate(offset) * sub-view homography.
+    // Full frame, our convention = translate(offset - 0.5) * sub-view homography.
     Eigen::Matrix3d shift = Eigen::Matrix3d::Identity();
-    shift(0, 2) = x_offset;
-    shift(1, 2) = y_offset;
+    shift(0, 2) = x_offset - 0.5;
+    shift(1, 2) = y_offset - 0.5;
     out.homography = shift * H;
     detections->Add(out);
   }

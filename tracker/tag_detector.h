@@ -3,10 +3,12 @@
 // ImageView<const uint8_t> the caller owns. The view is wrapped in an image_u8_t on the stack
 // (width, height, stride, buf): nothing is copied, and libapriltag only reads the pixels.
 //
-// Pixel convention of every corner and centre reported here (libapriltag's own): the CENTRE of
-// the top-left pixel is (0.5, 0.5), i.e. pixel (i, j) covers [i, i+1] x [j, j+1]. Checked in
-// tests/tracker/tag_detector_test.cc on tags rendered with exact area coverage. Our
-// CameraIntrinsics put that centre at (0, 0); ToIntrinsicsPixel converts (tag_pose.h does it).
+// Pixel convention of every corner, centre and homography reported here: the program's one
+// convention (CameraIntrinsics, RadialCamera): the CENTRE of the top-left pixel is (0, 0), i.e.
+// pixel (i, j) covers [i - 0.5, i + 0.5] x [j - 0.5, j + 0.5]. libapriltag itself puts that centre
+// at (0.5, 0.5); DetectView is the one place that reads its detections and subtracts 0.5 there, so
+// no other code converts. Checked in tests/tracker/tag_detector_test.cc on tags rendered with
+// exact area coverage: whole frame and region, full-resolution and decimated quad search.
 //
 // Corner order (libapriltag's): p[0..3] wrap counter-clockwise in the image around the tag, and
 // are the bottom-left, bottom-right, top-right, top-left corners of the upright tag, i.e. the tag
@@ -74,10 +76,10 @@ struct TagDetection {
   int id = -1;
   int hamming = 0;               // bit errors corrected
   float decision_margin = 0.0f;  // libapriltag's mean |bit intensity - threshold|
-  Eigen::Vector2d corners[4];    // libapriltag order and pixel convention (see the header comment)
+  Eigen::Vector2d corners[4];    // libapriltag order, our pixel convention (see the header comment)
   Eigen::Vector2d center = Eigen::Vector2d::Zero();
   // Maps the ideal tag square (-1,-1)..(1,1) (libapriltag's tag coordinates: x right, y DOWN on
-  // the upright tag) to full-frame pixels: pixel ~ H (x, y, 1).
+  // the upright tag) to full-frame pixels (our convention): pixel ~ H (x, y, 1).
   Eigen::Matrix3d homography = Eigen::Matrix3d::Identity();
 };
 

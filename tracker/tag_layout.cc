@@ -49,7 +49,7 @@ Result<BoardPose> EstimateBoardPose(const TagLayout& layout, const TagDetectionL
     return board;
   }
   Eigen::Vector2d normalized[kMaxRefinementPoints];
-  for (int i = 0; i < count; ++i) normalized[i] = intrinsics.Unproject(ToIntrinsicsPixel(pixels[i]));
+  for (int i = 0; i < count; ++i) normalized[i] = intrinsics.Unproject(pixels[i]);
   double best_rms = std::numeric_limits<double>::infinity();
   for (int i = 0; i < tags; ++i) {
     Result<TagPose> pose = EstimateTagPose(used_detections[i]->corners, used_tags[i]->size, intrinsics, options.pose);

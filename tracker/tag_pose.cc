@@ -151,8 +151,8 @@ Status PlanarPoseOptions::Check() const {
   return Status::Ok();
 }
 
-Result<TagPose> EstimatePlanarPose(const Eigen::Vector2d* plane_points, const Eigen::Vector2d* apriltag_pixels,
-                                   int count, const CameraIntrinsics& intrinsics, const PlanarPoseOptions& options) {
+Result<TagPose> EstimatePlanarPose(const Eigen::Vector2d* plane_points, const Eigen::Vector2d* pixels, int count,
+                                   const CameraIntrinsics& intrinsics, const PlanarPoseOptions& options) {
   if (!intrinsics.valid()) return InvalidArgument("EstimatePlanarPose: intrinsics need fx > 0 and fy > 0");
   if (count < 4 || count > kMaxRefinementPoints) {
     return InvalidArgument("EstimatePlanarPose: needs 4.." + std::to_string(kMaxRefinementPoints) + " points, got " +
@@ -162,7 +162,7 @@ Result<TagPose> EstimatePlanarPose(const Eigen::Vector2d* plane_points, const Ei
   Eigen::Vector2d normalized[kMaxRefinementPoints];
   Eigen::Vector3d world[kMaxRefinementPoints];
   for (int i = 0; i < count; ++i) {
-    normalized[i] = intrinsics.Unproject(ToIntrinsicsPixel(apriltag_pixels[i]));
+    normalized[i] = intrinsics.Unproject(pixels[i]);
     world[i] = Eigen::Vector3d(plane_points[i].x(), plane_points[i].y(), 0.0);
     if (!normalized[i].allFinite() || !world[i].allFinite()) {
       return InvalidArgument("EstimatePlanarPose: point " + std::to_string(i) + " is not finite");
@@ -192,7 +192,7 @@ Result<TagPose> EstimatePlanarPose(const Eigen::Vector2d* plane_points, const Ei
   return pose;
 }
 
-Result<TagPose> EstimateTagPose(const Eigen::Vector2d (&apriltag_corners)[4], double tag_size,
+Result<TagPose> EstimateTagPose(const Eigen::Vector2d (&corners_px)[4], double tag_size,
                                 const CameraIntrinsics& intrinsics, const PlanarPoseOptions& options) {
   if (!(tag_size > 0.0) || !std::isfinite(tag_size)) {
     return InvalidArgument("EstimateTagPose: tag size must be > 0, got " + std::to_string(tag_size));
@@ -200,16 +200,16 @@ Result<TagPose> EstimateTagPose(const Eigen::Vector2d (&apriltag_corners)[4], do
   const std::array<Eigen::Vector3d, 4> corners = TagCornersInTagFrame(tag_size);
   const Eigen::Vector2d plane[4] = {corners[0].head<2>(), corners[1].head<2>(), corners[2].head<2>(),
                                     corners[3].head<2>()};
-  return EstimatePlanarPose(plane, apriltag_corners, 4, intrinsics, options);
+  return EstimatePlanarPose(plane, corners_px, 4, intrinsics, options);
 }
 
-double RefinePoseOnPoints(const Eigen::Vector3d* world_points, const Eigen::Vector2d* apriltag_pixels, int count,
+double RefinePoseOnPoints(const Eigen::Vector3d* world_points, const Eigen::Vector2d* pixels, int count,
                           const CameraIntrinsics& intrinsics, const NormalLmOptions& lm, Rigid3* cam_from_world) {
   if (count < 1 || count > kMaxRefinementPoints || !intrinsics.valid()) {
     return std::numeric_limits<double>::infinity();
   }
   Eigen::Vector2d normalized[kMaxRefinementPoints];
-  for (int i = 0; i < count; ++i) normalized[i] = intrinsics.Unproject(ToIntrinsicsPixel(apriltag_pixels[i]));
+  for (int i = 0; i < count; ++i) normalized[i] = intrinsics.Unproject(pixels[i]);
   if (count >= 4) RefineOnNormalized(world_points, normalized, count, intrinsics, lm, cam_from_world);
   return RmsNormalized(*cam_from_world, world_points, normalized, count, intrinsics.fx, intrinsics.fy);
 }

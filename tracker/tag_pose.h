@@ -13,10 +13,9 @@
 // libapriltag's corners p[0..3] are (-s/2,-s/2,0), (s/2,-s/2,0), (s/2,s/2,0), (-s/2,s/2,0). This is
 // libapriltag's estimate_tag_pose frame (x right, y down, z into the tag) rotated 180 deg about x.
 //
-// Pixels: the functions taking "apriltag pixels" expect libapriltag's convention (centre of the
-// top-left pixel at (0.5, 0.5), see tag_detector.h) and convert with ToIntrinsicsPixel before
-// unprojecting with CameraIntrinsics (centre of the top-left pixel at (0, 0)). Reprojection errors
-// are in pixels, measured after undistortion (|fx, fy scaled normalised error|).
+// Pixels: in the program's one convention (CameraIntrinsics: centre of the top-left pixel at
+// (0, 0)), the convention TagDetection corners already come in (tag_detector.h converts once).
+// Reprojection errors are in pixels, measured after undistortion (|fx, fy scaled normalised error|).
 #include <array>
 
 #include <Eigen/Core>
@@ -27,14 +26,6 @@
 #include "core/math/rigid3.h"
 
 namespace reconar {
-
-// libapriltag pixel convention -> CameraIntrinsics pixel convention, and back.
-inline Eigen::Vector2d ToIntrinsicsPixel(const Eigen::Vector2d& apriltag_pixel) {
-  return apriltag_pixel - Eigen::Vector2d(0.5, 0.5);
-}
-inline Eigen::Vector2d ToAprilTagPixel(const Eigen::Vector2d& intrinsics_pixel) {
-  return intrinsics_pixel + Eigen::Vector2d(0.5, 0.5);
-}
 
 // The 4 corners of a tag of edge `tag_size` (edge of the black square) in the tag frame, in
 // libapriltag's corner order.
@@ -72,23 +63,23 @@ struct TagPose {
 };
 
 // Pose of a plane from count >= 4 points: plane_points (x, y, 0) in the plane frame and their
-// pixels in libapriltag's convention. InvalidArgument for bad intrinsics/options or count < 4;
+// pixels (TagDetection corners). InvalidArgument for bad intrinsics/options or count < 4;
 // FailedPrecondition when the points are degenerate or neither candidate puts them in front of
 // the camera. No heap allocation on success.
-Result<TagPose> EstimatePlanarPose(const Eigen::Vector2d* plane_points, const Eigen::Vector2d* apriltag_pixels,
-                                   int count, const CameraIntrinsics& intrinsics,
+Result<TagPose> EstimatePlanarPose(const Eigen::Vector2d* plane_points, const Eigen::Vector2d* pixels, int count,
+                                   const CameraIntrinsics& intrinsics,
                                    const PlanarPoseOptions& options = PlanarPoseOptions());
 
 // EstimatePlanarPose on the 4 corners of one tag of edge tag_size (metres, > 0).
-Result<TagPose> EstimateTagPose(const Eigen::Vector2d (&apriltag_corners)[4], double tag_size,
+Result<TagPose> EstimateTagPose(const Eigen::Vector2d (&corners_px)[4], double tag_size,
                                 const CameraIntrinsics& intrinsics,
                                 const PlanarPoseOptions& options = PlanarPoseOptions());
 
-// Refines cam_from_world on the pixel reprojection error of count points (world_points, pixels in
-// libapriltag's convention) with LM (trivial loss); returns the RMS error in pixels afterwards.
+// Refines cam_from_world on the pixel reprojection error of count points (world_points and their
+// pixels) with LM (trivial loss); returns the RMS error in pixels afterwards.
 // count <= kMaxRefinementPoints; no heap allocation.
 inline constexpr int kMaxRefinementPoints = 512;
-double RefinePoseOnPoints(const Eigen::Vector3d* world_points, const Eigen::Vector2d* apriltag_pixels, int count,
+double RefinePoseOnPoints(const Eigen::Vector3d* world_points, const Eigen::Vector2d* pixels, int count,
                           const CameraIntrinsics& intrinsics, const NormalLmOptions& lm, Rigid3* cam_from_world);
 
 }  // namespace reconar

@@ -118,7 +118,7 @@ bool TagTracker::PredictRegion(FollowedTag& track, int width, int height, int re
     hi = hi.cwiseMax(track.detection.corners[k]);
     const Eigen::Vector3d X = predicted * corners[k];
     if (!(X.z() > 0.0)) return false;
-    projected[k] = ToAprilTagPixel(options_.intrinsics.Project(X));
+    projected[k] = options_.intrinsics.Project(X);
     if (!projected[k].allFinite()) return false;
     lo = lo.cwiseMin(projected[k]);
     hi = hi.cwiseMax(projected[k]);
@@ -129,10 +129,12 @@ bool TagTracker::PredictRegion(FollowedTag& track, int width, int height, int re
                                   (track.detection.corners[(k + 1) % 4] - track.detection.corners[k]).norm()});
   }
   const double margin = options_.region_margin * (hi - lo).maxCoeff() + options_.region_margin_px;
-  const double x0 = std::max(0.0, std::floor(lo.x() - margin));
-  const double y0 = std::max(0.0, std::floor(lo.y() - margin));
-  const double x1 = std::min(static_cast<double>(width), std::ceil(hi.x() + margin));
-  const double y1 = std::min(static_cast<double>(height), std::ceil(hi.y() + margin));
+  // Pixel centres sit on integers, so pixel i covers [i - 0.5, i + 0.5]: the box's pixel edges are
+  // lo + 0.5 and hi + 0.5 in pixel-index units.
+  const double x0 = std::max(0.0, std::floor(lo.x() + 0.5 - margin));
+  const double y0 = std::max(0.0, std::floor(lo.y() + 0.5 - margin));
+  const double x1 = std::min(static_cast<double>(width), std::ceil(hi.x() + 0.5 + margin));
+  const double y1 = std::min(static_cast<double>(height), std::ceil(hi.y() + 0.5 + margin));
   // libapriltag needs a few pixels of white border around the tag; tiny regions cannot hold one.
   constexpr double kMinRegionSide = 16.0;
   if (!(x1 - x0 >= kMinRegionSide && y1 - y0 >= kMinRegionSide)) return false;

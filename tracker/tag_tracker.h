@@ -11,8 +11,8 @@
 // lost_after_missed_frames consecutive frames: still predicted and region-searched), kLost (missed
 // that many frames: only a full-frame search finds it again, reported as `reacquired`).
 //
-// Frames and pixels: see tag_pose.h and tag_detector.h (corners in libapriltag's convention, the
-// centre of the top-left pixel at (0.5, 0.5); cam_from_tag with the tag's z axis toward the viewer).
+// Frames and pixels: see tag_pose.h and tag_detector.h (corners in the program's convention, the
+// centre of the top-left pixel at (0, 0); cam_from_tag with the tag's z axis toward the viewer).
 //
 // Memory: every buffer (tracks, detection lists, the report's tag list) is sized at construction
 // from max_tags; Track() makes no heap allocation in our code in steady state (proved by

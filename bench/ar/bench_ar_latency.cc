@@ -1,8 +1,8 @@
 // AR latency per frame: tag tracking (TagTracker, 1 thread) + overlay rendering (background upload,
 // Stanford bunny standing on the tag, tag axes, readback) on a surfaceless EGL context, over the
-// 93 real frames of ../shared/data/apriltag_ar_video_id12, at 640x480 as recorded and at 1280x720
-// (frames upscaled bilinearly; K scaled with them). Frames are decoded up front: the figures are
-// what a live loop spends after the camera hands over a frame.
+// 93 real frames of ../shared/data/apriltag_ar_video_id12, at 640x480 as recorded and at 1280x960
+// (frames upscaled bilinearly; K by ScaleIntrinsicsToFrame, as the AR runtime scales it). Frames
+// are decoded up front: the figures are what a live loop spends after the camera hands over a frame.
 //   bench_ar_latency [repeats=3]
 #include <chrono>
 #include <cstdio>
@@ -14,6 +14,7 @@
 #include "core/io/image_io.h"
 #include "core/mesh/mesh_io.h"
 #include "platform/egl/egl_context.h"
+#include "render/ar/ar_project.h"
 #include "render/mesh_drawable.h"
 #include "render/model_placement.h"
 #include "render/overlay_renderer.h"
@@ -56,23 +57,17 @@ int Run(int repeats) {
               (*context)->renderer().c_str(), bunny->triangles.size(), repeats);
   std::printf("%-10s %10s %10s %14s %14s %8s\n", "size", "track", "render", "track+render", "p90 total", "tagged");
 
-  for (const auto& size : {std::pair<int, int>(640, 480), std::pair<int, int>(1280, 720)}) {
+  for (const auto& size : {std::pair<int, int>(640, 480), std::pair<int, int>(1280, 960)}) {
     const int width = size.first, height = size.second;
-    const double sx = width / 640.0, sy = height / 480.0;
     std::vector<Image<uint8_t>> rgb, gray;
     for (const Image<uint8_t>& frame : rgb_frames) {
       rgb.push_back(width == 640 ? frame : bench::ResizeBilinear(frame, width, height));
       gray.push_back(ToGray8(rgb.back()));
     }
-    const CameraIntrinsics camera = testing::ArVideoCamera();
-    TagTrackerOptions options;  // K scaled with the frames
-    options.intrinsics = camera;
-    options.intrinsics.width = width;
-    options.intrinsics.height = height;
-    options.intrinsics.fx = camera.fx * sx;
-    options.intrinsics.fy = camera.fy * sy;
-    options.intrinsics.cx = (camera.cx + 0.5) * sx - 0.5;
-    options.intrinsics.cy = (camera.cy + 0.5) * sy - 0.5;
+    auto scaled = ScaleIntrinsicsToFrame(testing::ArVideoCamera(), width, height);
+    if (!Check(scaled.ok() ? Status::Ok() : scaled.status())) return 1;
+    TagTrackerOptions options;
+    options.intrinsics = *scaled;
     options.tag_size = testing::kArVideoTagSize;
     OverlayRendererOptions render_options;
     render_options.width = width;

@@ -3,17 +3,16 @@
 //   (a) plain full-frame libapriltag with apriltag_detector_create() defaults (tag36h11, 1 thread),
 //   (b) our TagTracker with its defaults (1 thread; a fresh tracker per run, so its first frame is
 //       a full-frame search).
-// At 640x480 (as recorded) and at 1280x720 (the frames upscaled bilinearly, corners and K scaled
-// with them). Reports median ms/frame over the runs, the ratio (b)/(a), and each side's mean corner
-// error against corners.txt (upstream libapriltag, decimate 1).
+// At 640x480 (as recorded) and at 1280x960 (the frames upscaled bilinearly, corners scaled with
+// them, K by ScaleIntrinsicsToFrame as the AR runtime scales a photo camera to its video). Reports
+// median ms/frame over the runs, the ratio (b)/(a), and each side's mean corner error against
+// corners.txt (upstream libapriltag, decimate 1).
 //   bench_tracker [repeats=5]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -22,6 +21,7 @@
 
 #include "bench/common/bench_images.h"
 #include "core/io/image_io.h"
+#include "render/ar/ar_project.h"
 #include "tests/support/ar_video.h"
 #include "tracker/tag_tracker.h"
 
@@ -33,12 +33,12 @@ using reconar::bench::Median;
 
 struct Frame {
   Image<uint8_t> gray;
-  Eigen::Vector2d corners[4];  // reference, libapriltag pixel convention
+  Eigen::Vector2d corners[4];  // reference, the program's pixel convention (ReadArVideoFrames)
 };
 
-double MeanCornerError(const double (*p)[2], const Eigen::Vector2d (&ref)[4]) {
+double MeanCornerError(const Eigen::Vector2d (&corners)[4], const Eigen::Vector2d (&ref)[4]) {
   double sum = 0.0;
-  for (int k = 0; k < 4; ++k) sum += (Eigen::Vector2d(p[k][0], p[k][1]) - ref[k]).norm();
+  for (int k = 0; k < 4; ++k) sum += (corners[k] - ref[k]).norm();
   return sum / 4;
 }
 
@@ -65,7 +65,10 @@ RunResult RunPlain(const std::vector<Frame>& frames) {
       zarray_get(detections, i, &det);
       if (det->id != 12) continue;
       ++result.found;
-      error_sum += MeanCornerError(det->p, frame.corners);
+      // libapriltag's pixel convention to ours, as TagDetector converts.
+      Eigen::Vector2d corners[4];
+      for (int k = 0; k < 4; ++k) corners[k] = Eigen::Vector2d(det->p[k][0], det->p[k][1]) - Eigen::Vector2d(0.5, 0.5);
+      error_sum += MeanCornerError(corners, frame.corners);
     }
     apriltag_detections_destroy(detections);
   }
@@ -101,12 +104,7 @@ RunResult RunTracker(const std::vector<Frame>& frames, const reconar::CameraIntr
     for (const reconar::TrackedTag& t : report.tags) {
       if (t.id != 12 || !t.measured) continue;
       ++result.found;
-      double p[4][2];
-      for (int k = 0; k < 4; ++k) {
-        p[k][0] = t.detection.corners[k].x();
-        p[k][1] = t.detection.corners[k].y();
-      }
-      error_sum += MeanCornerError(p, frame.corners);
+      error_sum += MeanCornerError(t.detection.corners, frame.corners);
     }
     using Search = reconar::TagTrackerFrameReport::Search;
     breakdown->region_frames += report.search == Search::kRegions;
@@ -125,21 +123,16 @@ RunResult RunTracker(const std::vector<Frame>& frames, const reconar::CameraIntr
 
 int main(int argc, char** argv) {
   const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
-  const std::string dir = std::string(RECONAR_SHARED_DATA_DIR) + "/apriltag_ar_video_id12/";
-  std::ifstream list(dir + "corners.txt");
-  if (!list) {
-    std::fprintf(stderr, "%scorners.txt: cannot open\n", dir.c_str());
+  const std::vector<reconar::testing::ArVideoFrame> reference = reconar::testing::ReadArVideoFrames();
+  if (reference.empty()) {
+    std::fprintf(stderr, "%s/corners.txt: cannot open\n", reconar::testing::ArVideoDir().c_str());
     return 2;
   }
   std::vector<Frame> frames;
-  for (std::string line; std::getline(list, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    std::string name;
+  for (const reconar::testing::ArVideoFrame& entry : reference) {
     Frame frame;
-    fields >> name;
-    for (Eigen::Vector2d& c : frame.corners) fields >> c.x() >> c.y();
-    auto decoded = reconar::ReadImage(dir + "frames/" + name);
+    std::copy(entry.corners, entry.corners + 4, frame.corners);
+    auto decoded = reconar::ReadImage(reconar::testing::ArVideoDir() + "/frames/" + entry.name);
     if (!decoded.ok()) {
       std::fprintf(stderr, "%s\n", decoded.status().ToString().c_str());
       return 2;
@@ -151,8 +144,12 @@ int main(int argc, char** argv) {
 
   for (const int width : {640, 1280}) {
     std::vector<Frame> sized;
-    reconar::CameraIntrinsics sized_camera = camera;
-    const int height = width == 640 ? 480 : 720;
+    const int height = width * 3 / 4;
+    const auto sized_camera = reconar::ScaleIntrinsicsToFrame(camera, width, height);
+    if (!sized_camera.ok()) {
+      std::fprintf(stderr, "%s\n", sized_camera.status().ToString().c_str());
+      return 2;
+    }
     const double sx = width / 640.0, sy = height / 480.0;
     if (width == 640) {
       for (const Frame& f : frames) {
@@ -165,22 +162,19 @@ int main(int argc, char** argv) {
       for (const Frame& f : frames) {
         Frame scaled;
         scaled.gray = reconar::bench::ResizeBilinear(f.gray, width, height);
-        for (int k = 0; k < 4; ++k) scaled.corners[k] = Eigen::Vector2d(f.corners[k].x() * sx, f.corners[k].y() * sy);
+        // Pixel edges map to pixel edges: u' = (u + 0.5) * sx - 0.5 (pixel centres on integers).
+        for (int k = 0; k < 4; ++k) {
+          scaled.corners[k] = Eigen::Vector2d((f.corners[k].x() + 0.5) * sx - 0.5, (f.corners[k].y() + 0.5) * sy - 0.5);
+        }
         sized.push_back(std::move(scaled));
       }
-      sized_camera.width = width;
-      sized_camera.height = height;
-      sized_camera.fx *= sx;
-      sized_camera.fy *= sy;
-      sized_camera.cx = (camera.cx + 0.5) * sx - 0.5;
-      sized_camera.cy = (camera.cy + 0.5) * sy - 0.5;
     }
     std::vector<double> plain_ms, tracker_ms, ratios;
     RunResult plain, tracked;
     TrackerBreakdown breakdown;
     for (int r = 0; r < repeats; ++r) {
       plain = RunPlain(sized);
-      tracked = RunTracker(sized, sized_camera, &breakdown);
+      tracked = RunTracker(sized, *sized_camera, &breakdown);
       plain_ms.push_back(plain.ms_per_frame);
       tracker_ms.push_back(tracked.ms_per_frame);
       ratios.push_back(tracked.ms_per_frame / plain.ms_per_frame);

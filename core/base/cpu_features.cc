@@ -1,7 +1,5 @@
 #include "core/base/cpu_features.h"
 
-#include <algorithm>
-
 namespace reconar {
 namespace {
 
@@ -17,12 +15,6 @@ CpuFeatures DetectCpuFeatures() {
   features.neon = true;
 #endif
   return features;
-}
-
-// Filled only by namespace-scope initialisers (before main), read afterwards.
-std::vector<SimdDispatcher>& Dispatchers() {
-  static std::vector<SimdDispatcher> dispatchers;
-  return dispatchers;
 }
 
 }  // namespace
@@ -45,21 +37,6 @@ std::string CpuFeatureNames(const CpuFeatures& features) {
   add(features.avx512f, "avx512f");
   add(features.neon, "neon");
   return names.empty() ? "none" : names;
-}
-
-bool RegisterSimdDispatcher(SimdDispatcher dispatcher) {
-  Dispatchers().push_back(dispatcher);
-  return true;
-}
-
-std::vector<SimdKernelChoice> SelectedSimdKernels() {
-  std::vector<SimdKernelChoice> choices;
-  for (const SimdDispatcher& dispatcher : Dispatchers()) {
-    choices.push_back({dispatcher.name, dispatcher.selected_kernel()});
-  }
-  std::sort(choices.begin(), choices.end(),
-            [](const SimdKernelChoice& a, const SimdKernelChoice& b) { return a.dispatcher < b.dispatcher; });
-  return choices;
 }
 
 }  // namespace reconar

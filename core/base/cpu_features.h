@@ -1,11 +1,9 @@
 #pragma once
-// CPU-feature detection in one place, and the list of SIMD kernels the dispatchers selected.
-// Every SIMD dispatcher (descriptor distance in core/features, the SIFT kernel tables in
-// core/features/sift, the NCC kernel in core/mvs/pmvs) keeps its own kernel table but asks
-// HostCpuFeatures() whether the CPU runs a kernel, and registers itself here so that
-// `reconar --version` can say which kernel each one chose on this machine.
+// CPU-feature detection in one place. Every SIMD dispatcher (descriptor distance in core/features,
+// the SIFT kernel tables in core/features/sift, the NCC kernel in core/mvs/pmvs) keeps its own
+// kernel table but asks HostCpuFeatures() whether the CPU runs a kernel. Which kernel each one chose
+// is listed by SimdKernelReport() (core/pipeline/simd_kernels.h) for `reconar --version`.
 #include <string>
-#include <vector>
 
 namespace reconar {
 
@@ -23,23 +21,5 @@ struct CpuFeatures {
 const CpuFeatures& HostCpuFeatures();
 // The supported features, space-separated ("sse2 avx2 fma"); "none" when there are none.
 std::string CpuFeatureNames(const CpuFeatures& features);
-
-// A dispatcher: its name and a function returning the name of the kernel it selected.
-struct SimdDispatcher {
-  const char* name;
-  const char* (*selected_kernel)();
-};
-// Called once per dispatcher from a namespace-scope initialiser in the dispatcher's own file:
-//   const bool kRegistered = RegisterSimdDispatcher({"ncc", [] { return ActiveNccKernel().name; }});
-// Returns true so that it can initialise a constant.
-bool RegisterSimdDispatcher(SimdDispatcher dispatcher);
-
-struct SimdKernelChoice {
-  std::string dispatcher;  // e.g. "sift"
-  std::string kernel;      // e.g. "avx2"
-};
-// The kernel each dispatcher linked into this program selected, sorted by dispatcher name.
-// Asking runs the dispatchers' selection (it is cached by each dispatcher).
-std::vector<SimdKernelChoice> SelectedSimdKernels();
 
 }  // namespace reconar

@@ -63,9 +63,4 @@ const DescriptorDistanceKernel& ActiveDescriptorDistanceKernel() {
   return active;
 }
 
-namespace {
-[[maybe_unused]] const bool kRegistered =
-    RegisterSimdDispatcher({"descriptor_distance", [] { return ActiveDescriptorDistanceKernel().name; }});
-}  // namespace
-
 }  // namespace reconar

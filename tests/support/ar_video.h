@@ -1,7 +1,9 @@
 #pragma once
 // The recorded AR video of ../shared/data/apriltag_ar_video_id12 (SOURCE.txt): 93 frames 640x480 of
-// tag36h11 id 12, its camera matrix, tag size and reference corners (libapriltag decimate 1 output,
-// libapriltag's corner order and pixel convention: the centre of the top-left pixel at (0.5, 0.5)).
+// tag36h11 id 12, its camera matrix, tag size and reference corners (libapriltag decimate 1 output
+// in libapriltag's corner order; corners.txt has libapriltag's pixel convention, the centre of the
+// top-left pixel at (0.5, 0.5), and ReadArVideoFrames converts them to the program's, (0, 0), as
+// TagDetector does).
 // Header-only: used by tests and by the benchmarks.
 #include <fstream>
 #include <sstream>
@@ -32,7 +34,7 @@ inline CameraIntrinsics ArVideoCamera() {
 
 struct ArVideoFrame {
   std::string name;            // "frame0000.jpg"
-  Eigen::Vector2d corners[4];  // reference corners a..d
+  Eigen::Vector2d corners[4];  // reference corners a..d, the program's pixel convention
 };
 
 // corners.txt in file order; empty when the file cannot be read.
@@ -44,7 +46,10 @@ inline std::vector<ArVideoFrame> ReadArVideoFrames() {
     std::istringstream fields(line);
     ArVideoFrame frame;
     fields >> frame.name;
-    for (Eigen::Vector2d& c : frame.corners) fields >> c.x() >> c.y();
+    for (Eigen::Vector2d& c : frame.corners) {
+      fields >> c.x() >> c.y();
+      c -= Eigen::Vector2d(0.5, 0.5);
+    }
     if (fields) frames.push_back(frame);
   }
   return frames;

@@ -78,7 +78,7 @@ TEST(ArCli, TrackJsonOnRecordedVideoMatchesReferenceCornersAndPoses) {
       EXPECT_GT(translation.z(), 0.0) << name;
       EXPECT_LT(rotation.col(2).z(), 0.0) << name << ": the tag's z axis must face the camera";
       // The printed pose reprojects the tag's corners (tag frame (±s/2, ±s/2, 0)) onto the printed
-      // corners: libapriltag pixels are the intrinsics pixels + 0.5.
+      // corners (both in the program's pixel convention: the centre of the top-left pixel at (0, 0)).
       const double h = 0.07;
       const Eigen::Vector3d tag_corners[4] = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}};
       for (int k = 0; k < 4; ++k) {
@@ -86,7 +86,7 @@ TEST(ArCli, TrackJsonOnRecordedVideoMatchesReferenceCornersAndPoses) {
         corner_error_sum += (printed - reference.at(name)[k]).norm();
         ++corner_count;
         const Eigen::Vector3d cam = rotation * tag_corners[k] + translation;
-        const Eigen::Vector2d projected(823.8 * cam.x() / cam.z() + 304.8 + 0.5, 822.8 * cam.y() / cam.z() + 236.3 + 0.5);
+        const Eigen::Vector2d projected(823.8 * cam.x() / cam.z() + 304.8, 822.8 * cam.y() / cam.z() + 236.3);
         reprojection_sum += (projected - printed).norm();
       }
     }

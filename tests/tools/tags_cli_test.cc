@@ -4,12 +4,17 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <map>
+#include <set>
+#include <sstream>
 #include <string>
 
 #include "core/base/atomic_file.h"
+#include "core/base/json_reader.h"
 #include "core/io/image_io.h"
 #include "tests/support/run_command.h"
 #include "tracker/tag_detector.h"
@@ -115,6 +120,55 @@ TEST(TagsCli, BadArgumentsFailWithAClearMessageAndWriteNothing) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.output.find("unknown tag family"), std::string::npos) << run.output;
   EXPECT_EQ(RunCommand("ls " + dir + " | wc -l").output, "0\n");
+}
+
+// `reconar tags PHOTO --json` on a swatbotics photo lists the ids the dataset's groundtruth.txt
+// gives for it (a human-made list: "IMG_1369.JPG 11 13 19"), with the photo's size and the
+// corners inside it, in the program's pixel convention (centre of the top-left pixel at (0, 0)).
+TEST(TagsCli, JsonListsTheTagsInAPhoto) {
+  const std::string data = std::string(RECONAR_SHARED_DATA_DIR) + "/apriltag_swatbotics_mapping";
+  std::set<int> expected;
+  std::ifstream truth(data + "/groundtruth.txt");
+  for (std::string line; std::getline(truth, line);) {
+    std::istringstream fields(line);
+    std::string name;
+    fields >> name;
+    if (name != "IMG_1369.JPG") continue;
+    for (int id = 0; fields >> id;) expected.insert(id);
+  }
+  ASSERT_EQ(expected, (std::set<int>{11, 13, 19})) << "groundtruth.txt";
+  const auto run = RunReconar("tags " + data + "/IMG_1369.JPG --json", testing::StderrMode::kSeparate);
+  ASSERT_EQ(run.exit_code, 0) << run.error;
+  ASSERT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  auto json = ParseJson(run.output, "tags --json");
+  ASSERT_TRUE(json.ok()) << json.status().ToString();
+  EXPECT_EQ(json->Find("image")->string(), "IMG_1369.JPG");
+  EXPECT_EQ(json->Find("width")->number(), 816.0);
+  EXPECT_EQ(json->Find("height")->number(), 612.0);
+  const JsonValue& tags = *json->Find("tags");
+  std::set<int> found;
+  for (size_t i = 0; i < tags.size(); ++i) {
+    found.insert(static_cast<int>(tags[i].Find("id")->number()));
+    EXPECT_EQ(tags[i].Find("family")->string(), "tag36h11");
+    EXPECT_LE(tags[i].Find("hamming")->number(), 1.0);
+    EXPECT_GT(tags[i].Find("decision_margin")->number(), 0.0);
+    const JsonValue& corners = *tags[i].Find("corners");
+    ASSERT_EQ(corners.size(), 4u);
+    for (size_t k = 0; k < 4; ++k) {
+      EXPECT_GE(corners[k][0].number(), -0.5);
+      EXPECT_LE(corners[k][0].number(), 815.5);
+      EXPECT_GE(corners[k][1].number(), -0.5);
+      EXPECT_LE(corners[k][1].number(), 611.5);
+    }
+  }
+  EXPECT_EQ(found, expected);
+  EXPECT_EQ(tags.size(), expected.size());
+
+  // Without --json: one line per photo; a photo and sheet options together are a usage error.
+  const auto text = RunReconar("tags " + data + "/IMG_1369.JPG", testing::StderrMode::kSeparate);
+  EXPECT_EQ(text.exit_code, 0) << text.error;
+  EXPECT_EQ(text.output.rfind("IMG_1369.JPG 816x612: 3 tag(s)", 0), 0u) << text.output;
+  EXPECT_EQ(RunReconar("tags " + data + "/IMG_1369.JPG --ids 0").exit_code, 2);
 }
 
 }  // namespace

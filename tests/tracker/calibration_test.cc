@@ -44,8 +44,8 @@ struct SceneOptions {
 };
 
 // Each image sees `tags_per_image` tags at 0.6-1.6 m, spread over the field of view, each tilted
-// by a random angle in [min_tilt, max_tilt] about a random in-plane axis. Corners are reported in
-// libapriltag's convention (+0.5 px) as a detector would.
+// by a random angle in [min_tilt, max_tilt] about a random in-plane axis. Corners are in the
+// program's pixel convention, as TagDetector reports them.
 CalibrationObservations MakeScene(const CameraIntrinsics& k, const SceneOptions& options,
                                   std::vector<Rigid3>* cam_from_tags = nullptr) {
   std::mt19937 rng(options.seed);
@@ -85,7 +85,7 @@ CalibrationObservations MakeScene(const CameraIntrinsics& k, const SceneOptions&
       for (int c = 0; c < 4; ++c) {
         const Eigen::Vector2d p = k.Project(cam_from_tag * tag_corners[c]);
         inside = inside && p.x() > 0.0 && p.y() > 0.0 && p.x() < kWidth - 1 && p.y() < kHeight - 1;
-        tag.corners[c] = p + Eigen::Vector2d(noise(rng), noise(rng)) + Eigen::Vector2d::Constant(0.5);
+        tag.corners[c] = p + Eigen::Vector2d(noise(rng), noise(rng));
       }
       if (!inside) continue;
       image.tags.push_back(tag);
@@ -358,7 +358,7 @@ TEST(CalibrationTest, RigidLayoutSharesOneBoardPosePerImage) {
         const Eigen::Vector3d in_cam = cam_from_board * (pose * (scale * tag_corners[c]));
         const Eigen::Vector2d p = truth.Project(in_cam);
         inside = inside && in_cam.z() > 0.0 && p.x() > 0.0 && p.y() > 0.0 && p.x() < kWidth - 1 && p.y() < kHeight - 1;
-        tag.corners[c] = p + Eigen::Vector2d(noise(rng), noise(rng)) + Eigen::Vector2d::Constant(0.5);
+        tag.corners[c] = p + Eigen::Vector2d(noise(rng), noise(rng));
       }
       image.tags.push_back(tag);
     }

@@ -13,7 +13,7 @@ namespace reconar {
 namespace testing {
 namespace {
 
-// Pixel (libapriltag convention) from tag-plane point (X, Y, 1).
+// Pixel-edge coordinates (pixel (i, j) covers [i, i+1] x [j, j+1]) from tag-plane point (X, Y, 1).
 Eigen::Matrix3d PixelFromTagPlane(const SyntheticTag& tag, const CameraIntrinsics& camera) {
   Eigen::Matrix3d K;
   K << camera.fx, 0.0, camera.cx + 0.5, 0.0, camera.fy, camera.cy + 0.5, 0.0, 0.0, 1.0;
@@ -53,7 +53,7 @@ void GaussianBlur(double sigma, Image<uint8_t>* image) {
 std::array<Eigen::Vector2d, 4> ProjectedCorners(const SyntheticTag& tag, const CameraIntrinsics& camera) {
   const std::array<Eigen::Vector3d, 4> corners = TagCornersInTagFrame(tag.size);
   std::array<Eigen::Vector2d, 4> out;
-  for (int k = 0; k < 4; ++k) out[k] = ToAprilTagPixel(camera.Project(tag.cam_from_tag * corners[k]));
+  for (int k = 0; k < 4; ++k) out[k] = camera.Project(tag.cam_from_tag * corners[k]);
   return out;
 }
 

@@ -1,9 +1,9 @@
 #pragma once
 // Synthetic camera frames of AprilTags for the tracker tests: the real tag bitmap (RenderTagBitmap,
 // i.e. libapriltag's apriltag_to_image) seen by a pinhole camera (no distortion) at a known pose,
-// rendered with area coverage (supersampling) and an optional Gaussian blur. Pixel (i, j) covers
-// [i, i+1] x [j, j+1] in the coordinates of the corners returned here (libapriltag's convention,
-// tag_detector.h); CameraIntrinsics projections are shifted by +0.5 accordingly.
+// rendered with area coverage (supersampling) and an optional Gaussian blur. The corners returned
+// here are in the program's pixel convention (CameraIntrinsics, TagDetection: pixel (i, j) covers
+// [i - 0.5, i + 0.5] x [j - 0.5, j + 0.5]); the renderer samples in pixel-edge coordinates (+0.5).
 #include <array>
 #include <cstdint>
 
@@ -40,7 +40,7 @@ CameraIntrinsics TestCamera();
 Image<uint8_t> RenderTags(const SyntheticTag* tags, int count, const CameraIntrinsics& camera,
                           const SyntheticRenderOptions& options);
 
-// The tag's corners in libapriltag's order and pixel convention.
+// The tag's corners in libapriltag's order, in the program's pixel convention (as TagDetection).
 std::array<Eigen::Vector2d, 4> ProjectedCorners(const SyntheticTag& tag, const CameraIntrinsics& camera);
 
 }  // namespace testing

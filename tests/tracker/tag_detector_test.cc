@@ -78,9 +78,10 @@ TEST(TagDetectorTest, RejectsBadOptionsAndImages) {
   EXPECT_FALSE((*detector)->Detect(ImageView<const uint8_t>(4, 1, 2, pixels), &detections).ok());
 }
 
-// The corners libapriltag reports lie where a tag rendered with exact area coverage has its
-// corners when pixel (i, j) covers [i, i+1] x [j, j+1]: the centre of the top-left pixel is (0.5, 0.5).
-TEST(TagDetectorTest, CornersMatchTheRenderedTagInLibapriltagPixelConvention) {
+// The corners TagDetector reports lie where a tag rendered with exact area coverage has its corners
+// when the centre of the top-left pixel is (0, 0) (CameraIntrinsics' convention; libapriltag's own
+// (0.5, 0.5) is converted once, in TagDetector), with and without decimated quad search.
+TEST(TagDetectorTest, CornersMatchTheRenderedTagInOurPixelConvention) {
   const CameraIntrinsics camera = TestCamera();
   for (const float decimate : {1.0f, 2.0f}) {
     TagDetectorOptions options;
@@ -102,9 +103,9 @@ TEST(TagDetectorTest, CornersMatchTheRenderedTagInLibapriltagPixelConvention) {
       // libapriltag's line fit is biased by up to ~0.2 px when the edges run along the pixel grid
       // (angle 0; upstream issue #334 reports 0.125 px); tilted edges come within 0.07 px.
       EXPECT_LT(error, angle == 0.0 ? 0.25 : 0.1) << "angle " << angle << " decimate " << decimate;
-      // The other convention (pixel centres at integers) would be 0.5 * sqrt(2) px away.
+      // libapriltag's own convention (pixel centres at half-integers) would be 0.5 * sqrt(2) px away.
       std::array<Eigen::Vector2d, 4> shifted = expected;
-      for (Eigen::Vector2d& p : shifted) p -= Eigen::Vector2d(0.5, 0.5);
+      for (Eigen::Vector2d& p : shifted) p += Eigen::Vector2d(0.5, 0.5);
       EXPECT_GT(MeanCornerError(detections[0], shifted), 0.5);
       // The homography maps the ideal square (-1, 1), (1, 1), (1, -1), (-1, -1) to the corners.
       const Eigen::Vector2d ideal[4] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};

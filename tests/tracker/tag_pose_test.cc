@@ -72,7 +72,7 @@ TEST(TagPoseTest, IppeRecoversExactPosesAndRefinementKeepsThem) {
       const std::array<Eigen::Vector3d, 4> tag_corners = TagCornersInTagFrame(tag.size);
       for (int k = 0; k < 4; ++k) {
         plane[k] = tag_corners[k].head<2>();
-        normalized[k] = camera.Unproject(ToIntrinsicsPixel(corners[k]));
+        normalized[k] = camera.Unproject(corners[k]);
       }
       std::array<Rigid3, 2> candidates;
       ASSERT_EQ(IppePoses(plane, normalized, 4, &candidates), 2);
@@ -183,7 +183,8 @@ TEST(TagPoseTest, AgreesWithLibapriltagEstimateTagPose) {
     free(theirs.R);  // matd_destroy is not exported by Debian's libapriltag 3.3 (PLATFORM_NOTES)
     free(theirs.t);
     Eigen::Vector2d corners[4];
-    for (int k = 0; k < 4; ++k) corners[k] = Eigen::Vector2d(det->p[k][0], det->p[k][1]);
+    // As TagDetector does: libapriltag's corners to our convention.
+    for (int k = 0; k < 4; ++k) corners[k] = Eigen::Vector2d(det->p[k][0], det->p[k][1]) - Eigen::Vector2d(0.5, 0.5);
     apriltag_detections_destroy(detections);
     const Result<TagPose> ours = EstimateTagPose(corners, tag.size, camera);
     ASSERT_TRUE(ours.ok());

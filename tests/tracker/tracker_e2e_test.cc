@@ -292,7 +292,10 @@ TEST(TrackerE2eTest, UpstreamTestDataCornersMatchTheReference) {
       std::replace(text.begin(), text.end(), ')', ' ');
       std::istringstream fields(text);
       fields >> id;
-      for (Eigen::Vector2d& c : corners) fields >> c.x() >> c.y();
+      for (Eigen::Vector2d& c : corners) {
+        fields >> c.x() >> c.y();
+        c -= Eigen::Vector2d(0.5, 0.5);  // upstream's (libapriltag's) pixel convention to ours
+      }
       ++reference_count;
       ++in_image;
       // Upstream's test compares every coordinate at 0.1 px; the reference comes from v3.4.5, we

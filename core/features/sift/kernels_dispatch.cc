@@ -1,7 +1,5 @@
 #include "core/features/sift/kernels.h"
 
-#include "core/base/cpu_features.h"
-
 namespace reconar {
 
 std::vector<const SiftKernels*> AvailableSiftKernels() {
@@ -21,10 +19,6 @@ const SiftKernels& BestSiftKernels() {
   }();
   return *best;
 }
-
-namespace {
-[[maybe_unused]] const bool kRegistered = RegisterSimdDispatcher({"sift", [] { return BestSiftKernels().name; }});
-}  // namespace
 
 #if !defined(RECONAR_HAVE_AVX2)
 const SiftKernels* sift_internal::Avx2SiftKernels() { return nullptr; }

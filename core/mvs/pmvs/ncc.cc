@@ -56,11 +56,6 @@ const NccKernel& ActiveNccKernel() {
   return active;
 }
 
-namespace {
-[[maybe_unused]] const bool kRegistered =
-    RegisterSimdDispatcher({"ncc", [] { return ActiveNccKernel().name; }});
-}  // namespace
-
 bool NormalizeNccReference(float* values, int count, int padded_count, float min_std) {
   if (count <= 1) return false;
   double sum = 0.0, sum_squares = 0.0;

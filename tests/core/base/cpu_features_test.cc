@@ -28,17 +28,5 @@ TEST(CpuFeatures, Names) {
   EXPECT_EQ(CpuFeatureNames(features), "sse2 avx2 fma");
 }
 
-TEST(CpuFeatures, RegisteredDispatchersAreListedByName) {
-  const size_t before = SelectedSimdKernels().size();
-  RegisterSimdDispatcher({"zz_test", [] { return "scalar"; }});
-  RegisterSimdDispatcher({"aa_test", [] { return "wide"; }});
-  const std::vector<SimdKernelChoice> choices = SelectedSimdKernels();
-  ASSERT_EQ(choices.size(), before + 2);
-  EXPECT_EQ(choices.front().dispatcher, "aa_test");
-  EXPECT_EQ(choices.front().kernel, "wide");
-  EXPECT_EQ(choices.back().dispatcher, "zz_test");
-  EXPECT_EQ(choices.back().kernel, "scalar");
-}
-
 }  // namespace
 }  // namespace reconar
