@@ -16,7 +16,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/number_format.h"
 #include "core/geometry/homography_four_point.h"
-#include "core/math/normal_lm.h"
+#include "core/math/lm_loop.h"
 #include "tracker/tag_pose.h"
 
 namespace reconar {
@@ -365,75 +365,57 @@ State Plus(const State& x, const IntrinsicsParameterisation& param, const Eigen:
   return next;
 }
 
-double StateNorm(const State& x, const IntrinsicsParameterisation& param) {
-  double sq = (param.T.transpose() * x.intrinsics).squaredNorm();
-  for (const Rigid3& pose : x.poses) sq += pose.translation.squaredNorm();
-  return std::sqrt(sq);
-}
+// The joint refinement as a RunLm problem (core/math/lm_loop.h): the step from SolveSchur, the
+// step size over the free intrinsics and the pose translations.
+class Refinement {
+ public:
+  Refinement(const std::vector<Target>& targets, const IntrinsicsParameterisation& param,
+             const CalibrationOptions& options, State* x)
+      : targets_(targets), param_(param), options_(options), x_(x) {}
 
-// Levenberg-Marquardt with the trust region and the termination reasons of core/math/normal_lm.h
-// (NormalLmSolve's loop over the Schur-complement step of this problem's block structure).
-NormalLmSummary Refine(const std::vector<Target>& targets, const IntrinsicsParameterisation& param,
-                       const CalibrationOptions& options, State* x) {
-  using Termination = NormalLmSummary::Termination;
-  const NormalLmOptions lm;  // tolerances and radii shared with the other LM solvers
-  NormalLmSummary summary;
-  NormalEquations eq;
-  if (!Linearize(targets, param, options.loss, *x, &eq)) {
-    summary.termination = Termination::kNumericFailure;
-    return summary;
+  bool Linearize() { return reconar::Linearize(targets_, param_, options_.loss, *x_, &eq_); }
+  double Cost() const { return eq_.cost; }
+  double MaxGradient() const {
+    double max_gradient = eq_.g_intrinsics.size() > 0 ? eq_.g_intrinsics.cwiseAbs().maxCoeff() : 0.0;
+    for (const Vector6d& g : eq_.g_pose) max_gradient = std::max(max_gradient, g.cwiseAbs().maxCoeff());
+    return max_gradient;
   }
-  summary.initial_cost = eq.cost;
-  LmTrustRegion region(lm.initial_trust_region_radius);
-  Eigen::VectorXd d_intrinsics;
-  std::vector<Vector6d> d_poses;
-  NormalEquations trial;
-  summary.termination = Termination::kMaxIterations;
-  while (summary.iterations < options.max_iterations) {
-    double max_gradient = eq.g_intrinsics.size() > 0 ? eq.g_intrinsics.cwiseAbs().maxCoeff() : 0.0;
-    for (const Vector6d& g : eq.g_pose) max_gradient = std::max(max_gradient, g.cwiseAbs().maxCoeff());
-    if (max_gradient <= lm.gradient_tolerance) {
-      summary.termination = Termination::kGradientTolerance;
-      break;
-    }
-    ++summary.iterations;
-    double predicted = 0.0;
-    bool accepted = false;
-    if (SolveSchur(eq, region.radius(), lm.min_diagonal, &d_intrinsics, &d_poses, &predicted)) {
-      double step_sq = d_intrinsics.squaredNorm();
-      for (const Vector6d& dp : d_poses) step_sq += dp.tail<3>().squaredNorm();
-      if (std::sqrt(step_sq) <= lm.parameter_tolerance * (StateNorm(*x, param) + lm.parameter_tolerance)) {
-        summary.termination = Termination::kParameterTolerance;
-        break;
-      }
-      const State next = Plus(*x, param, d_intrinsics, d_poses);
-      if (predicted > 0.0 && Linearize(targets, param, options.loss, next, &trial)) {
-        const double gain = (eq.cost - trial.cost) / predicted;
-        if (gain > lm.min_relative_decrease) {
-          accepted = true;
-          const double change = eq.cost - trial.cost;
-          const double old_cost = eq.cost;
-          *x = next;
-          std::swap(eq, trial);
-          region.Accept(gain, lm.max_trust_region_radius);
-          if (std::abs(change) <= options.function_tolerance * old_cost) {
-            summary.termination = Termination::kFunctionTolerance;
-            break;
-          }
-        }
-      }
-    }
-    if (!accepted) {
-      region.Reject();
-      if (region.radius() < lm.min_trust_region_radius) {
-        summary.termination = Termination::kTrustRegionTooSmall;
-        break;
-      }
-    }
+  bool SolveStep(double radius) {
+    return SolveSchur(eq_, radius, options_.lm.min_diagonal, &d_intrinsics_, &d_poses_, &predicted_);
   }
-  summary.final_cost = eq.cost;
-  return summary;
-}
+  double StepNorm() const {
+    double step_sq = d_intrinsics_.squaredNorm();
+    for (const Vector6d& dp : d_poses_) step_sq += dp.tail<3>().squaredNorm();
+    return std::sqrt(step_sq);
+  }
+  double StateNorm() const {
+    double sq = (param_.T.transpose() * x_->intrinsics).squaredNorm();
+    for (const Rigid3& pose : x_->poses) sq += pose.translation.squaredNorm();
+    return std::sqrt(sq);
+  }
+  double PredictedReduction() const { return predicted_; }
+  bool EvaluateStep(double* cost) {
+    next_ = Plus(*x_, param_, d_intrinsics_, d_poses_);
+    const bool ok = reconar::Linearize(targets_, param_, options_.loss, next_, &trial_);
+    *cost = trial_.cost;
+    return ok;
+  }
+  void AcceptStep() {
+    *x_ = next_;
+    std::swap(eq_, trial_);
+  }
+
+ private:
+  const std::vector<Target>& targets_;
+  const IntrinsicsParameterisation& param_;
+  const CalibrationOptions& options_;
+  State* x_;
+  State next_;
+  NormalEquations eq_, trial_;
+  Eigen::VectorXd d_intrinsics_;
+  std::vector<Vector6d> d_poses_;
+  double predicted_ = 0.0;
+};
 
 // Squared pixel errors of every corner of every target.
 std::vector<std::vector<double>> SquaredErrors(const std::vector<Target>& targets, const State& x) {
@@ -494,8 +476,7 @@ Status CalibrationOptions::Check() const {
     return InvalidArgument("CalibrationOptions: aspect_ratio must be positive");
   }
   if (estimate_k2 && !estimate_k1) return InvalidArgument("CalibrationOptions: estimate_k2 needs estimate_k1");
-  if (max_iterations < 0) return InvalidArgument("CalibrationOptions: max_iterations must be >= 0");
-  if (!(function_tolerance >= 0.0)) return InvalidArgument("CalibrationOptions: function_tolerance must be >= 0");
+  RECONAR_RETURN_IF_ERROR(lm.Check().WithContext("CalibrationOptions.lm"));
   if (!(loss.scale > 0.0) || !std::isfinite(loss.scale)) {
     return InvalidArgument("CalibrationOptions: loss.scale must be positive");
   }
@@ -652,8 +633,9 @@ Result<CalibrationReport> CalibrateIntrinsics(const CalibrationObservations& obs
     x.intrinsics(kCy) = norm.centre.y();
   }
   const IntrinsicsParameterisation param = IntrinsicsParameterisation::From(options);
-  const NormalLmSummary summary = Refine(targets, param, options, &x);
-  if (summary.termination == NormalLmSummary::Termination::kNumericFailure) {
+  Refinement refinement(targets, param, options, &x);
+  const LmSummary summary = RunLm(refinement, options.lm);
+  if (summary.termination == LmTermination::kNumericFailure) {
     return NumericFailure("calibration: the reprojection error is not finite at the initial estimate");
   }
   report.iterations = summary.iterations;

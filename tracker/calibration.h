@@ -14,8 +14,8 @@
 //     explains all of the image's board corners.
 //  4. Joint Levenberg-Marquardt refinement of (fx, fy, cx, cy, k1, k2) and every target pose on the
 //     robustly weighted pixel reprojection error (core/math/robust_loss.h), the poses eliminated
-//     by the Schur complement (each pose block 6x6, independent of the others), the trust region
-//     of core/math/normal_lm.h. Parameter standard deviations come from the inverse of the reduced
+//     by the Schur complement (each pose block 6x6, independent of the others), the LM loop of
+//     core/math/lm_loop.h. Parameter standard deviations come from the inverse of the reduced
 //     (intrinsics) Gauss-Newton matrix scaled by the residual variance.
 //
 // Conventions.
@@ -34,7 +34,7 @@
 
 #include "core/base/status.h"
 #include "core/math/camera_intrinsics.h"
-#include "core/math/normal_lm.h"
+#include "core/math/lm_loop.h"
 #include "core/math/rigid3.h"
 #include "core/math/robust_loss.h"
 #include "tracker/tag_detector.h"
@@ -73,9 +73,14 @@ struct CalibrationOptions {
   double aspect_ratio = 1.0;         // used with fix_aspect_ratio
   bool estimate_k1 = true;           // otherwise k1 = 0
   bool estimate_k2 = true;           // otherwise k2 = 0; needs estimate_k1
-  int max_iterations = 200;          // LM iterations, accepted and rejected steps both count
-  // LM stops when an accepted step changes the cost by <= function_tolerance * cost.
-  double function_tolerance = 1e-9;
+  // The refinement's LM settings (core/math/lm_loop.h): at most 200 iterations, and a stop when an
+  // accepted step changes the cost by <= 1e-9 * cost.
+  LmOptions lm = [] {
+    LmOptions defaults;
+    defaults.max_iterations = 200;
+    defaults.function_tolerance = 1e-9;
+    return defaults;
+  }();
   RobustLoss loss{LossType::kHuber, 1.0};  // on the pixel reprojection error of each corner
   // Least number of targets (tag instances or board views) and of distinct images.
   int min_targets = 3;
@@ -122,9 +127,9 @@ struct CalibrationReport {
   int num_targets = 0;
   int num_corners = 0;
   int iterations = 0;
-  // Why the LM stopped (core/math/normal_lm.h); never kNumericFailure in a returned report.
-  NormalLmSummary::Termination termination = NormalLmSummary::Termination::kMaxIterations;
-  bool converged = false;  // LM stopped on a tolerance (not max_iterations or a collapsed trust region)
+  // Why the LM stopped (core/math/lm_loop.h); never kNumericFailure in a returned report.
+  LmTermination termination = LmTermination::kMaxIterations;
+  bool converged = false;  // LmConverged(termination): stopped on a tolerance, for the JSON report
   bool principal_point_from_closed_form = false;  // false: the closed form fixed it at the centre
   double constraint_ratio = 0.0;  // of the closed form that was used (see min_constraint_ratio)
   CameraIntrinsics closed_form;  // the initial estimate (k1 = k2 = 0)

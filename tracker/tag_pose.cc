@@ -146,10 +146,7 @@ double RmsReprojectionErrorPx(const Rigid3& cam_from_world, const Eigen::Vector3
   return RmsNormalized(cam_from_world, world_points, normalized, count, intrinsics.fx, intrinsics.fy);
 }
 
-Status PlanarPoseOptions::Check() const {
-  if (lm.max_iterations < 0) return InvalidArgument("PlanarPoseOptions.lm.max_iterations must be >= 0");
-  return Status::Ok();
-}
+Status PlanarPoseOptions::Check() const { return lm.Check().WithContext("PlanarPoseOptions.lm"); }
 
 Result<TagPose> EstimatePlanarPose(const Eigen::Vector2d* plane_points, const Eigen::Vector2d* pixels, int count,
                                    const CameraIntrinsics& intrinsics, const PlanarPoseOptions& options) {

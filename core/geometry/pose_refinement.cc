@@ -141,16 +141,7 @@ Status PoseRefinementOptions::Check() const {
     return InvalidArgument("PoseRefinementOptions.loss_scale_px must be positive and finite, got " +
                            std::to_string(loss_scale_px));
   }
-  if (lm.max_iterations < 0) {
-    return InvalidArgument("PoseRefinementOptions.lm.max_iterations must be >= 0, got " +
-                           std::to_string(lm.max_iterations));
-  }
-  if (!(lm.initial_trust_region_radius > 0.0) || !(lm.min_relative_decrease >= 0.0) || !(lm.min_diagonal > 0.0) ||
-      !(lm.function_tolerance >= 0.0) || !(lm.gradient_tolerance >= 0.0) || !(lm.parameter_tolerance >= 0.0)) {
-    return InvalidArgument(
-        "PoseRefinementOptions.lm: tolerances must be >= 0, initial_trust_region_radius and min_diagonal > 0");
-  }
-  return Status::Ok();
+  return lm.Check().WithContext("PoseRefinementOptions.lm");
 }
 
 NormalLmSummary RefineAbsolutePoseInPlace(const Eigen::Vector2d* points_px, const Eigen::Vector3d* world_points,

@@ -9,8 +9,8 @@
 // top-left pixel is (0, 0). A camera point X maps to
 //   p = X.xy / X.z (the "normalised" point),  d(r2) = 1 + k1 r2 + k2 r2^2 with r2 = |p|^2,
 //   u = f d p.x + cx,  v = a f d p.y + cy      (fx = f, fy = a f).
-// The bundle adjuster evaluates the same model with analytic Jacobians over its parameter block
-// in core/optim/radial_camera_model.h (checked against this one in tests/core/math).
+// The bundle adjuster projects through this model too (PixelFromNormalised and its Jacobian) over
+// its parameter block, in core/optim/radial_camera_model.h.
 #include <Eigen/Core>
 #include <cmath>
 

@@ -31,6 +31,30 @@ inline void RodriguesCoefficients(double theta2, double* a, double* b, double* c
   }
 }
 
+// X rotated by the angle-axis vector w (Rodrigues' formula, R(w) X = X + a w x X + b w x (w x X)),
+// with the coefficients its Jacobians need; shared by the BAL and the radial parameter blocks.
+struct AngleAxisRotation {
+  AngleAxisRotation(const Eigen::Vector3d& angle_axis, const Eigen::Vector3d& x) : w(angle_axis) {
+    RodriguesCoefficients(w.squaredNorm(), &a, &b, &c);
+    const Eigen::Vector3d wx = w.cross(x);
+    rx = x + a * wx + b * w.cross(wx);
+  }
+
+  // d(R(w) X) / dw = -[R(w) X]x J_l(w).
+  Eigen::Matrix3d JacobianWrtAngleAxis() const {
+    const Eigen::Matrix3d wxm = Skew(w);
+    const Eigen::Matrix3d jl = Eigen::Matrix3d::Identity() + b * wxm + c * wxm * wxm;
+    return -Skew(rx) * jl;
+  }
+
+  // d(R(w) X) / dX = R(w).
+  Eigen::Matrix3d Matrix() const { return Eigen::Matrix3d::Identity() + a * Skew(w) + b * Skew(w) * Skew(w); }
+
+  Eigen::Vector3d w;
+  double a = 0.0, b = 0.0, c = 0.0;  // RodriguesCoefficients of |w|^2
+  Eigen::Vector3d rx;                // R(w) X
+};
+
 // Projects `point` (3 doubles) with `camera` (9 doubles) into predicted[2]. When jac_camera
 // (2x9, row-major) or jac_point (2x3, row-major) are non-null, fills d predicted / d params.
 // Returns false when the point lies on the camera plane (P.z == 0); outputs are then undefined.
@@ -41,11 +65,8 @@ inline bool ProjectBal(const double* camera, const double* point, double* predic
   const double f = camera[6], k1 = camera[7], k2 = camera[8];
   const Eigen::Map<const Eigen::Vector3d> x(point);
 
-  double a, b, c;
-  RodriguesCoefficients(w.squaredNorm(), &a, &b, &c);
-  const Eigen::Vector3d wx = w.cross(x);
-  const Eigen::Vector3d rx = x + a * wx + b * w.cross(wx);  // R(w) X
-  const Eigen::Vector3d p3 = rx + t;
+  const AngleAxisRotation rotation(w, x);
+  const Eigen::Vector3d p3 = rotation.rx + t;
   if (p3.z() == 0.0) return false;
   const double inv_z = 1.0 / p3.z();
   const double px = -p3.x() * inv_z, py = -p3.y() * inv_z;
@@ -65,9 +86,7 @@ inline bool ProjectBal(const double* camera, const double* point, double* predic
 
   if (jac_camera != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 2, 9, Eigen::RowMajor>> jc(jac_camera);
-    const Eigen::Matrix3d wxm = Skew(w);
-    const Eigen::Matrix3d jl = Eigen::Matrix3d::Identity() + b * wxm + c * wxm * wxm;
-    jc.block<2, 3>(0, 0) = du_dP * (-Skew(rx) * jl);
+    jc.block<2, 3>(0, 0) = du_dP * rotation.JacobianWrtAngleAxis();
     jc.block<2, 3>(0, 3) = du_dP;
     jc(0, 6) = d * px;
     jc(1, 6) = d * py;
@@ -77,9 +96,8 @@ inline bool ProjectBal(const double* camera, const double* point, double* predic
     jc(1, 8) = f * r2 * r2 * py;
   }
   if (jac_point != nullptr) {
-    const Eigen::Matrix3d rot = Eigen::Matrix3d::Identity() + a * Skew(w) + b * Skew(w) * Skew(w);
     Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jp(jac_point);
-    jp = du_dP * rot;
+    jp = du_dP * rotation.Matrix();
   }
   return true;
 }

@@ -16,7 +16,7 @@
 #include <memory>
 
 #include "core/base/thread_pool.h"
-#include "core/math/normal_lm.h"
+#include "core/math/lm_loop.h"
 #include "core/optim/bal_camera_model.h"
 #include "core/optim/cholmod_ldlt.h"
 #include "core/optim/radial_camera_model.h"
@@ -43,7 +43,6 @@ constexpr int kP = 3;
 using Mat33 = Eigen::Matrix<double, kP, kP>;
 using Mat23 = Eigen::Matrix<double, 2, kP, Eigen::RowMajor>;
 using Vec3 = Eigen::Vector3d;
-using Termination = BundleAdjustmentSummary::Termination;
 // The 9x9 block products below use lazyProduct: with 9 + 9 + depth >= 20 Eigen would otherwise
 // route these fixed-size products through its general (blocked GEMM) kernel, which costs more
 // than the arithmetic at this size.
@@ -130,71 +129,50 @@ class Solver {
     if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
   }
 
-  BundleAdjustmentSummary Run() {
-    BundleAdjustmentSummary summary;
-    Linearize();
-    summary.initial_cost = cost_;
-    summary.final_cost = cost_;
-    if (!std::isfinite(cost_)) {
-      summary.termination = Termination::kNumericFailure;
-      return summary;
+  // The RunLm problem (core/math/lm_loop.h). The damping lambda = 1 / radius multiplies the
+  // clamped diagonals; a trial step is judged by its cost alone and linearised once accepted.
+  bool Linearize() {
+    BuildNormalEquations();
+    return std::isfinite(cost_);
+  }
+  double Cost() const { return cost_; }
+  double MaxGradient() const {
+    double m = 0.0;
+    for (const Vec9& g : gc_) m = std::max(m, g.cwiseAbs().maxCoeff());
+    for (const Vec3& g : gp_) m = std::max(m, g.cwiseAbs().maxCoeff());
+    return m;
+  }
+
+  bool SolveStep(double radius) {
+    lambda_ = 1.0 / radius;
+    return SolveSchur(lambda_);
+  }
+  double StepNorm() const { return std::sqrt(step_c_.squaredNorm() + StepPointSquaredNorm()); }
+  double StateNorm() const { return std::sqrt(SquaredNorm(problem_->cameras) + SquaredNorm(problem_->points)); }
+  // L(0) - L(dx) for the model L(dx) = 1/2 |r + J dx|^2. Since (J^T J + lambda D) dx = -g,
+  // this equals 1/2 (lambda dx^T D dx - g^T dx).
+  double PredictedReduction() const {
+    double s = 0.0;
+    for (int i = 0; i < nc_; ++i) {
+      const auto d = step_c_.segment<kC>(kC * i);
+      s += lambda_ * d.dot(dc_diag_[static_cast<size_t>(i)].cwiseProduct(d)) - gc_[static_cast<size_t>(i)].dot(d);
     }
-    LmTrustRegion region(opt_.initial_trust_region_radius);
-    int numeric_failures = 0;
-    summary.termination = Termination::kMaxIterations;
-    while (true) {
-      if (MaxGradient() <= opt_.gradient_tolerance) {
-        summary.termination = Termination::kGradientTolerance;
-        break;
-      }
-      if (summary.iterations >= opt_.max_iterations) {
-        summary.termination = Termination::kMaxIterations;
-        break;
-      }
-      ++summary.iterations;
-      const double lambda = 1.0 / region.radius();
-      if (!SolveStep(lambda)) {
-        if (++numeric_failures >= opt_.max_consecutive_numeric_failures) {
-          summary.termination = Termination::kNumericFailure;
-          break;
-        }
-        region.Reject();
-        continue;
-      }
-      numeric_failures = 0;
-      const double x_norm =
-          std::sqrt(SquaredNorm(problem_->cameras) + SquaredNorm(problem_->points));
-      const double step_norm = std::sqrt(step_c_.squaredNorm() + StepPointSquaredNorm());
-      if (step_norm <= opt_.parameter_tolerance * (x_norm + opt_.parameter_tolerance)) {
-        summary.termination = Termination::kParameterTolerance;
-        break;
-      }
-      const double predicted = PredictedReduction(lambda);
-      ApplyStep();
-      const double new_cost = EvaluateCost(cand_cameras_, cand_points_);
-      const double gain = (cost_ - new_cost) / predicted;
-      if (std::isfinite(new_cost) && predicted > 0.0 && gain > opt_.min_relative_decrease) {
-        const double change = cost_ - new_cost;
-        problem_->cameras.swap(cand_cameras_);
-        problem_->points.swap(cand_points_);
-        ++summary.accepted_steps;
-        const double old_cost = cost_;
-        Linearize();
-        region.Accept(gain, opt_.max_trust_region_radius);
-        if (std::abs(change) <= opt_.function_tolerance * old_cost) {
-          summary.termination = Termination::kFunctionTolerance;
-          break;
-        }
-      } else {
-        region.Reject();
-        if (region.radius() < opt_.min_trust_region_radius) {
-          summary.termination = Termination::kTrustRegionTooSmall;
-          break;
-        }
-      }
+    for (int j = 0; j < np_; ++j) {
+      const Vec3& d = step_p_[static_cast<size_t>(j)];
+      s += lambda_ * d.dot(dp_diag_[static_cast<size_t>(j)].cwiseProduct(d)) - gp_[static_cast<size_t>(j)].dot(d);
     }
-    summary.final_cost = cost_;
-    return summary;
+    return 0.5 * s;
+  }
+
+  bool EvaluateStep(double* cost) {
+    ApplyStep();
+    *cost = EvaluateCost(cand_cameras_, cand_points_);
+    return true;
+  }
+  void AcceptStep() {
+    problem_->cameras.swap(cand_cameras_);
+    problem_->points.swap(cand_points_);
+    BuildNormalEquations();
   }
 
  private:
@@ -230,7 +208,7 @@ class Solver {
   }
 
   // Residuals, robust weights, Jacobians, cost, and the blocks of J^T J and J^T r.
-  void Linearize() {
+  void BuildNormalEquations() {
     const std::vector<BalObservation>& obs = problem_->observations;
     ParallelRange(no_, 512, [this, &obs](int begin, int end) {
       for (int k = begin; k < end; ++k) {
@@ -300,17 +278,10 @@ class Solver {
     });
   }
 
-  double MaxGradient() const {
-    double m = 0.0;
-    for (const Vec9& g : gc_) m = std::max(m, g.cwiseAbs().maxCoeff());
-    for (const Vec3& g : gp_) m = std::max(m, g.cwiseAbs().maxCoeff());
-    return m;
-  }
-
   // Solves (J^T J + lambda D) dx = -J^T r by eliminating the points: with U, V, W the camera,
   // point and cross blocks, S = U - W V^-1 W^T, S dc = -gc + W V^-1 gp, then
   // dp = V^-1 (-gp - W^T dc). False if the Cholesky factorisation of S fails.
-  bool SolveStep(double lambda) {
+  bool SolveSchur(double lambda) {
     ParallelRange(np_, 256, [this, lambda](int begin, int end) {
       for (int j = begin; j < end; ++j) {
         Mat33& vinv = vinv_[static_cast<size_t>(j)];
@@ -460,23 +431,6 @@ class Solver {
     reduced_llt_->solveInPlace(rhs_reduced_);
     for (int a = 0; a < n; ++a) solution_[a] = rhs_reduced_[reduced_index_[static_cast<size_t>(a)]];
     return true;
-  }
-
-  // L(0) - L(dx) for the model L(dx) = 1/2 |r + J dx|^2. Since (J^T J + lambda D) dx = -g,
-  // this equals 1/2 (lambda dx^T D dx - g^T dx).
-  double PredictedReduction(double lambda) const {
-    double s = 0.0;
-    for (int i = 0; i < nc_; ++i) {
-      const auto d = step_c_.segment<kC>(kC * i);
-      s += lambda * d.dot(dc_diag_[static_cast<size_t>(i)].cwiseProduct(d)) -
-           gc_[static_cast<size_t>(i)].dot(d);
-    }
-    for (int j = 0; j < np_; ++j) {
-      const Vec3& d = step_p_[static_cast<size_t>(j)];
-      s += lambda * d.dot(dp_diag_[static_cast<size_t>(j)].cwiseProduct(d)) -
-           gp_[static_cast<size_t>(j)].dot(d);
-    }
-    return 0.5 * s;
   }
 
   void ApplyStep() {
@@ -675,6 +629,7 @@ class Solver {
   Eigen::VectorXd rhs_, step_c_, solution_;
   std::vector<double> cand_cameras_, cand_points_;
   double cost_ = 0.0;
+  double lambda_ = 0.0;  // damping of the last SolveStep
 
   std::unique_ptr<ThreadPool> pool_;
   void (*job_)(void*, int, int) = nullptr;
@@ -685,49 +640,10 @@ class Solver {
 
 }  // namespace
 
-const char* TerminationName(BundleAdjustmentSummary::Termination termination) {
-  switch (termination) {
-    case Termination::kFunctionTolerance:
-      return "function_tolerance";
-    case Termination::kGradientTolerance:
-      return "gradient_tolerance";
-    case Termination::kParameterTolerance:
-      return "parameter_tolerance";
-    case Termination::kMaxIterations:
-      return "max_iterations";
-    case Termination::kTrustRegionTooSmall:
-      return "trust_region_too_small";
-    case Termination::kNumericFailure:
-      return "numeric_failure";
-  }
-  return "unknown";
-}
-
 Status BundleAdjustmentOptions::Check() const {
-  if (max_iterations < 0) return InvalidArgument("BundleAdjustmentOptions: max_iterations < 0");
-  if (!(function_tolerance >= 0.0))
-    return InvalidArgument("BundleAdjustmentOptions: function_tolerance < 0");
-  if (!(gradient_tolerance >= 0.0))
-    return InvalidArgument("BundleAdjustmentOptions: gradient_tolerance < 0");
-  if (!(parameter_tolerance >= 0.0))
-    return InvalidArgument("BundleAdjustmentOptions: parameter_tolerance < 0");
-  if (!(initial_trust_region_radius > 0.0)) {
-    return InvalidArgument("BundleAdjustmentOptions: initial_trust_region_radius <= 0");
-  }
-  if (!(max_trust_region_radius >= initial_trust_region_radius)) {
-    return InvalidArgument("BundleAdjustmentOptions: max_trust_region_radius < initial");
-  }
-  if (!(min_trust_region_radius > 0.0)) {
-    return InvalidArgument("BundleAdjustmentOptions: min_trust_region_radius <= 0");
-  }
-  if (!(min_relative_decrease >= 0.0 && min_relative_decrease < 1.0)) {
-    return InvalidArgument("BundleAdjustmentOptions: min_relative_decrease not in [0, 1)");
-  }
-  if (!(min_diagonal > 0.0 && max_diagonal >= min_diagonal)) {
+  RECONAR_RETURN_IF_ERROR(LmOptions::Check().WithContext("BundleAdjustmentOptions"));
+  if (!(max_diagonal >= min_diagonal)) {
     return InvalidArgument("BundleAdjustmentOptions: need 0 < min_diagonal <= max_diagonal");
-  }
-  if (max_consecutive_numeric_failures < 1) {
-    return InvalidArgument("BundleAdjustmentOptions: max_consecutive_numeric_failures < 1");
   }
   if (!(loss.scale > 0.0)) return InvalidArgument("BundleAdjustmentOptions: loss.scale <= 0");
   return Status::Ok();
@@ -783,7 +699,8 @@ Result<BundleAdjustmentSummary> SolveImpl(const BundleAdjustmentOptions& options
   }
   const auto start = std::chrono::steady_clock::now();
   Solver<Model> solver(options, constancy, problem);
-  BundleAdjustmentSummary summary = solver.Run();
+  BundleAdjustmentSummary summary;
+  static_cast<LmSummary&>(summary) = RunLm(solver, options);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

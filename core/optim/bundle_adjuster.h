@@ -1,39 +1,32 @@
 #pragma once
 // Bundle adjustment of BAL problems: Levenberg-Marquardt with a trust-region radius update
-// (Nocedal & Wright, "Numerical Optimization", 2nd ed., ch. 4 and 10.3; Madsen, Nielsen &
-// Tingleff, "Methods for Non-Linear Least Squares Problems", 2004, sec. 3.2), Marquardt scaling
-// of the damping by diag(J^T J), analytic Jacobians (bal_camera_model.h), and the Schur
+// (the one LM loop, core/math/lm_loop.h: Nocedal & Wright, "Numerical Optimization", 2nd ed.,
+// ch. 4 and 10.3; Madsen, Nielsen & Tingleff, "Methods for Non-Linear Least Squares Problems",
+// 2004, sec. 3.2), Marquardt scaling of the damping by diag(J^T J), analytic Jacobians
+// (bal_camera_model.h, radial_camera_model.h), and the Schur
 // complement that eliminates the points (Triggs et al., "Bundle Adjustment - A Modern
 // Synthesis", 2000, sec. 6.1; Brown 1958). The reduced camera system is solved with a dense
 // Cholesky factorisation or, optionally, a block-sparse LDL^T.
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/math/lm_loop.h"
 #include "core/math/robust_loss.h"
 #include "core/optim/bal_problem.h"
 
 namespace reconar {
 
-struct BundleAdjustmentOptions {
-  int max_iterations = 100;  // LM iterations, accepted and rejected steps both count
-  // Stop when |cost_old - cost_new| <= function_tolerance * cost_old after an accepted step.
-  double function_tolerance = 1e-6;
-  // Stop when max_k |g_k| <= gradient_tolerance, g = J^T r on the free parameters.
-  double gradient_tolerance = 1e-10;
-  // Stop when |dx| <= parameter_tolerance * (|x| + parameter_tolerance).
-  double parameter_tolerance = 1e-8;
-  // Trust region radius Delta; the damping is diag(J^T J) / Delta (Marquardt 1963).
-  double initial_trust_region_radius = 1e4;
-  double max_trust_region_radius = 1e16;
-  double min_trust_region_radius = 1e-32;
-  // Steps with gain ratio rho = actual / predicted reduction below this are rejected.
-  double min_relative_decrease = 1e-3;
+// The LM settings (core/math/lm_loop.h) with the bundle adjuster's defaults, and its own.
+struct BundleAdjustmentOptions : LmOptions {
+  BundleAdjustmentOptions() {
+    max_iterations = 100;
+    function_tolerance = 1e-6;
+    gradient_tolerance = 1e-10;  // on g = J^T r over the free parameters
+    parameter_tolerance = 1e-8;
+    max_consecutive_numeric_failures = 5;  // failed Cholesky factorisations of the reduced system
+  }
   // diag(J^T J) is clamped to [min_diagonal, max_diagonal] before scaling the damping.
-  double min_diagonal = 1e-6;
   double max_diagonal = 1e32;
-  // Consecutive failed Cholesky factorisations tolerated (each shrinks the radius) before
-  // giving up with kNumericFailure.
-  int max_consecutive_numeric_failures = 5;
   RobustLoss loss;
   // Solver of the reduced camera system S dc = b (S is 9 * cameras square).
   enum class LinearSolver {
@@ -49,32 +42,13 @@ struct BundleAdjustmentOptions {
   Status Check() const;
 };
 
-struct BundleAdjustmentSummary {
-  enum class Termination {
-    kFunctionTolerance,    // an accepted step changed the cost by <= function_tolerance * cost
-    kGradientTolerance,    // max |J^T r| over free parameters <= gradient_tolerance
-    kParameterTolerance,   // |dx| <= parameter_tolerance * (|x| + parameter_tolerance)
-    kMaxIterations,        // max_iterations LM iterations ran without another criterion
-    kTrustRegionTooSmall,  // the radius shrank below min_trust_region_radius (no progress)
-    kNumericFailure,       // the initial cost is not finite, or the Cholesky factorisation of
-                           // the reduced camera system failed (or gave a non-finite step)
-                           // max_consecutive_numeric_failures times in a row
-  };
-  Termination termination = Termination::kMaxIterations;
-  double initial_cost = 0.0;  // 1/2 sum rho(|r|^2) at the start
-  double final_cost = 0.0;    // same at the returned parameters
-  int iterations = 0;         // LM iterations run (accepted + rejected)
-  int accepted_steps = 0;
+// RunLm's summary (termination, costs 1/2 sum rho(|r|^2), iterations, accepted steps); the
+// kNumericFailure of the bundle adjuster: the initial cost is not finite, or the Cholesky
+// factorisation of the reduced camera system failed (or gave a non-finite step)
+// max_consecutive_numeric_failures times in a row.
+struct BundleAdjustmentSummary : LmSummary {
   double seconds = 0.0;  // wall time of SolveBundleAdjustment (setup included)
-
-  bool converged() const {
-    return termination == Termination::kFunctionTolerance ||
-           termination == Termination::kGradientTolerance ||
-           termination == Termination::kParameterTolerance;
-  }
 };
-
-const char* TerminationName(BundleAdjustmentSummary::Termination termination);
 
 // Which parameter blocks are held constant; empty vectors mean every block is free, otherwise
 // one entry per camera / point (non-zero = constant).

@@ -1,9 +1,9 @@
 #pragma once
 // Levenberg-Marquardt for tiny fixed-size problems (a pose, a point, a homography), entirely on
-// Eigen fixed-size types: no heap allocation. The solver is NormalLmSolve (core/math/normal_lm.h:
-// Marquardt damping diag(J^T J) / radius, gain-ratio trust-region update of Madsen, Nielsen &
-// Tingleff (2004, sec. 3.2), Cholesky of the damped normal equations) on J^T J and J^T r formed
-// from the functor's residuals and Jacobian.
+// Eigen fixed-size types: no heap allocation. The solver is NormalLmSolve (core/math/normal_lm.h,
+// Cholesky of the damped normal equations, over the one LM loop of core/math/lm_loop.h: Marquardt
+// damping diag(J^T J) / radius, gain-ratio trust-region update of Madsen, Nielsen & Tingleff 2004,
+// sec. 3.2) on J^T J and J^T r formed from the functor's residuals and Jacobian.
 //
 // The functor computes residuals and, when `jacobian` is non-null, the Jacobian:
 //   bool operator()(const Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, M, 1>* residual,

@@ -379,7 +379,7 @@ TEST(EstimateAbsolutePose, RecoversPoseFromNoisyDataWithOutliers) {
       ASSERT_TRUE(result->success()) << result->reason;
       EXPECT_TRUE(result->reason.empty());
       EXPECT_TRUE(result->refined);
-      EXPECT_TRUE(result->refinement.converged()) << NormalLmTerminationName(result->refinement.termination);
+      EXPECT_TRUE(result->refinement.converged()) << TerminationName(result->refinement.termination);
       // Every true inlier within 4 px (noise 0.5 px: ~2e-14 miss probability) and no outlier (>= 20 px off).
       EXPECT_EQ(result->num_inliers, scene.num_inliers());
       for (int i : result->inliers) EXPECT_TRUE(scene.is_inlier[i]) << i;
@@ -634,7 +634,7 @@ TEST(RefineAbsolutePose, ConvergesWithFocalAndDistortionOnExactData) {
     const Result<NormalLmSummary> summary = RefineAbsolutePose(scene.exact_pixels, scene.world, AllIndices(scene),
                                                                refine, &start.camera, &start.R, &start.t);
     ASSERT_TRUE(summary.ok()) << summary.status().ToString();
-    EXPECT_TRUE(summary->converged()) << NormalLmTerminationName(summary->termination);
+    EXPECT_TRUE(summary->converged()) << TerminationName(summary->termination);
     EXPECT_LT(summary->final_cost, 1e-16);
     EXPECT_LT(RotationDifference(start.R, scene.R).norm(), 1e-10);
     EXPECT_LT((start.t - scene.t).norm(), 1e-9);
