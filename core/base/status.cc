@@ -23,9 +23,12 @@ std::string Status::ToString() const {
   return message_.empty() ? std::string(StatusCodeName(code_)) : message_;
 }
 
-Status Status::WithContext(const std::string& context) const {
+Status Status::WithContext(std::string_view context) const {
   if (ok()) return *this;
-  return Status(code_, context + ": " + message_);
+  std::string message(context);
+  message += ": ";
+  message += message_;
+  return Status(code_, std::move(message));
 }
 
 Status InvalidArgument(std::string m) { return Status(StatusCode::kInvalidArgument, std::move(m)); }

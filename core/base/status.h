@@ -3,6 +3,7 @@
 // Messages name the file (or object) and the reason, e.g. "photos/a.jpg: truncated JPEG data".
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "core/base/check.h"
@@ -35,8 +36,9 @@ class [[nodiscard]] Status {
   const std::string& message() const { return message_; }
   std::string ToString() const;
 
-  // Returns a copy whose message is "context: message" (e.g. prefixing a file name).
-  Status WithContext(const std::string& context) const;
+  // Returns a copy whose message is "context: message" (e.g. prefixing a file name); an ok status
+  // is returned as it is, without allocating (per-frame option checks call this).
+  Status WithContext(std::string_view context) const;
 
  private:
   StatusCode code_ = StatusCode::kOk;
