@@ -105,6 +105,10 @@ struct MapperReport {
   std::vector<Unregistered> unregistered;
   int num_local_ba = 0;
   int num_global_ba = 0;
+  // Adjustments that failed numerically (the model was left as it was before each) and the
+  // first one's message; the mapper carries on after them.
+  int num_failed_ba = 0;
+  std::string first_ba_failure;
   double seconds_ba = 0.0;
   double seconds_total = 0.0;
   double mean_reprojection_error_px = 0.0;
@@ -118,7 +122,8 @@ struct MapperReport {
 using MapperProgress = std::function<void(int, int)>;
 
 // Builds a model from the images and their verified pairwise matches. InvalidArgument for bad
-// options or inconsistent input (a match indexing a missing keypoint); FailedPrecondition, with
+// options or inconsistent input (a match indexing a missing keypoint), or a bundle adjustment
+// refusing its problem (a programming error); FailedPrecondition, with
 // the reason, when no initial pair can be found (e.g. unrelated photos or too few matches).
 Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& images,
                                             const std::vector<MapperPair>& pairs,
