@@ -5,23 +5,18 @@
 #include <cmath>
 #include <vector>
 
+#include "core/math/rotation.h"
 #include "tests/core/sfm/synthetic_scene.h"
 
 namespace reconar {
 namespace {
 
-using testing::MakeScene;
-using testing::Scene;
-using testing::SceneOptions;
-using testing::TrueModel;
-using testing::TruePointOf;
-
-Scene RingScene() {
-  SceneOptions o;
+testing::Scene RingScene() {
+  testing::SceneOptions o;
   o.num_cameras = 8;
   o.num_points = 1000;
   o.noise_px = 0.4;
-  return MakeScene(o);
+  return testing::MakeScene(o);
 }
 
 // Removes `image` from the model as if it had not been registered: no pose, no observation.
@@ -41,14 +36,9 @@ void Unregister(MapperModel* model, int image) {
   }
 }
 
-double AngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  const double c = 0.5 * ((a * b.transpose()).trace() - 1.0);
-  return std::acos(std::min(1.0, std::max(-1.0, c))) * 180.0 / M_PI;
-}
-
 TEST(ImageRegistrationTest, RecoversTheTruePoseAndAddsTheInlierObservations) {
-  const Scene scene = RingScene();
-  MapperModel model = TrueModel(scene);
+  const testing::Scene scene = RingScene();
+  MapperModel model = testing::TrueModel(scene);
   const int image = 3;
   Unregister(&model, image);
   MapperOptions options;
@@ -60,7 +50,8 @@ TEST(ImageRegistrationTest, RecoversTheTruePoseAndAddsTheInlierObservations) {
   const SfmImage& img = model.rec.images[static_cast<size_t>(image)];
   EXPECT_TRUE(img.registered);
   EXPECT_TRUE(model.failure[static_cast<size_t>(image)].empty());
-  EXPECT_LT(AngleDeg(img.cam_from_world.rotation, scene.poses[static_cast<size_t>(image)].rotation), 0.05);
+  EXPECT_LT(RotationAngle(img.cam_from_world.rotation, scene.poses[static_cast<size_t>(image)].rotation) * 180.0 / M_PI,
+            0.05);
   EXPECT_LT((img.Center() - CameraCenterInWorld(scene.poses[static_cast<size_t>(image)])).norm(), 0.01);
   // The observations added are of the right points, and most visible points are observed.
   int observed = 0;
@@ -69,7 +60,7 @@ TEST(ImageRegistrationTest, RecoversTheTruePoseAndAddsTheInlierObservations) {
     if (id < 0) continue;
     ++observed;
     EXPECT_EQ(scene.point_of_keypoint[static_cast<size_t>(image)][kp],
-              TruePointOf(scene, model.rec.points[static_cast<size_t>(id)]));
+              testing::TruePointOf(scene, model.rec.points[static_cast<size_t>(id)]));
     const std::vector<TrackElement>& track = model.rec.points[static_cast<size_t>(id)].track;
     EXPECT_EQ(track.back().image_id, image);
     EXPECT_EQ(track.back().keypoint_id, static_cast<int>(kp));
@@ -78,8 +69,8 @@ TEST(ImageRegistrationTest, RecoversTheTruePoseAndAddsTheInlierObservations) {
 }
 
 TEST(ImageRegistrationTest, FailureGivesTheReasonAndLeavesTheImageUnregistered) {
-  const Scene scene = RingScene();
-  MapperModel model = TrueModel(scene);
+  const testing::Scene scene = RingScene();
+  MapperModel model = testing::TrueModel(scene);
   Unregister(&model, 5);
   MapperOptions options;
   options.registration_min_inliers = 100000;
@@ -95,11 +86,11 @@ TEST(ImageRegistrationTest, FailureGivesTheReasonAndLeavesTheImageUnregistered) 
 // uses that camera yet, so the registration estimates the focal (paper eq. 5 keeps the EXIF
 // focal when it lies within 0.7-1.4 x the estimate).
 double FocalAfterRegistration(double factor) {
-  const Scene scene = RingScene();
+  const testing::Scene scene = RingScene();
   std::vector<MapperImage> images = scene.images;
   images[2].focal_from_exif = true;
   images[2].focal_prior = factor * scene.camera.focal;
-  MapperModel model = TrueModel(scene);
+  MapperModel model = testing::TrueModel(scene);
   SfmCamera exif = scene.camera;
   exif.focal = images[2].focal_prior;
   model.rec.cameras.push_back(exif);
@@ -119,8 +110,8 @@ TEST(ImageRegistrationTest, UnconfirmedFocalIsEstimatedAndADistrustedExifFocalRe
 }
 
 TEST(ImageRegistrationTest, GuessCameraAveragesRegisteredCamerasOfTheSameSize) {
-  const Scene scene = RingScene();
-  MapperModel model = TrueModel(scene);
+  const testing::Scene scene = RingScene();
+  MapperModel model = testing::TrueModel(scene);
   SfmCamera fresh = scene.camera;
   fresh.focal = 2000.0;
   fresh.k1 = 0.0;

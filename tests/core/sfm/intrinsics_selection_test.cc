@@ -7,11 +7,6 @@
 namespace reconar {
 namespace {
 
-using testing::MakeScene;
-using testing::Scene;
-using testing::SceneOptions;
-using testing::TrueModel;
-
 // The radial distortion factor - 1 at normalised radius 0.6 (540 px at the true focal): k1 and
 // k2 trade against each other, their sum at a radius less so. (The scene fills the middle of
 // the images, where the focal takes up part of the distortion too: the bounds below are loose.)
@@ -29,13 +24,13 @@ struct Selection {
 // The true model of a ring (0.4 px noise) started without distortion (and with the principal
 // point at the image centre, 5.5 and 3.5 px off, when `centred`), then the choice.
 Selection Select(bool distortion, MapperOptions::PrincipalPoint principal_point, bool centred) {
-  SceneOptions o;
+  testing::SceneOptions o;
   o.num_cameras = 8;
   o.num_points = 1500;
   o.wrong_fraction = 0.0;
   o.distortion = distortion;
-  const Scene scene = MakeScene(o);
-  MapperModel model = TrueModel(scene);
+  const testing::Scene scene = testing::MakeScene(o);
+  MapperModel model = testing::TrueModel(scene);
   model.rec.cameras[0].k1 = model.rec.cameras[0].k2 = 0.0;
   if (centred) {
     model.rec.cameras[0].cx = 0.5 * (scene.camera.width - 1);

@@ -12,57 +12,16 @@
 namespace reconar {
 namespace {
 
-using testing::MakeScene;
-using testing::Scene;
-using testing::SceneOptions;
-using testing::TrueModel;
-
-Scene ExactScene() {
-  SceneOptions o;
-  o.num_cameras = 6;
-  o.num_points = 400;
-  o.noise_px = 0.0;
-  o.wrong_fraction = 0.0;
-  return MakeScene(o);
-}
-
-MapperOptions SingleThreaded() {
-  MapperOptions options;
-  options.num_threads = 1;
-  return options;
-}
-
-void ExpectSameModel(const MapperModel& a, const MapperModel& b) {
-  ASSERT_EQ(a.rec.cameras.size(), b.rec.cameras.size());
-  for (size_t c = 0; c < a.rec.cameras.size(); ++c) {
-    const SfmCamera& x = a.rec.cameras[c];
-    const SfmCamera& y = b.rec.cameras[c];
-    EXPECT_EQ(x.focal, y.focal);
-    EXPECT_EQ(x.k1, y.k1);
-    EXPECT_EQ(x.k2, y.k2);
-    EXPECT_EQ(x.cx, y.cx);
-    EXPECT_EQ(x.cy, y.cy);
-    EXPECT_EQ(x.aspect, y.aspect);
-  }
-  for (size_t i = 0; i < a.rec.images.size(); ++i) {
-    EXPECT_EQ(a.rec.images[i].cam_from_world.rotation, b.rec.images[i].cam_from_world.rotation) << "image " << i;
-    EXPECT_EQ(a.rec.images[i].cam_from_world.translation, b.rec.images[i].cam_from_world.translation) << "image " << i;
-  }
-  for (size_t p = 0; p < a.rec.points.size(); ++p) {
-    EXPECT_EQ(a.rec.points[p].position, b.rec.points[p].position) << "point " << p;
-  }
-}
-
 TEST(MapperAdjustmentTest, ExactModelRoundTripsUnchanged) {
-  const Scene scene = ExactScene();
-  MapperModel model = TrueModel(scene);
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  MapperModel model = testing::TrueModel(scene);
   const MapperModel before = model;
   MapperReport report;
   MapperAdjustment adjustment;
   adjustment.iterations = 20;
   adjustment.free.distortion = true;
   const Result<double> cost =
-      BundleAdjust(&model, scene.images, model.RegisteredImages(), adjustment, SingleThreaded(), &report);
+      BundleAdjust(&model, scene.images, model.RegisteredImages(), adjustment, testing::SingleThreaded(), &report);
   ASSERT_TRUE(cost.ok()) << cost.status().ToString();
   EXPECT_LT(cost.value(), 1e-12);
   EXPECT_EQ(report.num_global_ba, 1);
@@ -86,8 +45,8 @@ TEST(MapperAdjustmentTest, ExactModelRoundTripsUnchanged) {
 }
 
 TEST(MapperAdjustmentTest, RecoversPerturbedPosesAndHoldsTheOthersConstant) {
-  const Scene scene = ExactScene();
-  MapperModel model = TrueModel(scene);
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  MapperModel model = testing::TrueModel(scene);
   const std::vector<int> variable = {2, 3, 4, 5};  // 0 and 1 fix the gauge (and the scale)
   for (int image : variable) {
     Rigid3& pose = model.rec.images[static_cast<size_t>(image)].cam_from_world;
@@ -102,7 +61,8 @@ TEST(MapperAdjustmentTest, RecoversPerturbedPosesAndHoldsTheOthersConstant) {
   MapperAdjustment adjustment;
   adjustment.iterations = 100;
   adjustment.function_tolerance = 1e-14;
-  const Result<double> cost = BundleAdjust(&model, scene.images, variable, adjustment, SingleThreaded(), &report);
+  const Result<double> cost =
+      BundleAdjust(&model, scene.images, variable, adjustment, testing::SingleThreaded(), &report);
   ASSERT_TRUE(cost.ok()) << cost.status().ToString();
   EXPECT_LT(cost.value(), 1e-6);
   EXPECT_EQ(report.num_local_ba, 1);
@@ -124,8 +84,8 @@ TEST(MapperAdjustmentTest, RecoversPerturbedPosesAndHoldsTheOthersConstant) {
 }
 
 TEST(MapperAdjustmentTest, NumericFailureReturnsAStatusAndLeavesTheModelUnchanged) {
-  const Scene scene = ExactScene();
-  MapperModel model = TrueModel(scene);
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  MapperModel model = testing::TrueModel(scene);
   // A keypoint that is not a number makes the initial cost non-finite.
   const TrackElement e = model.rec.points[0].track[0];
   model.rec.images[static_cast<size_t>(e.image_id)].keypoints[static_cast<size_t>(e.keypoint_id)].x() =
@@ -138,11 +98,11 @@ TEST(MapperAdjustmentTest, NumericFailureReturnsAStatusAndLeavesTheModelUnchange
   MapperAdjustment adjustment;
   adjustment.iterations = 10;
   const Result<double> cost =
-      BundleAdjust(&model, scene.images, model.RegisteredImages(), adjustment, SingleThreaded(), &report);
+      BundleAdjust(&model, scene.images, model.RegisteredImages(), adjustment, testing::SingleThreaded(), &report);
   ASSERT_FALSE(cost.ok());
   EXPECT_EQ(cost.status().code(), StatusCode::kNumericFailure);
   EXPECT_NE(cost.status().message().find("numeric failure"), std::string::npos) << cost.status().message();
-  ExpectSameModel(model, before);
+  testing::ExpectIdenticalModels(model.rec, before.rec);
   EXPECT_EQ(report.num_global_ba, 1);  // it ran
 
   // Counted, the first message kept, the mapper carries on.
@@ -153,8 +113,8 @@ TEST(MapperAdjustmentTest, NumericFailureReturnsAStatusAndLeavesTheModelUnchange
 }
 
 TEST(MapperAdjustmentTest, InvalidOptionsAreAnErrorThatIsNotCounted) {
-  const Scene scene = ExactScene();
-  MapperModel model = TrueModel(scene);
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  MapperModel model = testing::TrueModel(scene);
   for (size_t i = 0; i < model.rec.images.size(); ++i) model.rec.images[i].cam_from_world.translation.y() += 0.01;
   const MapperModel before = model;
   MapperReport report;
@@ -162,10 +122,10 @@ TEST(MapperAdjustmentTest, InvalidOptionsAreAnErrorThatIsNotCounted) {
   adjustment.iterations = 10;
   adjustment.function_tolerance = -1.0;
   const Result<double> cost =
-      BundleAdjust(&model, scene.images, model.RegisteredImages(), adjustment, SingleThreaded(), &report);
+      BundleAdjust(&model, scene.images, model.RegisteredImages(), adjustment, testing::SingleThreaded(), &report);
   ASSERT_FALSE(cost.ok());
   EXPECT_EQ(cost.status().code(), StatusCode::kInvalidArgument);
-  ExpectSameModel(model, before);
+  testing::ExpectIdenticalModels(model.rec, before.rec);
   const Status counted = CountFailedAdjustment(cost.status(), &report);
   EXPECT_EQ(counted.code(), StatusCode::kInvalidArgument);
   EXPECT_EQ(report.num_failed_ba, 0);
@@ -174,8 +134,8 @@ TEST(MapperAdjustmentTest, InvalidOptionsAreAnErrorThatIsNotCounted) {
 }
 
 TEST(MapperAdjustmentTest, LocalBundleIsTheImageAndItsBestConnectedNeighbours) {
-  const Scene scene = ExactScene();
-  const MapperModel model = TrueModel(scene);
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  const MapperModel model = testing::TrueModel(scene);
   MapperOptions options;
   options.local_ba_images = 2;
   const std::vector<int> local = LocalBundle(model, 0, options);

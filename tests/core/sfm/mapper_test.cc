@@ -23,12 +23,7 @@ namespace {
 using testing::MakeScene;
 using testing::Scene;
 using testing::SceneOptions;
-
-MapperOptions SingleThreaded() {
-  MapperOptions options;
-  options.num_threads = 1;
-  return options;
-}
+using testing::SingleThreaded;
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -301,36 +296,7 @@ TEST(IncrementalMapperTest, TwoRunsGiveIdenticalModels) {
   ASSERT_TRUE(second.ok()) << second.status().ToString();
   EXPECT_EQ(first_report.num_registered, static_cast<int>(scene.images.size()));
 
-  const Reconstruction& a = *first;
-  const Reconstruction& b = *second;
-  ASSERT_EQ(a.cameras.size(), b.cameras.size());
-  for (size_t c = 0; c < a.cameras.size(); ++c) {
-    EXPECT_EQ(a.cameras[c].focal, b.cameras[c].focal);
-    EXPECT_EQ(a.cameras[c].cx, b.cameras[c].cx);
-    EXPECT_EQ(a.cameras[c].cy, b.cameras[c].cy);
-    EXPECT_EQ(a.cameras[c].k1, b.cameras[c].k1);
-    EXPECT_EQ(a.cameras[c].k2, b.cameras[c].k2);
-    EXPECT_EQ(a.cameras[c].aspect, b.cameras[c].aspect);
-  }
-  ASSERT_EQ(a.images.size(), b.images.size());
-  for (size_t i = 0; i < a.images.size(); ++i) {
-    EXPECT_EQ(a.images[i].registered, b.images[i].registered);
-    EXPECT_EQ(a.images[i].camera_id, b.images[i].camera_id);
-    EXPECT_TRUE(a.images[i].cam_from_world.rotation == b.images[i].cam_from_world.rotation) << i;
-    EXPECT_TRUE(a.images[i].cam_from_world.translation == b.images[i].cam_from_world.translation) << i;
-    EXPECT_EQ(a.images[i].point3d_ids, b.images[i].point3d_ids) << i;
-  }
-  ASSERT_EQ(a.points.size(), b.points.size());
-  for (size_t p = 0; p < a.points.size(); ++p) {
-    EXPECT_EQ(a.points[p].deleted, b.points[p].deleted);
-    EXPECT_TRUE(a.points[p].position == b.points[p].position) << p;
-    EXPECT_EQ(a.points[p].error, b.points[p].error);
-    ASSERT_EQ(a.points[p].track.size(), b.points[p].track.size());
-    for (size_t e = 0; e < a.points[p].track.size(); ++e) {
-      EXPECT_EQ(a.points[p].track[e].image_id, b.points[p].track[e].image_id);
-      EXPECT_EQ(a.points[p].track[e].keypoint_id, b.points[p].track[e].keypoint_id);
-    }
-  }
+  testing::ExpectIdenticalModels(*first, *second);
   EXPECT_EQ(first_report.num_points, second_report.num_points);
   EXPECT_EQ(first_report.initial_pair, second_report.initial_pair);
   EXPECT_EQ(first_report.num_local_ba, second_report.num_local_ba);

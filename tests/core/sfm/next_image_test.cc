@@ -32,11 +32,16 @@ MapperModel HandMadeModel() {
   return model;
 }
 
-TEST(NextImageTest, MostVisiblePointsFirstTiesByIndex) {
-  MapperModel model = HandMadeModel();
+// The candidates with registration_min_inliers = 2.
+std::vector<NextImageCandidate> CandidatesOf(MapperModel* model) {
   MapperOptions options;
   options.registration_min_inliers = 2;
-  const std::vector<NextImageCandidate> candidates = NextImageCandidates(&model, options);
+  return NextImageCandidates(model, options);
+}
+
+TEST(NextImageTest, MostVisiblePointsFirstTiesByIndex) {
+  MapperModel model = HandMadeModel();
+  const std::vector<NextImageCandidate> candidates = CandidatesOf(&model);
   ASSERT_EQ(candidates.size(), 3u);
   EXPECT_EQ(candidates[0].image, 3);
   EXPECT_EQ(candidates[0].visible, 8);
@@ -52,9 +57,7 @@ TEST(NextImageTest, MostVisiblePointsFirstTiesByIndex) {
 TEST(NextImageTest, NewPointsMakeAFailedImageACandidateAgain) {
   MapperModel model = HandMadeModel();
   model.tracks.track_of[5].push_back(8);  // image 5 now sees 9 points, more than when it failed
-  MapperOptions options;
-  options.registration_min_inliers = 2;
-  const std::vector<NextImageCandidate> candidates = NextImageCandidates(&model, options);
+  const std::vector<NextImageCandidate> candidates = CandidatesOf(&model);
   ASSERT_EQ(candidates.size(), 4u);
   EXPECT_EQ(candidates[0].image, 5);
   EXPECT_EQ(candidates[0].visible, 9);

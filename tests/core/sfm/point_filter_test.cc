@@ -9,18 +9,7 @@
 namespace reconar {
 namespace {
 
-using testing::MakeScene;
-using testing::SceneOptions;
-using testing::TrueModel;
-
-MapperModel ExactTrueModel() {
-  SceneOptions o;
-  o.num_cameras = 6;
-  o.num_points = 400;
-  o.noise_px = 0.0;
-  o.wrong_fraction = 0.0;
-  return TrueModel(MakeScene(o));
-}
+MapperModel ExactTrueModel() { return testing::TrueModel(testing::MakeExactScene(6, 400)); }
 
 int FirstPointWithTrackLength(const MapperModel& model, size_t min_length, size_t max_length, int after = -1) {
   for (size_t p = static_cast<size_t>(after + 1); p < model.rec.points.size(); ++p) {

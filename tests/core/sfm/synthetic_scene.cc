@@ -1,5 +1,7 @@
 #include "tests/core/sfm/synthetic_scene.h"
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -145,6 +147,21 @@ Scene MakeScene(const SceneOptions& options) {
   return scene;
 }
 
+Scene MakeExactScene(int num_cameras, int num_points) {
+  SceneOptions o;
+  o.num_cameras = num_cameras;
+  o.num_points = num_points;
+  o.noise_px = 0.0;
+  o.wrong_fraction = 0.0;
+  return MakeScene(o);
+}
+
+MapperOptions SingleThreaded() {
+  MapperOptions options;
+  options.num_threads = 1;
+  return options;
+}
+
 MapperModel TrueModel(const Scene& scene) {
   MapperModel model;
   model.rec.cameras.push_back(scene.camera);
@@ -186,6 +203,37 @@ MapperModel TrueModel(const Scene& scene) {
     for (const TrackElement& e : track) model.AddObservation(id, e.image_id, e.keypoint_id);
   }
   return model;
+}
+
+void ExpectIdenticalModels(const Reconstruction& a, const Reconstruction& b) {
+  ASSERT_EQ(a.cameras.size(), b.cameras.size());
+  for (size_t c = 0; c < a.cameras.size(); ++c) {
+    EXPECT_EQ(a.cameras[c].focal, b.cameras[c].focal);
+    EXPECT_EQ(a.cameras[c].cx, b.cameras[c].cx);
+    EXPECT_EQ(a.cameras[c].cy, b.cameras[c].cy);
+    EXPECT_EQ(a.cameras[c].k1, b.cameras[c].k1);
+    EXPECT_EQ(a.cameras[c].k2, b.cameras[c].k2);
+    EXPECT_EQ(a.cameras[c].aspect, b.cameras[c].aspect);
+  }
+  ASSERT_EQ(a.images.size(), b.images.size());
+  for (size_t i = 0; i < a.images.size(); ++i) {
+    EXPECT_EQ(a.images[i].registered, b.images[i].registered);
+    EXPECT_EQ(a.images[i].camera_id, b.images[i].camera_id);
+    EXPECT_TRUE(a.images[i].cam_from_world.rotation == b.images[i].cam_from_world.rotation) << i;
+    EXPECT_TRUE(a.images[i].cam_from_world.translation == b.images[i].cam_from_world.translation) << i;
+    EXPECT_EQ(a.images[i].point3d_ids, b.images[i].point3d_ids) << i;
+  }
+  ASSERT_EQ(a.points.size(), b.points.size());
+  for (size_t p = 0; p < a.points.size(); ++p) {
+    EXPECT_EQ(a.points[p].deleted, b.points[p].deleted);
+    EXPECT_TRUE(a.points[p].position == b.points[p].position) << p;
+    EXPECT_EQ(a.points[p].error, b.points[p].error);
+    ASSERT_EQ(a.points[p].track.size(), b.points[p].track.size());
+    for (size_t e = 0; e < a.points[p].track.size(); ++e) {
+      EXPECT_EQ(a.points[p].track[e].image_id, b.points[p].track[e].image_id);
+      EXPECT_EQ(a.points[p].track[e].keypoint_id, b.points[p].track[e].keypoint_id);
+    }
+  }
 }
 
 int TruePointOf(const Scene& scene, const SfmPoint& point) {

@@ -61,10 +61,20 @@ struct Scene {
 // keypoints. Wrong matches keep each pair one-to-one, like the matcher's output.
 Scene MakeScene(const SceneOptions& options);
 
+// A ring of num_cameras with exact keypoints (no noise) and no wrong matches: every track is one
+// true point.
+Scene MakeExactScene(int num_cameras, int num_points);
+
+// The mapper's default options on one thread (the tests' results do not depend on the count).
+MapperOptions SingleThreaded();
+
 // The model at the truth: every image registered at its true pose with one shared camera (the
 // true one), the tracks of the scene's matches, and a point at the true position for each track
 // whose keypoints all observe one true point (with all of them as observations).
 MapperModel TrueModel(const Scene& scene);
+
+// Expects (gtest) the two models equal to the bit: cameras, poses, observations, points.
+void ExpectIdenticalModels(const Reconstruction& a, const Reconstruction& b);
 
 // The true point a model point observes (that of its first observation), or -1 for clutter.
 int TruePointOf(const Scene& scene, const SfmPoint& point);

@@ -10,22 +10,6 @@
 namespace reconar {
 namespace {
 
-using testing::MakeScene;
-using testing::Scene;
-using testing::SceneOptions;
-using testing::TrueModel;
-using testing::TruePointOf;
-
-// Six cameras, exact keypoints, no wrong matches: every track is one true point.
-Scene ExactScene() {
-  SceneOptions o;
-  o.num_cameras = 6;
-  o.num_points = 400;
-  o.noise_px = 0.0;
-  o.wrong_fraction = 0.0;
-  return MakeScene(o);
-}
-
 // The model at the truth with its points removed (every track untriangulated).
 MapperModel WithoutPoints(MapperModel model) {
   model.rec.points.clear();
@@ -36,14 +20,14 @@ MapperModel WithoutPoints(MapperModel model) {
 }
 
 TEST(TrackTriangulationTest, RetriangulateAllRecoversTheTruePoints) {
-  const Scene scene = ExactScene();
-  const MapperModel truth = TrueModel(scene);
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  const MapperModel truth = testing::TrueModel(scene);
   MapperModel model = WithoutPoints(truth);
   RetriangulateAll(&model, MapperOptions());
   ASSERT_GE(model.rec.NumPoints(), truth.rec.NumPoints() * 95 / 100);
   for (size_t p = 0; p < model.rec.points.size(); ++p) {
     const SfmPoint& point = model.rec.points[p];
-    const int true_point = TruePointOf(scene, point);
+    const int true_point = testing::TruePointOf(scene, point);
     ASSERT_GE(true_point, 0);
     EXPECT_LT((point.position - scene.points[static_cast<size_t>(true_point)]).norm(), 1e-6) << "point " << p;
     // All of the track's views are observations (the keypoints are exact).
@@ -57,8 +41,8 @@ TEST(TrackTriangulationTest, RetriangulateAllRecoversTheTruePoints) {
 }
 
 TEST(TrackTriangulationTest, TrackWithAPlantedOutlierKeepsTheOtherViews) {
-  const Scene scene = ExactScene();
-  MapperModel model = WithoutPoints(TrueModel(scene));
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  MapperModel model = WithoutPoints(testing::TrueModel(scene));
   int track = -1;
   for (size_t t = 0; t < model.tracks.tracks.size() && track < 0; ++t) {
     if (model.tracks.tracks[t].size() >= 4) track = static_cast<int>(t);
@@ -72,7 +56,7 @@ TEST(TrackTriangulationTest, TrackWithAPlantedOutlierKeepsTheOtherViews) {
   const SfmPoint& point = model.rec.points[0];
   EXPECT_EQ(point.track.size(), model.tracks.tracks[static_cast<size_t>(track)].size() - 1);
   for (const TrackElement& e : point.track) EXPECT_FALSE(e.image_id == outlier.image_id);
-  EXPECT_LT((point.position - scene.points[static_cast<size_t>(TruePointOf(scene, point))]).norm(), 1e-6);
+  EXPECT_LT((point.position - scene.points[static_cast<size_t>(testing::TruePointOf(scene, point))]).norm(), 1e-6);
   EXPECT_EQ(model.point_of_track[static_cast<size_t>(track)], 0);
   EXPECT_EQ(
       model.rec.images[static_cast<size_t>(outlier.image_id)].point3d_ids[static_cast<size_t>(outlier.keypoint_id)],
@@ -80,8 +64,8 @@ TEST(TrackTriangulationTest, TrackWithAPlantedOutlierKeepsTheOtherViews) {
 }
 
 TEST(TrackTriangulationTest, TriangulateImageUsesOnlyRegisteredViews) {
-  const Scene scene = ExactScene();
-  MapperModel model = WithoutPoints(TrueModel(scene));
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  MapperModel model = WithoutPoints(testing::TrueModel(scene));
   for (size_t i = 2; i < model.rec.images.size(); ++i) model.rec.images[i].registered = false;
   TriangulateImage(&model, 1, MapperOptions());
   // Every track seen by both images 0 and 1 becomes a point observed exactly there.
@@ -100,13 +84,13 @@ TEST(TrackTriangulationTest, TriangulateImageUsesOnlyRegisteredViews) {
     ASSERT_EQ(point.track.size(), 2u);
     EXPECT_EQ(point.track[0].image_id, 0);
     EXPECT_EQ(point.track[1].image_id, 1);
-    EXPECT_LT((point.position - scene.points[static_cast<size_t>(TruePointOf(scene, point))]).norm(), 1e-6);
+    EXPECT_LT((point.position - scene.points[static_cast<size_t>(testing::TruePointOf(scene, point))]).norm(), 1e-6);
   }
 }
 
 TEST(TrackTriangulationTest, TooSmallAnAngleMakesNoPoint) {
-  const Scene scene = ExactScene();
-  MapperModel model = WithoutPoints(TrueModel(scene));
+  const testing::Scene scene = testing::MakeExactScene(6, 400);
+  MapperModel model = WithoutPoints(testing::TrueModel(scene));
   MapperOptions options;
   options.min_triangulation_angle_deg = 160.0;  // no two cameras see a point from more than 150 degrees apart
   RetriangulateAll(&model, options);
