@@ -4,6 +4,10 @@
 // 2016): an initial pair with enough parallax, then one image at a time registered from its
 // 2D-3D correspondences (P3P in LO-RANSAC), new tracks triangulated, local bundle adjustment
 // around the new image, global bundle adjustment at growth milestones, and outlier filtering.
+// mapper.cc holds only that orchestration; each step is its own part, over the shared state of
+// mapper_model.h: initial_pair.h, next_image.h, image_registration.h, track_triangulation.h,
+// point_filter.h, mapper_adjustment.h (the bundle-adjustment adapter) and intrinsics_selection.h
+// (the final intrinsics model by BIC).
 #include <functional>
 #include <string>
 #include <vector>
