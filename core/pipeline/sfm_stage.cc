@@ -208,6 +208,8 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("seconds_bundle_adjustment").Double(m.seconds_ba);
   json->Key("local_bundle_adjustments").Int(m.num_local_ba);
   json->Key("global_bundle_adjustments").Int(m.num_global_ba);
+  json->Key("failed_bundle_adjustments").Int(m.num_failed_ba);
+  if (m.num_failed_ba > 0) json->Key("first_bundle_adjustment_failure").String(m.first_ba_failure);
   json->Key("unregistered").BeginArray();
   for (const MapperReport::Unregistered& u : m.unregistered) {
     json->BeginObject().Key("image").String(u.name).Key("reason").String(u.reason).EndObject();

@@ -4,6 +4,10 @@
 // 2016): an initial pair with enough parallax, then one image at a time registered from its
 // 2D-3D correspondences (P3P in LO-RANSAC), new tracks triangulated, local bundle adjustment
 // around the new image, global bundle adjustment at growth milestones, and outlier filtering.
+// mapper.cc holds only that orchestration; each step is its own part, over the shared state of
+// mapper_model.h: initial_pair.h, next_image.h, image_registration.h, track_triangulation.h,
+// point_filter.h, mapper_adjustment.h (the bundle-adjustment adapter) and intrinsics_selection.h
+// (the final intrinsics model by BIC).
 #include <functional>
 #include <string>
 #include <vector>
@@ -105,6 +109,10 @@ struct MapperReport {
   std::vector<Unregistered> unregistered;
   int num_local_ba = 0;
   int num_global_ba = 0;
+  // Adjustments that failed numerically (the model was left as it was before each) and the
+  // first one's message; the mapper carries on after them.
+  int num_failed_ba = 0;
+  std::string first_ba_failure;
   double seconds_ba = 0.0;
   double seconds_total = 0.0;
   double mean_reprojection_error_px = 0.0;
@@ -118,7 +126,8 @@ struct MapperReport {
 using MapperProgress = std::function<void(int, int)>;
 
 // Builds a model from the images and their verified pairwise matches. InvalidArgument for bad
-// options or inconsistent input (a match indexing a missing keypoint); FailedPrecondition, with
+// options or inconsistent input (a match indexing a missing keypoint), or a bundle adjustment
+// refusing its problem (a programming error); FailedPrecondition, with
 // the reason, when no initial pair can be found (e.g. unrelated photos or too few matches).
 Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& images,
                                             const std::vector<MapperPair>& pairs,

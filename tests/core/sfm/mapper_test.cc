@@ -14,193 +14,16 @@
 #include <string>
 #include <vector>
 
+#include "tests/core/sfm/synthetic_scene.h"
 #include "tests/support/sfm_evaluation.h"
 
 namespace reconar {
 namespace {
 
-// ---- synthetic scene ----------------------------------------------------------------------------
-
-struct SceneOptions {
-  int num_cameras = 10;
-  int num_points = 2000;
-  double ring_radius = 10.0;
-  // Camera heights vary by +- this (elevations +-17 degrees) and cameras are rolled by up to +-
-  // max_roll_deg, like hand-held photos. A flatter ring (+-1.5) is close to a critical motion for
-  // self-calibration: the vertical principal point and the aspect ratio trade against a common
-  // tilt of the cameras and a vertical stretch of the scene, and the poses come out ~0.2 degrees
-  // off for reasons that have nothing to do with the mapper.
-  double height_amplitude = 3.0;
-  double max_roll_deg = 5.0;
-  double noise_px = 0.4;          // standard deviation per pixel coordinate
-  double wrong_fraction = 0.15;   // wrong matches added per pair, relative to its true matches
-  int wrong_real_real = 3;        // of which at most this many join two true tracks
-  int min_common_points = 40;     // pairs sharing fewer points get no MapperPair
-  double visible_within_deg = 75; // a point is seen when its normal is this close to the view ray
-  double detection_rate = 0.9;
-  double focal_prior_factor = 1.2;  // focal prior = this x max(width, height), as without EXIF
-  unsigned seed = 1;
-};
-
-// The true camera: 1000 x 750 px, focal 900, principal point a few pixels off the centre, a
-// little barrel distortion (about 4 px at the corners).
-SfmCamera TrueCamera() {
-  SfmCamera camera;
-  camera.width = 1000;
-  camera.height = 750;
-  camera.focal = 900.0;
-  camera.cx = 505.0;
-  camera.cy = 371.0;
-  camera.k1 = -0.02;
-  return camera;
-}
-
-struct Scene {
-  SfmCamera camera;
-  std::vector<Rigid3> poses;
-  std::vector<Eigen::Vector3d> points;
-  std::vector<MapperImage> images;
-  std::vector<MapperPair> pairs;
-  // Per image and keypoint: the true point it observes, or -1 for a clutter keypoint (one that
-  // exists only as the end of a wrong match).
-  std::vector<std::vector<int>> point_of_keypoint;
-  int num_true_matches = 0;
-  int num_wrong_matches = 0;
-};
-
-// Cameras on a ring (height varying by +-3) around the origin, each looking at a point near
-// the origin; points uniform in a 6 x 6 x 4 box, each with a random normal so that it is seen
-// only from one side (opposite cameras share nothing, neighbours share most). Keypoints are the
-// true projections plus Gaussian noise; every pair sharing enough points gets its true matches
-// plus wrong_fraction wrong ones: a few join keypoints of two different true points (merging two
-// tracks), a quarter join a true keypoint to a clutter keypoint, the rest join two clutter
-// keypoints. Wrong matches keep each pair one-to-one, like the matcher's output.
-Scene MakeScene(const SceneOptions& o) {
-  std::mt19937 rng(o.seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  Scene scene;
-  scene.camera = TrueCamera();
-  const SfmCamera& cam = scene.camera;
-
-  for (int i = 0; i < o.num_cameras; ++i) {
-    const double angle = 2.0 * M_PI * i / o.num_cameras;
-    const Eigen::Vector3d centre(o.ring_radius * std::cos(angle), o.ring_radius * std::sin(angle),
-                                 o.height_amplitude * std::sin(2.0 * angle + 0.3));
-    const Eigen::Vector3d target(0.3 * uniform(rng), 0.3 * uniform(rng), 0.3 * uniform(rng));
-    const Eigen::Vector3d forward = (target - centre).normalized();
-    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
-    const Eigen::Vector3d down = forward.cross(right);
-    Rigid3 pose;
-    pose.rotation.row(0) = right.transpose();
-    pose.rotation.row(1) = down.transpose();
-    pose.rotation.row(2) = forward.transpose();
-    const double roll = o.max_roll_deg * M_PI / 180.0 * uniform(rng);
-    pose.rotation = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                                   pose.rotation;
-    pose.translation = -pose.rotation * centre;
-    scene.poses.push_back(pose);
-  }
-
-  std::vector<Eigen::Vector3d> normals;
-  for (int p = 0; p < o.num_points; ++p) {
-    scene.points.emplace_back(3.0 * uniform(rng), 3.0 * uniform(rng), 2.0 * uniform(rng));
-    normals.push_back(Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized());
-  }
-
-  // Observations; keypoint order within an image is shuffled.
-  const double cos_visible = std::cos(o.visible_within_deg * M_PI / 180.0);
-  std::vector<std::vector<int>> keypoint_of_point(static_cast<size_t>(o.num_cameras),
-                                                  std::vector<int>(static_cast<size_t>(o.num_points), -1));
-  scene.images.resize(static_cast<size_t>(o.num_cameras));
-  scene.point_of_keypoint.resize(static_cast<size_t>(o.num_cameras));
-  for (int i = 0; i < o.num_cameras; ++i) {
-    MapperImage& image = scene.images[static_cast<size_t>(i)];
-    image.name = "view" + std::to_string(i) + ".jpg";
-    image.width = cam.width;
-    image.height = cam.height;
-    image.focal_prior = o.focal_prior_factor * std::max(cam.width, cam.height);
-    image.focal_from_exif = false;
-    std::vector<int> seen;
-    for (int p = 0; p < o.num_points; ++p) {
-      const Eigen::Vector3d& X = scene.points[static_cast<size_t>(p)];
-      const Rigid3& pose = scene.poses[static_cast<size_t>(i)];
-      const Eigen::Vector3d to_camera = (CameraCenterInWorld(pose) - X).normalized();
-      const bool detected = unit(rng) < o.detection_rate;
-      if (normals[static_cast<size_t>(p)].dot(to_camera) < cos_visible || !detected) continue;
-      const Eigen::Vector3d c = pose * X;
-      if (c.z() < 0.1) continue;
-      const Eigen::Vector2d x = cam.Project(c);
-      if (x.x() < 2.0 || x.y() < 2.0 || x.x() > cam.width - 3.0 || x.y() > cam.height - 3.0) continue;
-      seen.push_back(p);
-    }
-    std::shuffle(seen.begin(), seen.end(), rng);
-    for (int p : seen) {
-      const Eigen::Vector2d x = cam.Project(scene.poses[static_cast<size_t>(i)] * (scene.points[static_cast<size_t>(p)]));
-      keypoint_of_point[static_cast<size_t>(i)][static_cast<size_t>(p)] = static_cast<int>(image.keypoints.size());
-      image.keypoints.push_back(x + o.noise_px * Eigen::Vector2d(gauss(rng), gauss(rng)));
-      scene.point_of_keypoint[static_cast<size_t>(i)].push_back(p);
-    }
-  }
-
-  const auto add_clutter = [&](int i) {
-    MapperImage& image = scene.images[static_cast<size_t>(i)];
-    image.keypoints.emplace_back(0.5 * (cam.width - 1) * (1.0 + uniform(rng)),
-                                 0.5 * (cam.height - 1) * (1.0 + uniform(rng)));
-    scene.point_of_keypoint[static_cast<size_t>(i)].push_back(-1);
-    return static_cast<int>(image.keypoints.size()) - 1;
-  };
-  for (int a = 0; a < o.num_cameras; ++a) {
-    for (int b = a + 1; b < o.num_cameras; ++b) {
-      const std::vector<int>& ka = keypoint_of_point[static_cast<size_t>(a)];
-      const std::vector<int>& kb = keypoint_of_point[static_cast<size_t>(b)];
-      MapperPair pair;
-      pair.matches.image_a = a;
-      pair.matches.image_b = b;
-      std::vector<int> only_a, only_b;  // true keypoints without a partner in the other image
-      for (int p = 0; p < o.num_points; ++p) {
-        const int xa = ka[static_cast<size_t>(p)], xb = kb[static_cast<size_t>(p)];
-        if (xa >= 0 && xb >= 0) pair.matches.matches.push_back({xa, xb});
-        if (xa >= 0 && xb < 0) only_a.push_back(xa);
-        if (xa < 0 && xb >= 0) only_b.push_back(xb);
-      }
-      const int num_true = static_cast<int>(pair.matches.matches.size());
-      if (num_true < o.min_common_points) continue;
-      std::shuffle(only_a.begin(), only_a.end(), rng);
-      std::shuffle(only_b.begin(), only_b.end(), rng);
-      const int num_wrong = static_cast<int>(std::lround(o.wrong_fraction * num_true));
-      for (int w = 0; w < num_wrong; ++w) {
-        FeatureMatch m;
-        if (w < o.wrong_real_real && !only_a.empty() && !only_b.empty()) {
-          m = {only_a.back(), only_b.back()};
-          only_a.pop_back();
-          only_b.pop_back();
-        } else if (w % 4 == 0 && !only_a.empty()) {
-          m = {only_a.back(), add_clutter(b)};
-          only_a.pop_back();
-        } else if (w % 4 == 1 && !only_b.empty()) {
-          m = {add_clutter(a), only_b.back()};
-          only_b.pop_back();
-        } else {
-          m = {add_clutter(a), add_clutter(b)};
-        }
-        pair.matches.matches.push_back(m);
-      }
-      std::shuffle(pair.matches.matches.begin(), pair.matches.matches.end(), rng);
-      scene.num_true_matches += num_true;
-      scene.num_wrong_matches += num_wrong;
-      scene.pairs.push_back(std::move(pair));
-    }
-  }
-  return scene;
-}
-
-MapperOptions SingleThreaded() {
-  MapperOptions options;
-  options.num_threads = 1;
-  return options;
-}
+using testing::MakeScene;
+using testing::Scene;
+using testing::SceneOptions;
+using testing::SingleThreaded;
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -473,36 +296,7 @@ TEST(IncrementalMapperTest, TwoRunsGiveIdenticalModels) {
   ASSERT_TRUE(second.ok()) << second.status().ToString();
   EXPECT_EQ(first_report.num_registered, static_cast<int>(scene.images.size()));
 
-  const Reconstruction& a = *first;
-  const Reconstruction& b = *second;
-  ASSERT_EQ(a.cameras.size(), b.cameras.size());
-  for (size_t c = 0; c < a.cameras.size(); ++c) {
-    EXPECT_EQ(a.cameras[c].focal, b.cameras[c].focal);
-    EXPECT_EQ(a.cameras[c].cx, b.cameras[c].cx);
-    EXPECT_EQ(a.cameras[c].cy, b.cameras[c].cy);
-    EXPECT_EQ(a.cameras[c].k1, b.cameras[c].k1);
-    EXPECT_EQ(a.cameras[c].k2, b.cameras[c].k2);
-    EXPECT_EQ(a.cameras[c].aspect, b.cameras[c].aspect);
-  }
-  ASSERT_EQ(a.images.size(), b.images.size());
-  for (size_t i = 0; i < a.images.size(); ++i) {
-    EXPECT_EQ(a.images[i].registered, b.images[i].registered);
-    EXPECT_EQ(a.images[i].camera_id, b.images[i].camera_id);
-    EXPECT_TRUE(a.images[i].cam_from_world.rotation == b.images[i].cam_from_world.rotation) << i;
-    EXPECT_TRUE(a.images[i].cam_from_world.translation == b.images[i].cam_from_world.translation) << i;
-    EXPECT_EQ(a.images[i].point3d_ids, b.images[i].point3d_ids) << i;
-  }
-  ASSERT_EQ(a.points.size(), b.points.size());
-  for (size_t p = 0; p < a.points.size(); ++p) {
-    EXPECT_EQ(a.points[p].deleted, b.points[p].deleted);
-    EXPECT_TRUE(a.points[p].position == b.points[p].position) << p;
-    EXPECT_EQ(a.points[p].error, b.points[p].error);
-    ASSERT_EQ(a.points[p].track.size(), b.points[p].track.size());
-    for (size_t e = 0; e < a.points[p].track.size(); ++e) {
-      EXPECT_EQ(a.points[p].track[e].image_id, b.points[p].track[e].image_id);
-      EXPECT_EQ(a.points[p].track[e].keypoint_id, b.points[p].track[e].keypoint_id);
-    }
-  }
+  testing::ExpectIdenticalModels(*first, *second);
   EXPECT_EQ(first_report.num_points, second_report.num_points);
   EXPECT_EQ(first_report.initial_pair, second_report.initial_pair);
   EXPECT_EQ(first_report.num_local_ba, second_report.num_local_ba);
@@ -600,6 +394,26 @@ TEST(IncrementalMapperTest, OutOfRangeKeypointOrImageIsInvalidArgument) {
   result = RunIncrementalMapper(images, scene.pairs, SingleThreaded(), nullptr);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.status().code(), StatusCode::kInvalidArgument);
+}
+
+// A bundle adjustment that refuses its options is a programming error: it ends the run with
+// InvalidArgument (it was once swallowed as an infinite cost), unlike a numeric failure, which is
+// counted in the report while the mapper carries on.
+TEST(IncrementalMapperTest, AdjustmentRefusingItsOptionsIsInvalidArgument) {
+  const Scene scene = MakeScene(SmallScene());
+  MapperOptions options = SingleThreaded();
+  options.final_ba_function_tolerance = -1.0;  // reaches only the final adjustments
+  MapperReport report;
+  const Result<Reconstruction> result = RunIncrementalMapper(scene.images, scene.pairs, options, &report);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.status().code(), StatusCode::kInvalidArgument) << result.status().ToString();
+  EXPECT_NE(result.status().message().find("function_tolerance"), std::string::npos) << result.status().message();
+  EXPECT_EQ(report.num_failed_ba, 0);
+
+  const Result<Reconstruction> fine = RunIncrementalMapper(scene.images, scene.pairs, SingleThreaded(), &report);
+  ASSERT_TRUE(fine.ok()) << fine.status().ToString();
+  EXPECT_EQ(report.num_failed_ba, 0);
+  EXPECT_TRUE(report.first_ba_failure.empty());
 }
 
 TEST(IncrementalMapperTest, ImagesThatCannotBeRegisteredAreListedWithAReason) {

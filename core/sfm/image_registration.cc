@@ -1,0 +1,95 @@
+#include "core/sfm/image_registration.h"
+
+#include <string>
+
+#include "core/geometry/absolute_pose.h"
+
+namespace reconar {
+
+SfmCamera GuessCamera(const MapperModel& model, int image) {
+  const Reconstruction& rec = model.rec;
+  const int camera_id = rec.images[static_cast<size_t>(image)].camera_id;
+  SfmCamera camera = rec.cameras[static_cast<size_t>(camera_id)];
+  if (model.CameraUsers(camera_id) > 0 || model.camera_from_exif[static_cast<size_t>(camera_id)]) return camera;
+  double focal_sum = 0.0, k1_sum = 0.0, k2_sum = 0.0;
+  int n = 0;
+  for (size_t i = 0; i < rec.images.size(); ++i) {
+    const int other_id = rec.images[i].camera_id;
+    const SfmCamera& other = rec.cameras[static_cast<size_t>(other_id)];
+    if (!rec.images[i].registered || other.width != camera.width || other.height != camera.height) continue;
+    if (model.camera_from_exif[static_cast<size_t>(other_id)]) continue;
+    focal_sum += other.focal;
+    k1_sum += other.k1;
+    k2_sum += other.k2;
+    ++n;
+  }
+  if (n > 0) {
+    camera.focal = focal_sum / n;
+    camera.k1 = k1_sum / n;
+    camera.k2 = k2_sum / n;
+  }
+  return camera;
+}
+
+bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, int image, const MapperOptions& options,
+                   bool* focal_changed) {
+  *focal_changed = false;
+  Reconstruction& rec = model->rec;
+  SfmImage& img = rec.images[static_cast<size_t>(image)];
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> world;
+  std::vector<int> keypoint_of;
+  const std::vector<int>& track_of = model->tracks.track_of[static_cast<size_t>(image)];
+  for (size_t kp = 0; kp < track_of.size(); ++kp) {
+    const int t = track_of[kp];
+    if (t < 0 || model->point_of_track[static_cast<size_t>(t)] < 0) continue;
+    pixels.push_back(img.keypoints[kp]);
+    world.push_back(rec.points[static_cast<size_t>(model->point_of_track[static_cast<size_t>(t)])].position);
+    keypoint_of.push_back(static_cast<int>(kp));
+  }
+  SfmCamera camera = GuessCamera(*model, image);
+  const RadialCamera& pose_camera = camera;  // with its aspect ratio
+  // Until three images confirm a camera's focal, the model is shaped by a prior the data has not
+  // checked: register with the focal free, under a looser bound, falling back to the DLT for an
+  // unknown focal; a global adjustment with the focal free follows (the caller's).
+  const int camera_id = img.camera_id;
+  const bool exif = images[static_cast<size_t>(image)].focal_from_exif;
+  const bool focal_confirmed = model->CameraUsers(camera_id) >= 3 || !options.refine_focal;
+  AbsolutePoseOptions pose_options;
+  pose_options.max_error_px = options.registration_max_error_px * (focal_confirmed ? 1.0 : 2.0);
+  pose_options.min_inliers = options.registration_min_inliers;
+  pose_options.refine_focal = !focal_confirmed;
+  auto result = EstimateAbsolutePose(pixels, world, pose_camera, pose_options);
+  if (result.ok() && !result->success() && !focal_confirmed) {
+    result = EstimateAbsolutePoseUnknownFocal(pixels, world, pose_camera, pose_options);
+  }
+  if (!result.ok() || !result->success()) {
+    model->failure[static_cast<size_t>(image)] =
+        "pose from " + std::to_string(pixels.size()) +
+        " 2D-3D correspondences failed: " + (result.ok() ? result->reason : result.status().message());
+    return false;
+  }
+  if (!focal_confirmed && result->focal > 0.0) {
+    // Paper eq. 5: the EXIF focal is kept when it lies within 0.7-1.4 of the data's estimate.
+    double focal = result->focal;
+    const double prior = images[static_cast<size_t>(image)].focal_prior;
+    if (exif && prior > options.focal_prior_min_ratio * focal && prior < options.focal_prior_max_ratio * focal) {
+      focal = prior;
+    }
+    camera.focal = focal;
+    rec.cameras[static_cast<size_t>(camera_id)] = camera;
+    *focal_changed = true;
+  }
+  img.cam_from_world.rotation = result->cam_from_world.rotation;
+  img.cam_from_world.translation = result->cam_from_world.translation;
+  img.registered = true;
+  for (int index : result->inliers) {
+    const int kp = keypoint_of[static_cast<size_t>(index)];
+    const int t = track_of[static_cast<size_t>(kp)];
+    model->AddObservation(model->point_of_track[static_cast<size_t>(t)], image, kp);
+  }
+  model->failure[static_cast<size_t>(image)].clear();
+  return true;
+}
+
+}  // namespace reconar

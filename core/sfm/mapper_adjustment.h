@@ -1,0 +1,47 @@
+#pragma once
+// The mapper's bundle-adjustment adapter: the model's registered images and points become a
+// RadialProblem (12 doubles per camera: angle-axis, translation, f, k1, k2, cx, cy, aspect),
+// SolveBundleAdjustment (core/optim/bundle_adjuster.h) refines it, and the result is written back.
+#include <string>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/sfm/mapper.h"
+#include "core/sfm/mapper_model.h"
+
+namespace reconar {
+
+// Which intrinsics beyond the focal an adjustment refines.
+struct IntrinsicsChoice {
+  bool principal_point = false;
+  bool distortion = false;
+  bool aspect = false;
+};
+
+struct MapperAdjustment {
+  int iterations = 0;
+  double function_tolerance = 1e-6;  // relative cost change that ends the adjustment
+  IntrinsicsChoice free;
+};
+
+// Adjusts the cameras `variable`, every point they see, and holds the other registered cameras
+// that see those points constant. The focal (MapperOptions::refine_focal) and the distortion are
+// refined only once three images are registered, a shared camera only in a global adjustment
+// (`variable` = every registered image). Counts the adjustment and its time in `report`.
+// Returns the final cost. On failure the model is left unchanged: InvalidArgument for bad options
+// or a malformed problem (from SolveBundleAdjustment), NumericFailure when the adjuster ended in
+// numeric failure.
+Result<double> BundleAdjust(MapperModel* model, const std::vector<MapperImage>& images,
+                            const std::vector<int>& variable, const MapperAdjustment& adjustment,
+                            const MapperOptions& options, MapperReport* report);
+
+// Records a failed adjustment in `report` (num_failed_ba, first_ba_failure) and returns Ok, so
+// that the mapper carries on with the model as it was; InvalidArgument, a programming error, is
+// returned instead. Ok passes through uncounted.
+Status CountFailedAdjustment(const Status& status, MapperReport* report);
+
+// The new image and up to MapperOptions::local_ba_images registered images sharing the most
+// points with it (most first, ties by index).
+std::vector<int> LocalBundle(const MapperModel& model, int image, const MapperOptions& options);
+
+}  // namespace reconar
