@@ -5,6 +5,7 @@
 
 #include "core/math/rotation.h"
 #include "core/optim/bundle_adjuster.h"
+#include "core/optim/radial_camera_model.h"
 
 namespace reconar {
 namespace {
@@ -116,12 +117,7 @@ Result<double> BundleAdjust(MapperModel* model, const std::vector<MapperImage>& 
     const double* block = problem.camera(static_cast<int>(slot));
     img.cam_from_world.rotation = RotationFromAngleAxis(Eigen::Vector3d(block[0], block[1], block[2]));
     img.cam_from_world.translation = Eigen::Vector3d(block[3], block[4], block[5]);
-    cam.focal = block[6];
-    cam.k1 = block[7];
-    cam.k2 = block[8];
-    cam.cx = block[9];
-    cam.cy = block[10];
-    cam.aspect = block[11];
+    static_cast<RadialCamera&>(cam) = RadialCameraOfBlock(block);
   }
   for (size_t j = 0; j < point_ids.size(); ++j) {
     rec.points[static_cast<size_t>(point_ids[j])].position = Eigen::Vector3d(problem.point(static_cast<int>(j)));
