@@ -53,6 +53,12 @@ int NearestCentroid(const DescriptorDistanceKernel& kernel, const uint8_t* query
   return best;
 }
 
+// Reads values->size() plain values; an empty vector has no storage to hand to memcpy.
+template <typename T>
+bool GetArray(ByteReader* reader, std::vector<T>* values) {
+  return values->empty() ? reader->ok() : reader->GetBytes(values->data(), values->size() * sizeof(T));
+}
+
 Status TreeError(const std::string& what, const std::string& reason) {
   return InvalidArgument(what + ": vocabulary tree: " + reason);
 }
@@ -133,10 +139,12 @@ class VocabularyTree::Trainer {
         assignment_(ids_.size()),
         distance_(ids_.size()),
         scratch_ids_(ids_.size()),
-        centroids_(static_cast<size_t>(options.branching) * kDescriptorSize),
-        sums_(static_cast<size_t>(options.branching) * kDescriptorSize),
-        counts_(static_cast<size_t>(options.branching)),
-        remap_(static_cast<size_t>(options.branching)) {
+        // A node is split only when it has at least `branching` descriptors.
+        max_clusters_(std::min(ids_.size(), static_cast<size_t>(options.branching))),
+        centroids_(max_clusters_ * kDescriptorSize),
+        sums_(max_clusters_ * kDescriptorSize),
+        counts_(max_clusters_),
+        remap_(max_clusters_) {
     const int threads = ThreadPool::ResolveThreadCount(options.num_threads);
     if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
   }
@@ -343,7 +351,8 @@ class VocabularyTree::Trainer {
   std::vector<int32_t> assignment_;   // per position in ids_: cluster within the current node
   std::vector<int32_t> distance_;     // per position: squared distance to that cluster's centroid
   std::vector<int32_t> scratch_ids_;  // partition buffer
-  std::vector<uint8_t> centroids_;    // the current node's k centroids
+  const size_t max_clusters_;
+  std::vector<uint8_t> centroids_;  // the current node's k centroids
   std::vector<uint64_t> sums_;
   std::vector<uint64_t> counts_;
   std::vector<int32_t> remap_;
@@ -427,7 +436,7 @@ Result<VocabularyTree> VocabularyTree::Deserialize(ByteReader* reader, const std
     reader->Get(&node.word);
   }
   tree.centroids_.resize(static_cast<size_t>(num_nodes) * kDescriptorSize);
-  reader->GetBytes(tree.centroids_.data(), tree.centroids_.size());
+  GetArray(reader, &tree.centroids_);
   if (!reader->ok()) return TreeError(what, "truncated nodes");
 
   // Children lie after their parent (no cycles) and every node but the root has exactly one
@@ -623,14 +632,14 @@ Result<InvertedFile> InvertedFile::Deserialize(ByteReader* reader, const std::st
   file.num_images_ = num_images;
   file.idf_.resize(num_words);
   file.posting_offsets_.resize(static_cast<size_t>(num_words) + 1);
-  reader->GetBytes(file.idf_.data(), file.idf_.size() * sizeof(float));
-  reader->GetBytes(file.posting_offsets_.data(), file.posting_offsets_.size() * sizeof(uint32_t));
+  GetArray(reader, &file.idf_);
+  GetArray(reader, &file.posting_offsets_);
   uint32_t num_postings = 0;
   if (!reader->GetCount(sizeof(Posting), UINT32_MAX, &num_postings)) {
     return IndexError(what, "truncated words or posting count beyond the record");
   }
   file.postings_.resize(num_postings);
-  if (!reader->GetBytes(file.postings_.data(), file.postings_.size() * sizeof(Posting))) {
+  if (!GetArray(reader, &file.postings_)) {
     return IndexError(what, "truncated postings");
   }
   for (uint32_t w = 0; w < num_words; ++w) {

@@ -173,6 +173,10 @@ TEST(VocabularyTreeTest, EmptyAndTinyTrees) {
   EXPECT_EQ(tiny.num_nodes(), 1);
   EXPECT_EQ(tiny.num_words(), 1);
   EXPECT_EQ(tiny.Quantize(d.data()), 0);
+  VocabularyTreeOptions wide;
+  wide.branching = 1 << 24;  // no buffer sized by the branching alone
+  wide.depth = 1;
+  EXPECT_EQ(TrainOrDie(std::vector<uint8_t>(5 * kDescriptorSize, 9), wide).num_words(), 1);
   // Identical descriptors cannot be split: a leaf however many there are.
   const VocabularyTree same = TrainOrDie(std::vector<uint8_t>(500 * kDescriptorSize, 9), VocabularyTreeOptions());
   EXPECT_EQ(same.num_words(), 1);
@@ -597,6 +601,15 @@ TEST(RetrievalAllocationTest, QueryAndQuantizeDoNotAllocate) {
   }
   EXPECT_EQ(allocations, 0);
   EXPECT_EQ(found_first, 8);
+  // The counter does see operator new (so the zero above means something), e.g. a query whose
+  // `out` has no room.
+  std::vector<RetrievalCandidate> unreserved;
+  {
+    testing::NoAllocationScope scope;
+    file.Query(words.data(), query_size, 5, &scratch, &unreserved);
+    allocations = scope.allocations();
+  }
+  EXPECT_GT(allocations, 0);
 }
 
 }  // namespace
