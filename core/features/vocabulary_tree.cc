@@ -18,6 +18,7 @@ namespace {
 constexpr int kMaxWords = 1 << 24;
 constexpr int kMaxNodes = 2 * kMaxWords;  // every inner node has >= 2 children
 constexpr int kMaxImages = 1 << 24;
+constexpr float kMaxIdf = 17.0f;  // above log(kMaxImages) = 16.6
 constexpr size_t kNodeRecordBytes = 3 * sizeof(int32_t) + kDescriptorSize;
 // Nodes smaller than this are clustered on the calling thread: a parallel pass costs more.
 constexpr int kParallelMinPoints = 8192;
@@ -643,7 +644,7 @@ Result<InvertedFile> InvertedFile::Deserialize(ByteReader* reader, const std::st
     return IndexError(what, "truncated postings");
   }
   for (uint32_t w = 0; w < num_words; ++w) {
-    if (!std::isfinite(file.idf_[w]) || file.idf_[w] < 0.0f) {
+    if (!(file.idf_[w] >= 0.0f && file.idf_[w] <= kMaxIdf)) {
       return IndexError(what, "word " + std::to_string(w) + " has idf " + std::to_string(file.idf_[w]));
     }
   }

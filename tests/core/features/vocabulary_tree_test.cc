@@ -538,6 +538,13 @@ TEST(InvertedFileTest, RoundTripAndDamage) {
   }
   EXPECT_EQ(RoundTrip(InvertedFile()).num_images(), 0);
   ExpectTruncationsRefused<InvertedFile>(bytes, "map.bin: inverted file: ");
+  // An idf beyond log(2^24 images) would overflow the query's float weights.
+  for (const float idf : {1e30f, -1.0f, std::nanf("")}) {
+    std::string damaged = bytes;
+    std::memcpy(&damaged[8], &idf, 4);  // word 0, after num_images and num_words
+    ByteReader reader(damaged);
+    EXPECT_FALSE(InvertedFile::Deserialize(&reader, "map.bin").ok()) << idf;
+  }
   SplitMix64 rng(13);
   int accepted = 0;
   for (int m = 0; m < 4000; ++m) {
