@@ -128,8 +128,7 @@ Status VocabularyTreeOptions::Check() const {
 // Clusters the training subset top-down. The descriptors of a node are the range [begin, end) of
 // ids_; k-means splits it into at most `branching` clusters whose ranges become the children's.
 // Each node draws its k-means++ seeds from its own generator (seed and node index), and every
-// parallel step writes per-point results or integer sums, so the tree depends on neither the
-// thread count nor the order in which nodes are processed.
+// parallel step writes per-descriptor results, so the tree does not depend on the thread count.
 class VocabularyTree::Trainer {
  public:
   Trainer(const uint8_t* descriptors, std::vector<int32_t> ids, const VocabularyTreeOptions& options)
@@ -145,7 +144,8 @@ class VocabularyTree::Trainer {
         centroids_(max_clusters_ * kDescriptorSize),
         sums_(max_clusters_ * kDescriptorSize),
         counts_(max_clusters_),
-        remap_(max_clusters_) {
+        remap_(max_clusters_),
+        offsets_(max_clusters_ + 1) {
     const int threads = ThreadPool::ResolveThreadCount(options.num_threads);
     if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
   }
@@ -169,13 +169,7 @@ class VocabularyTree::Trainer {
       const int k = Cluster(task.node, task.begin, task.end - task.begin);
       if (k < 2) continue;
       // Counting sort of the node's ids by cluster (stable): child c gets [begin + offset[c], ...).
-      int32_t offsets[kMaxBranchingOnStack + 1];
-      std::vector<int32_t> big_offsets;
-      int32_t* offset = offsets;
-      if (k > kMaxBranchingOnStack) {
-        big_offsets.resize(static_cast<size_t>(k) + 1);
-        offset = big_offsets.data();
-      }
+      std::vector<int32_t>& offset = offsets_;
       offset[0] = task.begin;
       for (int c = 0; c < k; ++c) offset[c + 1] = offset[c] + static_cast<int32_t>(counts_[c]);
       for (int c = 0; c < k; ++c) counts_[c] = 0;
@@ -211,8 +205,6 @@ class VocabularyTree::Trainer {
   }
 
  private:
-  static constexpr int kMaxBranchingOnStack = 256;
-
   const uint8_t* Descriptor(int32_t position) const {
     return descriptors_ + static_cast<int64_t>(ids_[position]) * kDescriptorSize;
   }
@@ -356,7 +348,8 @@ class VocabularyTree::Trainer {
   std::vector<uint8_t> centroids_;  // the current node's k centroids
   std::vector<uint64_t> sums_;
   std::vector<uint64_t> counts_;
-  std::vector<int32_t> remap_;
+  std::vector<int32_t> remap_;    // cluster -> kept cluster
+  std::vector<int32_t> offsets_;  // the children's ranges in ids_
 };
 
 Result<VocabularyTree> VocabularyTree::Train(const uint8_t* descriptors, int count,
