@@ -19,13 +19,13 @@
 namespace reconar {
 
 struct VocabularyTreeOptions {
-  int branching = 10;             // k of each k-means
-  int depth = 4;                  // levels below the root: at most branching^depth words
-  int kmeans_iterations = 12;     // Lloyd iterations per node (k-means++ seeding)
+  int branching = 10;                     // k of each k-means
+  int depth = 4;                          // levels below the root: at most branching^depth words
+  int kmeans_iterations = 12;             // Lloyd iterations per node (k-means++ seeding)
   int max_training_descriptors = 200000;  // a random subset beyond this
-  int min_descriptors_per_node = 0;  // a node with fewer than max(branching, this) descriptors is a leaf
+  int min_descriptors_per_node = 0;       // a node with fewer than max(branching, this) descriptors is a leaf
   uint64_t seed = 0x766f6361'62747265ull;
-  int num_threads = 1;            // <= 0: one per core; the result does not depend on it
+  int num_threads = 1;  // <= 0: one per core; the result does not depend on it
 
   Status Check() const;
 };
@@ -54,10 +54,11 @@ class VocabularyTree {
   static Result<VocabularyTree> Deserialize(ByteReader* reader, const std::string& what);
 
  private:
+  class Trainer;  // hierarchical k-means (vocabulary_tree.cc)
   struct Node {
     int32_t first_child = -1;  // index of the first of num_children consecutive nodes; -1 for a leaf
     int32_t num_children = 0;
-    int32_t word = -1;         // leaves only
+    int32_t word = -1;  // leaves only
   };
   int branching_ = 0;
   int num_words_ = 0;
@@ -79,10 +80,10 @@ class RetrievalScratch {
 
  private:
   friend class InvertedFile;
-  std::vector<int32_t> words_;          // the query's words, sorted, with counts below
-  std::vector<float> weights_;
-  std::vector<float> accumulators_;     // per image
-  std::vector<int32_t> touched_;        // images with a non-zero accumulator
+  std::vector<int32_t> words_;       // the query's distinct words, sorted
+  std::vector<float> weights_;       // their normalised tf-idf weights
+  std::vector<float> accumulators_;  // per image
+  std::vector<int32_t> touched_;     // images with a non-zero accumulator
 };
 
 // tf-idf inverted file over the words of a vocabulary.
@@ -94,9 +95,10 @@ class InvertedFile {
   // InvalidArgument when a word is outside 0..num_words-1.
   static Result<InvertedFile> Build(int num_words, const std::vector<std::vector<int32_t>>& document_words);
 
-  // The best max(0, top_k) images by score, best first (ties: lower image first), written to
-  // `out` (whose capacity must hold top_k: no allocation when `scratch` has been reserved).
-  // Words outside the vocabulary are ignored.
+  // The best min(max(0, top_k), num_images()) images by score, best first (ties: lower image
+  // first, so images sharing no word follow with score 0), written to `out` (whose capacity must
+  // hold top_k: no allocation when `scratch` has been reserved). Words outside the vocabulary
+  // are ignored.
   void Query(const int32_t* words, int count, int top_k, RetrievalScratch* scratch,
              std::vector<RetrievalCandidate>* out) const;
 
