@@ -1,7 +1,6 @@
 // The map file (core/sfm/localization_map.h): writer and validating reader.
 //
-// Payload layout (little-endian, ByteWriter/ByteReader of
-// core/base/binary_io.h):
+// Payload layout (little-endian, ByteWriter/ByteReader of core/base/binary_io.h):
 //   string frame; uint8 metric (0 or 1);
 //   uint32 num_points; double xyz[num_points][3]; uint8 rgb[num_points][3];
 //     uint8 descriptor[num_points][128];
@@ -9,10 +8,8 @@
 //     string name; int32 width, height;
 //     double focal, cx, cy, k1, k2, aspect;
 //     double R[9] (cam_from_world, row-major), t[3];
-//     uint32 num_observations; float keypoint[n][2]; int32 point_id[n]; uint8
-//     descriptor[n][128];
-//   the vocabulary tree (VocabularyTree::Serialize); the inverted file
-//   (InvertedFile::Serialize).
+//     uint32 num_observations; float keypoint[n][2]; int32 point_id[n]; uint8 descriptor[n][128];
+//   the vocabulary tree (VocabularyTree::Serialize); the inverted file (InvertedFile::Serialize).
 // A string is a uint32 length and its characters.
 #include <algorithm>
 #include <cmath>
@@ -32,17 +29,16 @@ constexpr size_t kHeaderBytes = sizeof(kMagic) + sizeof(uint32_t) + sizeof(uint6
 constexpr size_t kDescriptorBytes = 128;
 constexpr uint32_t kMaxStringBytes = 4096;
 constexpr uint32_t kMaxCount = static_cast<uint32_t>(std::numeric_limits<int32_t>::max());
-// Bytes of one element behind each count: the guard that keeps a damaged count
-// from allocating more than the payload can hold.
+// Bytes of one element behind each count: the guard that keeps a damaged count from allocating more
+// than the payload can hold.
 constexpr size_t kPointBytes = 3 * sizeof(double) + 3 + kDescriptorBytes;
 constexpr size_t kKeyframeMinBytes =
     sizeof(uint32_t) + 2 * sizeof(int32_t) + 6 * sizeof(double) + 12 * sizeof(double) + sizeof(uint32_t);
 constexpr size_t kObservationBytes = 2 * sizeof(float) + sizeof(int32_t) + kDescriptorBytes;
 constexpr double kRotationTolerance = 1e-6;
 
-// The first inconsistency between the arrays of the map that share a count in
-// the file, or "".
-std::string SizeMismatch(const LocalizationMap &map) {
+// The first inconsistency between the arrays of the map that share a count in the file, or "".
+std::string SizeMismatch(const LocalizationMap& map) {
   const size_t n = map.points.size();
   if (n > kMaxCount || map.keyframes.size() > kMaxCount) return "too many points or keyframes";
   if (map.colors.size() != n || map.point_descriptors.size() != kDescriptorBytes * n) {
@@ -51,7 +47,7 @@ std::string SizeMismatch(const LocalizationMap &map) {
   }
   if (map.frame.size() > kMaxStringBytes) return "frame name longer than " + std::to_string(kMaxStringBytes);
   for (size_t i = 0; i < map.keyframes.size(); ++i) {
-    const MapKeyframe &keyframe = map.keyframes[i];
+    const MapKeyframe& keyframe = map.keyframes[i];
     const size_t m = keyframe.point_ids.size();
     if (keyframe.name.size() > kMaxStringBytes) return "keyframe " + std::to_string(i) + ": name too long";
     if (m > kMaxCount || keyframe.keypoints.size() != m || keyframe.descriptors.size() != kDescriptorBytes * m) {
@@ -62,14 +58,14 @@ std::string SizeMismatch(const LocalizationMap &map) {
   return "";
 }
 
-void PutDoubles(ByteWriter *writer, const double *values, int count) {
+void PutDoubles(ByteWriter* writer, const double* values, int count) {
   for (int i = 0; i < count; ++i) writer->Put(values[i]);
 }
 
-std::string SerializePayload(const LocalizationMap &map) {
+std::string SerializePayload(const LocalizationMap& map) {
   ByteWriter writer;
   size_t estimate = 64 + kPointBytes * map.points.size();
-  for (const MapKeyframe &keyframe : map.keyframes) {
+  for (const MapKeyframe& keyframe : map.keyframes) {
     estimate += kKeyframeMinBytes + keyframe.name.size() + kObservationBytes * keyframe.point_ids.size();
   }
   writer.bytes().reserve(estimate);
@@ -77,16 +73,16 @@ std::string SerializePayload(const LocalizationMap &map) {
   writer.PutString(map.frame);
   writer.Put(static_cast<uint8_t>(map.metric ? 1 : 0));
   writer.Put(static_cast<uint32_t>(map.points.size()));
-  for (const Eigen::Vector3d &point : map.points) PutDoubles(&writer, point.data(), 3);
-  for (const std::array<uint8_t, 3> &color : map.colors) writer.PutBytes(color.data(), 3);
+  for (const Eigen::Vector3d& point : map.points) PutDoubles(&writer, point.data(), 3);
+  for (const std::array<uint8_t, 3>& color : map.colors) writer.PutBytes(color.data(), 3);
   writer.PutBytes(map.point_descriptors.data(), map.point_descriptors.size());
 
   writer.Put(static_cast<uint32_t>(map.keyframes.size()));
-  for (const MapKeyframe &keyframe : map.keyframes) {
+  for (const MapKeyframe& keyframe : map.keyframes) {
     writer.PutString(keyframe.name);
     writer.Put(static_cast<int32_t>(keyframe.width));
     writer.Put(static_cast<int32_t>(keyframe.height));
-    const RadialCamera &camera = keyframe.camera;
+    const RadialCamera& camera = keyframe.camera;
     const double intrinsics[6] = {camera.focal, camera.cx, camera.cy, camera.k1, camera.k2, camera.aspect};
     PutDoubles(&writer, intrinsics, 6);
     for (int r = 0; r < 3; ++r) {
@@ -94,7 +90,7 @@ std::string SerializePayload(const LocalizationMap &map) {
     }
     PutDoubles(&writer, keyframe.cam_from_world.translation.data(), 3);
     writer.Put(static_cast<uint32_t>(keyframe.point_ids.size()));
-    for (const Eigen::Vector2f &keypoint : keyframe.keypoints) {
+    for (const Eigen::Vector2f& keypoint : keyframe.keypoints) {
       writer.Put(keypoint.x());
       writer.Put(keypoint.y());
     }
@@ -106,7 +102,7 @@ std::string SerializePayload(const LocalizationMap &map) {
   return std::move(writer.bytes());
 }
 
-std::string Header(const std::string &payload) {
+std::string Header(const std::string& payload) {
   ByteWriter writer;
   writer.PutBytes(kMagic, sizeof(kMagic));
   writer.Put(kVersion);
@@ -115,18 +111,17 @@ std::string Header(const std::string &payload) {
   return std::move(writer.bytes());
 }
 
-bool AllFinite(const double *values, int count) {
+bool AllFinite(const double* values, int count) {
   for (int i = 0; i < count; ++i) {
     if (!std::isfinite(values[i])) return false;
   }
   return true;
 }
 
-// Parses and validates the payload; every error is InvalidArgument "<what>:
-// <reason>".
+// Parses and validates the payload; every error is InvalidArgument "<what>: <reason>".
 class PayloadParser {
  public:
-  PayloadParser(std::string_view payload, const std::string &what) : reader_(payload), what_(what) {}
+  PayloadParser(std::string_view payload, const std::string& what) : reader_(payload), what_(what) {}
 
   Result<LocalizationMap> Parse() {
     LocalizationMap map;
@@ -160,18 +155,17 @@ class PayloadParser {
   }
 
  private:
-  Status Error(const std::string &reason) const { return InvalidArgument(what_ + ": " + reason); }
-  Status Truncated(const std::string &field) const {
+  Status Error(const std::string& reason) const { return InvalidArgument(what_ + ": " + reason); }
+  Status Truncated(const std::string& field) const {
     return Error("malformed payload: " + field + " at byte " + std::to_string(reader_.position()) +
                  " does not fit in the payload");
   }
-  // The vocabulary's errors already name `what`; whatever their code, a bad
-  // record is bad input.
-  static Status AsInvalidArgument(const Status &status) {
+  // The vocabulary's errors already name `what`; whatever their code, a bad record is bad input.
+  static Status AsInvalidArgument(const Status& status) {
     return status.code() == StatusCode::kInvalidArgument ? status : InvalidArgument(status.message());
   }
 
-  Status ParseHeaderFields(LocalizationMap *map) {
+  Status ParseHeaderFields(LocalizationMap* map) {
     uint8_t metric = 0;
     if (!reader_.GetString(kMaxStringBytes, &map->frame)) return Truncated("the frame name");
     if (!reader_.Get(&metric)) return Truncated("the metric flag");
@@ -180,7 +174,7 @@ class PayloadParser {
     return Status::Ok();
   }
 
-  Status ParsePoints(LocalizationMap *map) {
+  Status ParsePoints(LocalizationMap* map) {
     uint32_t n = 0;
     if (!reader_.GetCount(kPointBytes, kMaxCount, &n)) return Truncated("the point count");
     map->points.resize(n);
@@ -198,7 +192,7 @@ class PayloadParser {
     return Status::Ok();
   }
 
-  Status ParseKeyframe(int index, int num_points, MapKeyframe *keyframe) {
+  Status ParseKeyframe(int index, int num_points, MapKeyframe* keyframe) {
     const std::string label = "keyframe " + std::to_string(index);
     if (!reader_.GetString(kMaxStringBytes, &keyframe->name)) return Truncated(label + "'s name");
     if (keyframe->name.empty() || keyframe->name.find('\0') != std::string::npos) {
@@ -268,17 +262,17 @@ class PayloadParser {
   }
 
   ByteReader reader_;
-  const std::string &what_;
+  const std::string& what_;
 };
 
 }  // namespace
 
-Status WriteLocalizationMap(const std::string &path, const LocalizationMap &map) {
+Status WriteLocalizationMap(const std::string& path, const LocalizationMap& map) {
   const std::string mismatch = SizeMismatch(map);
   if (!mismatch.empty()) return InvalidArgument(path + ": cannot write the map: " + mismatch);
   const std::string payload = SerializePayload(map);
   const std::string header = Header(payload);
-  return WriteFileAtomically(path, [&](std::FILE *file) {
+  return WriteFileAtomically(path, [&](std::FILE* file) {
     if (std::fwrite(header.data(), 1, header.size(), file) != header.size() ||
         std::fwrite(payload.data(), 1, payload.size(), file) != payload.size()) {
       return FileError(StatusCode::kIoError, path, "write failed");
@@ -287,14 +281,14 @@ Status WriteLocalizationMap(const std::string &path, const LocalizationMap &map)
   });
 }
 
-Result<LocalizationMap> ReadLocalizationMap(const std::string &path) {
+Result<LocalizationMap> ReadLocalizationMap(const std::string& path) {
   Result<std::string> bytes = ReadFileToString(path);
   if (!bytes.ok()) return bytes.status();
   return ParseLocalizationMap(*bytes, path);
 }
 
-Result<LocalizationMap> ParseLocalizationMap(std::string_view bytes, const std::string &what) {
-  const auto error = [&](const std::string &reason) { return InvalidArgument(what + ": " + reason); };
+Result<LocalizationMap> ParseLocalizationMap(std::string_view bytes, const std::string& what) {
+  const auto error = [&](const std::string& reason) { return InvalidArgument(what + ": " + reason); };
   if (bytes.empty()) return error("not a reconar map file (empty file)");
   if (std::memcmp(bytes.data(), kMagic, std::min(bytes.size(), sizeof(kMagic))) != 0) {
     return error("not a reconar map file (bad magic)");

@@ -1,18 +1,15 @@
-// Mutation fuzzer of the map file reader (ParseLocalizationMap,
-// core/sfm/localization_map.h).
+// Mutation fuzzer of the map file reader (ParseLocalizationMap, core/sfm/localization_map.h).
 //
-//   localization_map_fuzz [--seconds S] [--seed N]
+//   localization_map_fuzz [--seconds S] [--seed N]    (S: CPU seconds of this process)
 //
-// Starts from valid map files (tests/core/sfm/sample_localization_map.h) and
-// applies 1-4 random mutations per iteration: bit flips, byte sets, special
-// doubles, chunk deletions, duplications and insertions, truncations, and
-// extreme values written into count fields (the offsets where the valid file
-// holds one of the map's counts). In most iterations the header's payload size
-// and CRC are then repaired so that the structural parser behind the checksum
-// sees the damage. Every result must be an ok map whose invariants hold or an
-// InvalidArgument naming the input; a crash or sanitizer report is the failure
-// this harness exists to find (run it in an ASan+UBSan build). Exit status 1
-// when an accepted map breaks an invariant or a status is not InvalidArgument.
+// Starts from valid map files (tests/core/sfm/sample_localization_map.h) and applies 1-4 random
+// mutations per iteration: bit flips, byte sets, special doubles, chunk deletions, duplications and
+// insertions, truncations, and extreme values written into count fields (the offsets where the
+// valid file holds one of the map's counts). In most iterations the header's payload size and CRC
+// are then repaired so that the structural parser behind the checksum sees the damage. Every result
+// must be an ok map whose invariants hold or an InvalidArgument naming the input; a crash or
+// sanitizer report is the failure this harness exists to find (run it in an ASan+UBSan build). Exit
+// status 1 when an accepted map breaks an invariant or a status is not InvalidArgument.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -37,11 +34,10 @@ constexpr char kWhat[] = "fuzz.rmap";
 
 struct Seed {
   std::string bytes;
-  std::vector<size_t> count_offsets;  // where the file holds a uint32 equal to
-                                      // one of the map's counts
+  std::vector<size_t> count_offsets;  // where the file holds a uint32 equal to one of the map's counts
 };
 
-Seed MakeSeed(const LocalizationMap &map, const std::string &path) {
+Seed MakeSeed(const LocalizationMap& map, const std::string& path) {
   Seed seed;
   const Status written = WriteLocalizationMap(path, map);
   if (!written.ok()) {
@@ -59,7 +55,7 @@ Seed MakeSeed(const LocalizationMap &map, const std::string &path) {
                                   static_cast<uint32_t>(map.keyframes.size()),
                                   static_cast<uint32_t>(map.vocabulary.num_nodes()),
                                   static_cast<uint32_t>(map.vocabulary.num_words())};
-  for (const MapKeyframe &keyframe : map.keyframes) {
+  for (const MapKeyframe& keyframe : map.keyframes) {
     counts.push_back(static_cast<uint32_t>(keyframe.name.size()));
     counts.push_back(static_cast<uint32_t>(keyframe.point_ids.size()));
   }
@@ -84,7 +80,7 @@ class Mutator {
   bool Chance(double p) { return std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < p; }
 
   // A position, mostly in the payload.
-  size_t Position(const std::string &bytes) {
+  size_t Position(const std::string& bytes) {
     if (bytes.empty()) return 0;
     if (bytes.size() > kHeaderBytes && !Chance(0.05)) {
       return static_cast<size_t>(Uniform(static_cast<int>(kHeaderBytes), static_cast<int>(bytes.size()) - 1));
@@ -118,7 +114,7 @@ class Mutator {
   }
 
   // One mutation; returns its name.
-  const char *Mutate(const Seed &seed, std::string *bytes) {
+  const char* Mutate(const Seed& seed, std::string* bytes) {
     const size_t size = bytes->size();
     switch (Uniform(0, 8)) {
       case 0: {
@@ -164,7 +160,7 @@ class Mutator {
       }
       case 5: {
         std::string chunk(static_cast<size_t>(Chance(0.8) ? Uniform(1, 16) : Uniform(1, 512)), '\0');
-        for (char &c : chunk) c = static_cast<char>(Uniform(0, 255));
+        for (char& c : chunk) c = static_cast<char>(Uniform(0, 255));
         bytes->insert(Position(*bytes), chunk);
         return "chunk insertion";
       }
@@ -194,22 +190,21 @@ class Mutator {
   std::mt19937_64 rng_;
 };
 
-// The promises of an accepted map (what localisation relies on without checking
-// again).
-std::string BrokenInvariant(const LocalizationMap &map) {
+// The promises of an accepted map (what localisation relies on without checking again).
+std::string BrokenInvariant(const LocalizationMap& map) {
   const size_t n = map.points.size();
   if (map.colors.size() != n || map.point_descriptors.size() != 128 * n) return "point arrays differ in size";
-  for (const Eigen::Vector3d &point : map.points) {
+  for (const Eigen::Vector3d& point : map.points) {
     if (!point.allFinite()) return "non-finite point";
   }
   if (map.keyframe_index.num_images() != static_cast<int>(map.keyframes.size())) return "index size";
   if (map.keyframe_index.num_words() != map.vocabulary.num_words()) return "index words";
-  for (const MapKeyframe &keyframe : map.keyframes) {
+  for (const MapKeyframe& keyframe : map.keyframes) {
     const size_t m = keyframe.point_ids.size();
     if (keyframe.keypoints.size() != m || keyframe.descriptors.size() != 128 * m) return "observation arrays";
     if (!(keyframe.camera.focal > 0.0) || !(keyframe.camera.aspect > 0.0)) return "camera";
     if (keyframe.width <= 0 || keyframe.height <= 0) return "image size";
-    const Eigen::Matrix3d &r = keyframe.cam_from_world.rotation;
+    const Eigen::Matrix3d& r = keyframe.cam_from_world.rotation;
     if (!((r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-6)) return "rotation";
     for (const int32_t id : keyframe.point_ids) {
       if (id < 0 || static_cast<size_t>(id) >= n) return "point id";
@@ -222,9 +217,8 @@ std::string BrokenInvariant(const LocalizationMap &map) {
   return "";
 }
 
-// The kind of a refusal: its message without `what`, numbers and parenthesised
-// details.
-std::string RefusalKind(const std::string &message) {
+// The kind of a refusal: its message without `what`, numbers and parenthesised details.
+std::string RefusalKind(const std::string& message) {
   std::string kind = message.substr(std::min(message.size(), sizeof(kWhat) + 1));
   const size_t at_byte = kind.find(" at byte");
   if (at_byte != std::string::npos) kind.resize(at_byte);
@@ -243,7 +237,7 @@ int Run(double seconds, uint64_t seed_value) {
       "/tmp/reconar_map_fuzz_" + std::to_string(seed_value) + "_" + std::to_string(std::time(nullptr));
   const std::vector<Seed> seeds = {MakeSeed(testing::SampleLocalizationMap(24, 2, 1), temp + "a.rmap"),
                                    MakeSeed(testing::SampleLocalizationMap(60, 3, 2), temp + "b.rmap")};
-  for (const Seed &seed : seeds) {
+  for (const Seed& seed : seeds) {
     Result<LocalizationMap> map = ParseLocalizationMap(seed.bytes, kWhat);
     if (!map.ok()) {
       std::fprintf(stderr, "the valid seed is refused: %s\n", map.status().ToString().c_str());
@@ -259,8 +253,9 @@ int Run(double seconds, uint64_t seed_value) {
   const auto start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
   std::string bytes;
-  while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < seconds) {
-    const Seed &seed = seeds[static_cast<size_t>(mutator.Uniform(0, static_cast<int>(seeds.size()) - 1))];
+  const auto cpu_seconds = [&] { return static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC; };
+  while (cpu_seconds() < seconds) {
+    const Seed& seed = seeds[static_cast<size_t>(mutator.Uniform(0, static_cast<int>(seeds.size()) - 1))];
     bytes = seed.bytes;
     const int num_mutations = mutator.Chance(0.6) ? 1 : mutator.Uniform(2, 4);
     for (int i = 0; i < num_mutations; ++i) mutator.Mutate(seed, &bytes);
@@ -279,7 +274,7 @@ int Run(double seconds, uint64_t seed_value) {
       }
     } else {
       ++rejected;
-      const Status &status = map.status();
+      const Status& status = map.status();
       if (status.code() != StatusCode::kInvalidArgument || status.message().rfind(std::string(kWhat) + ": ", 0) != 0) {
         std::fprintf(stderr, "iteration %ld: unexpected status %s\n", iterations, status.ToString().c_str());
         return 1;
@@ -287,20 +282,20 @@ int Run(double seconds, uint64_t seed_value) {
       ++refusals[RefusalKind(status.message())];
     }
   }
-  const double cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf(
-      "localization_map_fuzz: seed %llu, %.1f CPU s, %ld iterations "
-      "(%ld with a repaired header): "
-      "%ld accepted, %ld rejected\n",
-      static_cast<unsigned long long>(seed_value), cpu_seconds, iterations, repaired, accepted, rejected);
-  for (const auto &[kind, count] : refusals) std::printf("  %8ld  %s\n", count, kind.c_str());
+      "localization_map_fuzz: seed %llu, %.1f CPU s (%.1f s wall), %ld iterations (%ld with a repaired "
+      "header): %ld accepted, %ld rejected\n",
+      static_cast<unsigned long long>(seed_value), cpu_seconds(), wall_seconds, iterations, repaired, accepted,
+      rejected);
+  for (const auto& [kind, count] : refusals) std::printf("  %8ld  %s\n", count, kind.c_str());
   return 0;
 }
 
 }  // namespace
 }  // namespace reconar
 
-int main(int argc, char **argv) {
+int main(int argc, char** argv) {
   double seconds = 10.0;
   uint64_t seed = 1;
   for (int i = 1; i < argc; ++i) {

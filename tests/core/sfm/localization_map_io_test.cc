@@ -16,36 +16,36 @@ namespace fs = std::filesystem;
 using testing::RepairMapHeader;
 using testing::SampleLocalizationMap;
 
-fs::path TempDir(const std::string &name) {
+fs::path TempDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("reconar_map_io_" + std::to_string(::getpid())) / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
 }
 
-std::string ReadBytes(const fs::path &path) {
+std::string ReadBytes(const fs::path& path) {
   Result<std::string> bytes = ReadFileToString(path.string());
   EXPECT_TRUE(bytes.ok()) << bytes.status().ToString();
   return bytes.ok() ? *bytes : std::string();
 }
 
-void WriteBytes(const fs::path &path, const std::string &bytes) {
+void WriteBytes(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
-std::string Serialized(const VocabularyTree &tree) {
+std::string Serialized(const VocabularyTree& tree) {
   ByteWriter writer;
   tree.Serialize(&writer);
   return writer.bytes();
 }
 
-std::string Serialized(const InvertedFile &index) {
+std::string Serialized(const InvertedFile& index) {
   ByteWriter writer;
   index.Serialize(&writer);
   return writer.bytes();
 }
 
-void ExpectMapsEqual(const LocalizationMap &a, const LocalizationMap &b) {
+void ExpectMapsEqual(const LocalizationMap& a, const LocalizationMap& b) {
   EXPECT_EQ(a.frame, b.frame);
   EXPECT_EQ(a.metric, b.metric);
   ASSERT_EQ(a.points.size(), b.points.size());
@@ -55,8 +55,8 @@ void ExpectMapsEqual(const LocalizationMap &a, const LocalizationMap &b) {
   ASSERT_EQ(a.keyframes.size(), b.keyframes.size());
   for (size_t k = 0; k < a.keyframes.size(); ++k) {
     SCOPED_TRACE("keyframe " + std::to_string(k));
-    const MapKeyframe &x = a.keyframes[k];
-    const MapKeyframe &y = b.keyframes[k];
+    const MapKeyframe& x = a.keyframes[k];
+    const MapKeyframe& y = b.keyframes[k];
     EXPECT_EQ(x.name, y.name);
     EXPECT_EQ(x.width, y.width);
     EXPECT_EQ(x.height, y.height);
@@ -82,14 +82,13 @@ void ExpectMapsEqual(const LocalizationMap &a, const LocalizationMap &b) {
   EXPECT_EQ(Serialized(a.keyframe_index), Serialized(b.keyframe_index));
 }
 
-// The vocabulary and the index read back answer like the ones written: every
-// descriptor falls in the same word and every keyframe's query ranks the
-// keyframes the same way.
-void ExpectSameRetrieval(const LocalizationMap &a, const LocalizationMap &b) {
+// The vocabulary and the index read back answer like the ones written: every descriptor falls in
+// the same word and every keyframe's query ranks the keyframes the same way.
+void ExpectSameRetrieval(const LocalizationMap& a, const LocalizationMap& b) {
   const int num_images = a.keyframe_index.num_images();
   RetrievalScratch scratch_a;
   RetrievalScratch scratch_b;
-  for (const MapKeyframe &keyframe : a.keyframes) {
+  for (const MapKeyframe& keyframe : a.keyframes) {
     std::vector<int32_t> words_a;
     std::vector<int32_t> words_b;
     for (size_t j = 0; j < keyframe.descriptors.size(); j += 128) {
@@ -114,9 +113,8 @@ void ExpectSameRetrieval(const LocalizationMap &a, const LocalizationMap &b) {
   }
 }
 
-// The message of a refused parse, or "" (with a test failure) when it was
-// accepted.
-std::string Refusal(const std::string &bytes, const std::string &what = "map.rmap") {
+// The message of a refused parse, or "" (with a test failure) when it was accepted.
+std::string Refusal(const std::string& bytes, const std::string& what = "map.rmap") {
   Result<LocalizationMap> map = ParseLocalizationMap(bytes, what);
   EXPECT_FALSE(map.ok());
   if (map.ok()) return "";
@@ -135,7 +133,7 @@ class LocalizationMapIoTest : public ::testing::Test {
   }
 
   // The map file of `map` (written and read back as bytes).
-  std::string BytesOf(const LocalizationMap &map) {
+  std::string BytesOf(const LocalizationMap& map) {
     const std::string path = (dir_ / "other.rmap").string();
     const Status status = WriteLocalizationMap(path, map);
     EXPECT_TRUE(status.ok()) << status.ToString();
@@ -242,8 +240,7 @@ TEST_F(LocalizationMapIoTest, RefusesTrailingBytes) {
 }
 
 TEST_F(LocalizationMapIoTest, RefusesEveryTruncatedPayloadBehindAValidChecksum) {
-  // Every cut of the payload, with the header repaired: the structural parser
-  // must refuse it.
+  // Every cut of the payload, with the header repaired: the structural parser must refuse it.
   for (size_t size = 24; size < bytes_.size(); ++size) {
     std::string bytes = bytes_.substr(0, size);
     RepairMapHeader(&bytes);
@@ -275,11 +272,10 @@ TEST_F(LocalizationMapIoTest, WriteErrorsNameThePath) {
   EXPECT_FALSE(fs::exists(path));
 }
 
-// Content the format can hold but a map must not: written (the writer checks
-// only that the arrays agree in size), then refused by the reader with the
-// reason.
+// Content the format can hold but a map must not: written (the writer checks only that the arrays
+// agree in size), then refused by the reader with the reason.
 TEST_F(LocalizationMapIoTest, RefusesInvalidContentBehindAValidChecksum) {
-  const auto refusal_of = [&](const LocalizationMap &map) { return Refusal(BytesOf(map)); };
+  const auto refusal_of = [&](const LocalizationMap& map) { return Refusal(BytesOf(map)); };
   const std::string kf1 = "map.rmap: keyframe 1 (IMG_1001.JPG): ";
   {
     LocalizationMap map = map_;
@@ -346,11 +342,9 @@ TEST_F(LocalizationMapIoTest, RefusesInvalidContentBehindAValidChecksum) {
   }
 }
 
-// A count far beyond the bytes left is refused before anything is allocated for
-// it.
+// A count far beyond the bytes left is refused before anything is allocated for it.
 TEST_F(LocalizationMapIoTest, RefusesHugeCountsBehindAValidChecksum) {
-  // The point count follows the frame name (uint32 length + characters) and the
-  // metric flag.
+  // The point count follows the frame name (uint32 length + characters) and the metric flag.
   const size_t at = 24 + 4 + map_.frame.size() + 1;
   uint32_t count = 0;
   std::memcpy(&count, &bytes_[at], sizeof(count));

@@ -63,7 +63,7 @@ LocalizationMap SampleLocalizationMap(int num_points, int num_keyframes, unsigne
   map.vocabulary = std::move(vocabulary).value();
   std::vector<std::vector<int32_t>> words(map.keyframes.size());
   for (size_t k = 0; k < map.keyframes.size(); ++k) {
-    const std::vector<uint8_t> &descriptors = map.keyframes[k].descriptors;
+    const std::vector<uint8_t>& descriptors = map.keyframes[k].descriptors;
     for (size_t j = 0; j < descriptors.size(); j += 128) words[k].push_back(map.vocabulary.Quantize(&descriptors[j]));
   }
   Result<InvertedFile> index = InvertedFile::Build(map.vocabulary.num_words(), words);
@@ -72,7 +72,7 @@ LocalizationMap SampleLocalizationMap(int num_points, int num_keyframes, unsigne
   return map;
 }
 
-void RepairMapHeader(std::string *file_bytes) {
+void RepairMapHeader(std::string* file_bytes) {
   constexpr size_t kHeaderBytes = 24;
   if (file_bytes->size() < kHeaderBytes) return;
   const uint64_t payload_bytes = file_bytes->size() - kHeaderBytes;
