@@ -52,6 +52,7 @@ class ByteReader {
   }
   bool GetBytes(void* out, size_t size) {
     if (!ok_ || size > remaining()) return ok_ = false;
+    if (size == 0) return true;  // `out` may be the null data() of an empty vector
     std::memcpy(out, bytes_.data() + position_, size);
     position_ += size;
     return true;
