@@ -54,12 +54,6 @@ int NearestCentroid(const DescriptorDistanceKernel& kernel, const uint8_t* query
   return best;
 }
 
-// Reads values->size() plain values; an empty vector has no storage to hand to memcpy.
-template <typename T>
-bool GetArray(ByteReader* reader, std::vector<T>* values) {
-  return values->empty() ? reader->ok() : reader->GetBytes(values->data(), values->size() * sizeof(T));
-}
-
 Status TreeError(const std::string& what, const std::string& reason) {
   return InvalidArgument(what + ": vocabulary tree: " + reason);
 }
@@ -430,7 +424,7 @@ Result<VocabularyTree> VocabularyTree::Deserialize(ByteReader* reader, const std
     reader->Get(&node.word);
   }
   tree.centroids_.resize(static_cast<size_t>(num_nodes) * kDescriptorSize);
-  GetArray(reader, &tree.centroids_);
+  reader->GetBytes(tree.centroids_.data(), tree.centroids_.size());
   if (!reader->ok()) return TreeError(what, "truncated nodes");
 
   // Children lie after their parent (no cycles) and every node but the root has exactly one
@@ -626,14 +620,14 @@ Result<InvertedFile> InvertedFile::Deserialize(ByteReader* reader, const std::st
   file.num_images_ = num_images;
   file.idf_.resize(num_words);
   file.posting_offsets_.resize(static_cast<size_t>(num_words) + 1);
-  GetArray(reader, &file.idf_);
-  GetArray(reader, &file.posting_offsets_);
+  reader->GetBytes(file.idf_.data(), file.idf_.size() * sizeof(float));
+  reader->GetBytes(file.posting_offsets_.data(), file.posting_offsets_.size() * sizeof(uint32_t));
   uint32_t num_postings = 0;
   if (!reader->GetCount(sizeof(Posting), UINT32_MAX, &num_postings)) {
     return IndexError(what, "truncated words or posting count beyond the record");
   }
   file.postings_.resize(num_postings);
-  if (!GetArray(reader, &file.postings_)) {
+  if (!reader->GetBytes(file.postings_.data(), file.postings_.size() * sizeof(Posting))) {
     return IndexError(what, "truncated postings");
   }
   for (uint32_t w = 0; w < num_words; ++w) {
