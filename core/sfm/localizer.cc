@@ -28,14 +28,17 @@ bool SameAspect(int width_a, int height_a, int width_b, int height_b) {
              0.01 * static_cast<double>(width_a) * height_b;
 }
 
-// Neighbours searched per query descriptor: the nearest and, among the rest, the nearest
-// observation of another map point (a point seen in several retrieved keyframes fills several).
-constexpr int kNeighbours = 6;
+// Neighbours searched per query descriptor: one more than the retrieved keyframes, so that
+// besides the nearest observation there is always one of another map point (a point has at most
+// one observation per keyframe), unless the forest holds no other.
+constexpr int kMaxNeighbours = LocalizerOptions::kMaxKeyframes + 1;
 
 }  // namespace
 
 Status LocalizerOptions::Check() const {
-  if (num_keyframes < 1) return InvalidArgument("LocalizerOptions: num_keyframes must be >= 1");
+  if (num_keyframes < 1 || num_keyframes > kMaxKeyframes) {
+    return InvalidArgument("LocalizerOptions: num_keyframes must be in 1.." + std::to_string(kMaxKeyframes));
+  }
   if (!(max_ratio > 0.0 && max_ratio <= 1.0)) return InvalidArgument("LocalizerOptions: max_ratio must be in (0, 1]");
   if (max_leaf_checks < 1) return InvalidArgument("LocalizerOptions: max_leaf_checks must be >= 1");
   if (min_inliers < 4) return InvalidArgument("LocalizerOptions: min_inliers must be >= 4");
@@ -174,15 +177,14 @@ Result<LocalizationResult> Localizer::Localize(const SiftFeatures &features, con
   std::vector<int> best_distance(map.points.size(), std::numeric_limits<int>::max());
   std::vector<int> touched;
   const double ratio_squared = options_.max_ratio * options_.max_ratio;
+  const int neighbours = std::min(static_cast<int>(result.keyframes.size()) + 1, kMaxNeighbours);
   for (int q = 0; q < num_features; ++q) {
-    int indices[kNeighbours], distances[kNeighbours];
-    const int found = forest.Search(features.descriptor(static_cast<size_t>(q)), kNeighbours, options_.max_leaf_checks,
+    int indices[kMaxNeighbours], distances[kMaxNeighbours];
+    const int found = forest.Search(features.descriptor(static_cast<size_t>(q)), neighbours, options_.max_leaf_checks,
                                     indices, distances, &search_scratch);
-    if (found < 2) continue;
+    if (found < 1) continue;
     const int point = point_of[static_cast<size_t>(indices[0])];
-    // The nearest observation of another point; when all found share the point, the farthest found
-    // bounds it from below.
-    int second = distances[found - 1];
+    int second = std::numeric_limits<int>::max();
     for (int k = 1; k < found; ++k) {
       if (point_of[static_cast<size_t>(indices[k])] != point) {
         second = distances[k];

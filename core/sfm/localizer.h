@@ -26,7 +26,8 @@
 namespace reconar {
 
 struct LocalizerOptions {
-  int num_keyframes = 10;     // retrieved keyframes matched against
+  static constexpr int kMaxKeyframes = 32;
+  int num_keyframes = 10;     // retrieved keyframes matched against, at most kMaxKeyframes
   double max_ratio = 0.8;     // Lowe's ratio (distances, not squared)
   int max_leaf_checks = 128;  // kd-forest search budget per query descriptor
   int min_inliers = 30;
