@@ -36,15 +36,15 @@ double Median(std::vector<double> values) {
   return n == 0 ? 0.0 : (n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
 }
 
-double RotationAngleDeg(const Eigen::Matrix3d &a, const Eigen::Matrix3d &b) {
+double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   const double c = std::clamp(((a * b.transpose()).trace() - 1.0) / 2.0, -1.0, 1.0);
   return std::acos(c) * 180.0 / M_PI;
 }
 
 // The views of `names` linked into a fresh directory.
-fs::path LinkViews(const fs::path &dir, const std::string &data, const std::vector<std::string> &names) {
+fs::path LinkViews(const fs::path& dir, const std::string& data, const std::vector<std::string>& names) {
   fs::create_directories(dir);
-  for (const std::string &name : names) fs::create_symlink(data + "/" + name, dir / name);
+  for (const std::string& name : names) fs::create_symlink(data + "/" + name, dir / name);
   return dir;
 }
 
@@ -56,7 +56,7 @@ struct Localized {
   std::string reason;
 };
 
-std::map<std::string, Localized> ParseLocalizeJson(const std::string &output) {
+std::map<std::string, Localized> ParseLocalizeJson(const std::string& output) {
   std::map<std::string, Localized> result;
   std::istringstream lines(output);
   std::string line;
@@ -69,10 +69,10 @@ std::map<std::string, Localized> ParseLocalizeJson(const std::string &output) {
     entry.registered = json->Find("registered")->bool_value();
     entry.reason = json->Find("reason")->string();
     if (entry.registered) {
-      const JsonValue &pose = *json->Find("cam_from_world");
+      const JsonValue& pose = *json->Find("cam_from_world");
       for (int i = 0; i < 9; ++i) entry.R(i / 3, i % 3) = (*pose.Find("R"))[static_cast<size_t>(i)].number();
       for (int i = 0; i < 3; ++i) entry.t(i) = (*pose.Find("t"))[static_cast<size_t>(i)].number();
-      const JsonValue &camera = *json->Find("camera");
+      const JsonValue& camera = *json->Find("camera");
       entry.fx = camera.Find("fx")->number();
       entry.fy = camera.Find("fy")->number();
       entry.cx = camera.Find("cx")->number();
@@ -85,7 +85,7 @@ std::map<std::string, Localized> ParseLocalizeJson(const std::string &output) {
   return result;
 }
 
-Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eigen::Vector3d &X) {
+Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera& camera, const Eigen::Vector3d& X) {
   const Eigen::Vector3d x = camera.K * (camera.cam_from_world_rotation * X + camera.cam_from_world_translation);
   return x.head<2>() / x.z();
 }
@@ -93,11 +93,11 @@ Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eige
 // Mean pixel distance between the points projected with the estimated camera (intrinsics,
 // rotation and centre in the ground truth's frame) and with the true one, over the points the
 // true camera sees in its 640 x 480 image.
-double OverlayError(const RadialCamera &camera, const Eigen::Matrix3d &rotation_gt, const Eigen::Vector3d &centre_gt,
-                    const testing::GroundTruthCamera &gt, const std::vector<Eigen::Vector3d> &points_gt, int *count) {
+double OverlayError(const RadialCamera& camera, const Eigen::Matrix3d& rotation_gt, const Eigen::Vector3d& centre_gt,
+                    const testing::GroundTruthCamera& gt, const std::vector<Eigen::Vector3d>& points_gt, int* count) {
   double sum = 0.0;
   *count = 0;
-  for (const Eigen::Vector3d &X : points_gt) {
+  for (const Eigen::Vector3d& X : points_gt) {
     const Eigen::Vector3d in_true = gt.cam_from_world_rotation * X + gt.cam_from_world_translation;
     const Eigen::Vector3d in_estimate = rotation_gt * (X - centre_gt);
     if (in_true.z() <= 0.0 || in_estimate.z() <= 0.0) continue;
@@ -131,10 +131,10 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
 
   // The similarity that aligns the map's own cameras to the ground truth.
   std::map<std::string, testing::GroundTruthCamera> truth_by_name;
-  for (const auto &named : *truth) truth_by_name[named.name] = named.camera;
+  for (const auto& named : *truth) truth_by_name[named.name] = named.camera;
   std::vector<testing::CameraPose> estimated, reference;
   std::set<std::string> in_map;
-  for (const SfmImage &image : model->images) {
+  for (const SfmImage& image : model->images) {
     if (!image.registered) continue;
     in_map.insert(image.name);
     estimated.push_back({image.cam_from_world.rotation, image.Center()});
@@ -142,7 +142,7 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   }
   auto alignment = testing::CameraCenterErrors(estimated, reference);
   ASSERT_TRUE(alignment.ok()) << alignment.status().ToString();
-  const Sim3 &gt_from_map = alignment->gt_from_estimate;
+  const Sim3& gt_from_map = alignment->gt_from_estimate;
   std::printf(
       "map: %zu of 24 odd views registered, mean centre error of the "
       "map's cameras %.3f mm\n",
@@ -155,12 +155,12 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   ASSERT_EQ(results.size(), even.size()) << localize.output;
 
   std::vector<Eigen::Vector3d> points_gt;
-  for (const SfmPoint &point : model->points) {
+  for (const SfmPoint& point : model->points) {
     if (!point.deleted) points_gt.push_back(gt_from_map.Apply(point.position));
   }
   // The map's own cameras under the same alignment: what localisation cannot do better than.
   std::vector<double> map_overlay_errors;
-  for (const SfmImage &image : model->images) {
+  for (const SfmImage& image : model->images) {
     if (!image.registered) continue;
     int count = 0;
     map_overlay_errors.push_back(OverlayError(model->cameras[static_cast<size_t>(image.camera_id)],
@@ -172,10 +172,10 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   std::vector<double> centre_errors, rotation_errors, overlay_errors;
   int expected = 0, localized_expected = 0, localized = 0;
   for (size_t i = 1; i < truth->size(); i += 2) {
-    const std::string &name = (*truth)[i].name;
+    const std::string& name = (*truth)[i].name;
     const bool neighbours_in_map = in_map.count((*truth)[i - 1].name) != 0 && in_map.count((*truth)[i + 1].name) != 0;
     expected += neighbours_in_map ? 1 : 0;
-    const Localized &result = results.at(name);
+    const Localized& result = results.at(name);
     if (!result.registered) {
       std::printf("%s: not localised (%s)%s\n", name.c_str(), result.reason.c_str(),
                   neighbours_in_map ? " [both neighbours in the map]" : "");
@@ -187,7 +187,7 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
     const Eigen::Vector3d centre_map = -result.R.transpose() * result.t;
     const Eigen::Vector3d centre_gt = gt_from_map.Apply(centre_map);
     const Eigen::Matrix3d rotation_gt = result.R * gt_from_map.rotation.transpose();
-    const testing::GroundTruthCamera &gt = truth_by_name.at(name);
+    const testing::GroundTruthCamera& gt = truth_by_name.at(name);
     centre_errors.push_back((centre_gt - gt.Centre()).norm());
     rotation_errors.push_back(RotationAngleDeg(rotation_gt, gt.cam_from_world_rotation));
     RadialCamera camera;
