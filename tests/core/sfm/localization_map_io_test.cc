@@ -306,7 +306,13 @@ TEST_F(LocalizationMapIoTest, RefusesInvalidContentBehindAValidChecksum) {
   {
     LocalizationMap map = map_;
     map.keyframes[0].name.clear();
-    EXPECT_EQ(refusal_of(map), "map.rmap: keyframe 0: empty name or NUL in name");
+    EXPECT_EQ(refusal_of(map), "map.rmap: keyframe 0: empty name or control character in name");
+    map.keyframes[0].name = std::string("IMG\0.JPG", 8);
+    EXPECT_EQ(refusal_of(map), "map.rmap: keyframe 0: empty name or control character in name");
+    map.keyframes[0].name = "IMG\n.JPG";
+    EXPECT_EQ(refusal_of(map), "map.rmap: keyframe 0: empty name or control character in name");
+    map.keyframes[0].name = "Caf\xc3\xa9 1.jpg";  // UTF-8 is a name like any other
+    EXPECT_TRUE(ParseLocalizationMap(BytesOf(map), "map.rmap").ok());
   }
   {
     LocalizationMap map = map_;
