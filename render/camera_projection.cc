@@ -14,19 +14,7 @@ Status DepthRange::Check() const {
 }
 
 CameraIntrinsics IntrinsicsForTarget(const CameraIntrinsics& intrinsics, int target_width, int target_height) {
-  CameraIntrinsics scaled = intrinsics;
-  if (intrinsics.width > 0 && intrinsics.height > 0 &&
-      (intrinsics.width != target_width || intrinsics.height != target_height)) {
-    const double sx = static_cast<double>(target_width) / intrinsics.width;
-    const double sy = static_cast<double>(target_height) / intrinsics.height;
-    scaled.fx = intrinsics.fx * sx;
-    scaled.fy = intrinsics.fy * sy;
-    scaled.cx = (intrinsics.cx + 0.5) * sx - 0.5;
-    scaled.cy = (intrinsics.cy + 0.5) * sy - 0.5;
-    scaled.width = target_width;
-    scaled.height = target_height;
-  }
-  return scaled;
+  return ScaledIntrinsics(intrinsics, target_width, target_height);
 }
 
 Eigen::Matrix4d ClipFromCamera(const CameraIntrinsics& intrinsics, int width, int height, const DepthRange& depth) {

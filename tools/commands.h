@@ -15,6 +15,8 @@ int RunExport(int argc, char** argv, int first);
 int RunMesh(int argc, char** argv, int first);
 int RunDense(int argc, char** argv, int first);
 int RunReconstruct(int argc, char** argv, int first);
+int RunMap(int argc, char** argv, int first);
+int RunLocalize(int argc, char** argv, int first);
 // reconstruct and sfm (sparse_only: the sparse stages, no preview): tools/reconstruct_command.cc.
 int RunReconstructCommand(int argc, char** argv, int first, const char* help, bool sparse_only);
 

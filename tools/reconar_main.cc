@@ -20,6 +20,8 @@ constexpr char kUsage[] =
     "  match IMAGE_A IMAGE_B [--pairs OUT.txt]             verified matches between two photos\n"
     "  match --project DIR                                 verified matches between all pairs of a project\n"
     "  sfm IMAGES_DIR PROJECT_DIR                          cameras and sparse points (structure from motion)\n"
+    "  map PROJECT_DIR                                     localisation map for markerless AR (rebuild)\n"
+    "  localize PROJECT_DIR IMAGE|DIR... [--json]          camera poses of photos against the map\n"
     "  dense PROJECT_DIR                                   dense oriented points (multi-view stereo)\n"
     "  mesh POINTS.ply OUT.{ply,obj,glb,wrl} [--depth N]   Poisson surface from oriented points\n"
     "  export IN.{ply,glb,obj} OUT.{ply,obj,glb,wrl}       convert a mesh or point cloud between formats\n"
@@ -62,6 +64,8 @@ int main(int argc, char** argv) {
   if (command == "mesh") return reconar::tools::RunMesh(argc, argv, 2);
   if (command == "dense") return reconar::tools::RunDense(argc, argv, 2);
   if (command == "reconstruct") return reconar::tools::RunReconstruct(argc, argv, 2);
+  if (command == "map") return reconar::tools::RunMap(argc, argv, 2);
+  if (command == "localize") return reconar::tools::RunLocalize(argc, argv, 2);
   if (command == "view") {
 #ifdef RECONAR_HAVE_VIEW
     return reconar::tools::RunView(argc, argv, 2);

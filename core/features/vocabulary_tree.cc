@@ -18,6 +18,7 @@ namespace {
 constexpr int kMaxWords = 1 << 24;
 constexpr int kMaxNodes = 2 * kMaxWords;  // every inner node has >= 2 children
 constexpr int kMaxImages = 1 << 24;
+constexpr float kMaxIdf = 17.0f;  // above log(kMaxImages) = 16.6
 constexpr size_t kNodeRecordBytes = 3 * sizeof(int32_t) + kDescriptorSize;
 // Nodes smaller than this are clustered on the calling thread: a parallel pass costs more.
 constexpr int kParallelMinPoints = 8192;
@@ -121,8 +122,7 @@ Status VocabularyTreeOptions::Check() const {
 // Clusters the training subset top-down. The descriptors of a node are the range [begin, end) of
 // ids_; k-means splits it into at most `branching` clusters whose ranges become the children's.
 // Each node draws its k-means++ seeds from its own generator (seed and node index), and every
-// parallel step writes per-point results or integer sums, so the tree depends on neither the
-// thread count nor the order in which nodes are processed.
+// parallel step writes per-descriptor results, so the tree does not depend on the thread count.
 class VocabularyTree::Trainer {
  public:
   Trainer(const uint8_t* descriptors, std::vector<int32_t> ids, const VocabularyTreeOptions& options)
@@ -133,10 +133,13 @@ class VocabularyTree::Trainer {
         assignment_(ids_.size()),
         distance_(ids_.size()),
         scratch_ids_(ids_.size()),
-        centroids_(static_cast<size_t>(options.branching) * kDescriptorSize),
-        sums_(static_cast<size_t>(options.branching) * kDescriptorSize),
-        counts_(static_cast<size_t>(options.branching)),
-        remap_(static_cast<size_t>(options.branching)) {
+        // A node is split only when it has at least `branching` descriptors.
+        max_clusters_(std::min(ids_.size(), static_cast<size_t>(options.branching))),
+        centroids_(max_clusters_ * kDescriptorSize),
+        sums_(max_clusters_ * kDescriptorSize),
+        counts_(max_clusters_),
+        remap_(max_clusters_),
+        offsets_(max_clusters_ + 1) {
     const int threads = ThreadPool::ResolveThreadCount(options.num_threads);
     if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
   }
@@ -160,13 +163,7 @@ class VocabularyTree::Trainer {
       const int k = Cluster(task.node, task.begin, task.end - task.begin);
       if (k < 2) continue;
       // Counting sort of the node's ids by cluster (stable): child c gets [begin + offset[c], ...).
-      int32_t offsets[kMaxBranchingOnStack + 1];
-      std::vector<int32_t> big_offsets;
-      int32_t* offset = offsets;
-      if (k > kMaxBranchingOnStack) {
-        big_offsets.resize(static_cast<size_t>(k) + 1);
-        offset = big_offsets.data();
-      }
+      std::vector<int32_t>& offset = offsets_;
       offset[0] = task.begin;
       for (int c = 0; c < k; ++c) offset[c + 1] = offset[c] + static_cast<int32_t>(counts_[c]);
       for (int c = 0; c < k; ++c) counts_[c] = 0;
@@ -202,8 +199,6 @@ class VocabularyTree::Trainer {
   }
 
  private:
-  static constexpr int kMaxBranchingOnStack = 256;
-
   const uint8_t* Descriptor(int32_t position) const {
     return descriptors_ + static_cast<int64_t>(ids_[position]) * kDescriptorSize;
   }
@@ -343,10 +338,12 @@ class VocabularyTree::Trainer {
   std::vector<int32_t> assignment_;   // per position in ids_: cluster within the current node
   std::vector<int32_t> distance_;     // per position: squared distance to that cluster's centroid
   std::vector<int32_t> scratch_ids_;  // partition buffer
-  std::vector<uint8_t> centroids_;    // the current node's k centroids
+  const size_t max_clusters_;
+  std::vector<uint8_t> centroids_;  // the current node's k centroids
   std::vector<uint64_t> sums_;
   std::vector<uint64_t> counts_;
-  std::vector<int32_t> remap_;
+  std::vector<int32_t> remap_;    // cluster -> kept cluster
+  std::vector<int32_t> offsets_;  // the children's ranges in ids_
 };
 
 Result<VocabularyTree> VocabularyTree::Train(const uint8_t* descriptors, int count,
@@ -634,7 +631,7 @@ Result<InvertedFile> InvertedFile::Deserialize(ByteReader* reader, const std::st
     return IndexError(what, "truncated postings");
   }
   for (uint32_t w = 0; w < num_words; ++w) {
-    if (!std::isfinite(file.idf_[w]) || file.idf_[w] < 0.0f) {
+    if (!(file.idf_[w] >= 0.0f && file.idf_[w] <= kMaxIdf)) {
       return IndexError(what, "word " + std::to_string(w) + " has idf " + std::to_string(file.idf_[w]));
     }
   }

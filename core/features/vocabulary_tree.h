@@ -32,7 +32,7 @@ struct VocabularyTreeOptions {
 
 class VocabularyTree {
  public:
-  VocabularyTree() = default;  // empty: every descriptor quantises to word 0 of 0 words
+  VocabularyTree() = default;  // empty: no words, Quantize returns -1
 
   // Trains on `count` descriptors (count * 128 bytes). InvalidArgument on bad options, a null
   // pointer or count < 1.

@@ -5,10 +5,13 @@
 // Pixel convention (DESIGN.md): the centre of the top-left pixel is (0, 0), x right, y down.
 // A camera point X (z forward) maps to p = X.xy / X.z, d = 1 + k1 |p|^2 + k2 |p|^4,
 // u = fx d p.x + cx, v = fy d p.y + cy.
+#include <cmath>
 #include <limits>
+#include <string>
 
 #include <Eigen/Core>
 
+#include "core/base/status.h"
 #include "core/math/radial_camera.h"
 
 namespace reconar {
@@ -47,5 +50,36 @@ struct CameraIntrinsics {
     return normalised;
   }
 };
+
+// The same camera for images of width x height (a resampled copy of its images): fx, cx scale by
+// width / this width, fy, cy by height / this height, pixel centres staying at integer
+// coordinates. Unchanged when its own size is unknown (0) or equal.
+inline CameraIntrinsics ScaledIntrinsics(const CameraIntrinsics& intrinsics, int width, int height) {
+  CameraIntrinsics scaled = intrinsics;
+  if (intrinsics.width > 0 && intrinsics.height > 0 && (intrinsics.width != width || intrinsics.height != height)) {
+    const double sx = static_cast<double>(width) / intrinsics.width;
+    const double sy = static_cast<double>(height) / intrinsics.height;
+    scaled.fx = intrinsics.fx * sx;
+    scaled.fy = intrinsics.fy * sy;
+    scaled.cx = (intrinsics.cx + 0.5) * sx - 0.5;
+    scaled.cy = (intrinsics.cy + 0.5) * sy - 0.5;
+    scaled.width = width;
+    scaled.height = height;
+  }
+  return scaled;
+}
+
+// ScaledIntrinsics for video or photos of another size with the same aspect ratio (a phone's
+// video mode); InvalidArgument when the aspect ratios differ by more than 1 %.
+inline Result<CameraIntrinsics> ScaleIntrinsicsToFrame(const CameraIntrinsics& photo, int width, int height) {
+  if (photo.width == width && photo.height == height) return photo;
+  if (photo.width <= 0 || std::abs(static_cast<double>(photo.width) * height -
+                                   static_cast<double>(photo.height) * width) > 0.01 * photo.width * height) {
+    return InvalidArgument("the project's photos are " + std::to_string(photo.width) + "x" +
+                           std::to_string(photo.height) + ", the images " + std::to_string(width) + "x" +
+                           std::to_string(height) + ": pass --intrinsics for this camera");
+  }
+  return ScaledIntrinsics(photo, width, height);
+}
 
 }  // namespace reconar

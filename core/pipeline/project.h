@@ -1,6 +1,6 @@
 #pragma once
 // A project folder: features/ (one .rfeat per image plus images.txt), matches/ (matches.txt),
-// sparse/ (the sparse model, see sfm_stage.h) and report.json.
+// sparse/ (the sparse model, see sfm_stage.h), map/ (the localisation map, map_stage.h) and report.json.
 // images.txt lists, one image per line, "name width height focal_px focal_source path"; names are
 // unique within a project and key every other file.
 #include <cstddef>
@@ -41,6 +41,8 @@ class Project {
   std::string TagLayoutPath() const { return root_ + "/tags.layout"; }
   std::string DensePointsPath() const { return root_ + "/dense/points.ply"; }
   std::string MeshDir() const { return root_ + "/mesh"; }
+  std::string MapDir() const { return root_ + "/map"; }
+  std::string MapPath() const { return MapDir() + "/map.rmap"; }  // core/sfm/localization_map.h
 
   Status WriteImageList(const std::vector<ProjectImage>& images) const;
   Result<std::vector<ProjectImage>> ReadImageList() const;

@@ -14,6 +14,7 @@
 #include "core/base/memory_usage.h"
 #include "core/base/thread_pool.h"
 #include "core/io/image_io.h"
+#include "core/pipeline/map_stage.h"
 #include "core/pipeline/stage_record.h"
 #include "core/sfm/model_io.h"
 
@@ -85,7 +86,7 @@ class StageRunner {
       report_->stages.push_back(summary);
       return Status::Ok();
     }
-    redone_ = true;
+    if (!IsSideStage(name)) redone_ = true;  // no later stage reads a side stage's outputs
     if (options_.show_progress) std::fprintf(stderr, "reconstruct: [%d] %s\n", index_, name.c_str());
     ReleaseFreeHeapMemory();
     ResetPeakResidentBytes();
@@ -212,6 +213,7 @@ Status ReconstructOptions::Check() const {
   if (memory_budget_bytes < (64u << 20)) return InvalidArgument("the memory budget must be at least 64 MiB");
   if (!(sfm.mapper.max_reprojection_error_px > 0.0))
     return InvalidArgument("the maximum reprojection error must be positive");
+  RECONAR_RETURN_IF_ERROR(map.Check());
   RECONAR_RETURN_IF_ERROR(dense.Check());
   return mesh.Check();
 }
@@ -325,6 +327,17 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
                                                  {"world_tag", sfm.tags.registration.world_tag},
                                                  {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}}),
                                        Exists(project.SparseDir() + "/report.json"), runner.redone(), run_mapping));
+
+    MapStageOptions map = options.map;
+    map.build.num_threads = threads;
+    const auto run_map = [&](StageSummary* summary) -> Status {
+      RECONAR_ASSIGN_OR_RETURN(const MapStageReport r, RunMapStage(project, map));
+      summary->note = std::to_string(r.build.keyframes) + " keyframes, " + std::to_string(r.build.points) +
+                      " points, " + std::to_string(static_cast<int>(Mib(r.file_bytes) + 0.5)) + " MiB";
+      return Status::Ok();
+    };
+    RECONAR_RETURN_IF_ERROR(
+        runner.Run("map", MapStageSettings(map), Exists(project.MapDir() + "/report.json"), runner.redone(), run_map));
   }
 
   if (options.run_dense) {

@@ -1,7 +1,8 @@
 #pragma once
 // The whole job (paper Fig. 2), `reconar reconstruct IMAGES_DIR PROJECT_DIR`: features -> matching
 // -> tags (AprilTags in the photos, when a tag size is given) -> mapping (incremental SfM with the
-// tag corners in bundle adjustment, then metric registration to the world tag) -> dense (CMVS +
+// tag corners in bundle adjustment, then metric registration to the world tag) -> map (the
+// localisation map for markerless AR, map_stage.h; part of the sparse stages) -> dense (CMVS +
 // PMVS) -> mesh (screened Poisson, exports). Every stage writes its outputs atomically and is then
 // recorded in PROJECT/stages.txt (stage_record.h) with its settings, so a re-run after an
 // interruption (even SIGKILL) redoes only the stages that had not finished, and gives the same
@@ -27,6 +28,7 @@
 #include "core/pipeline/dense_stage.h"
 #include "core/pipeline/feature_stage.h"
 #include "core/pipeline/match_stage.h"
+#include "core/pipeline/map_stage.h"
 #include "core/pipeline/mesh_stage.h"
 #include "core/pipeline/project.h"
 #include "core/pipeline/sfm_stage.h"
@@ -60,6 +62,7 @@ struct ReconstructOptions {
   // mapper.principal_point, refine_distortion and max_reprojection_error_px (with the equal
   // registration_max_error_px) are `--principal-point`, `--fixed-distortion` and `--max-error`.
   SfmStageOptions sfm;  // sfm.tags.enabled follows tag_size_m > 0
+  MapStageOptions map;  // part of the sparse stages
   DenseStageOptions dense;
   MeshStageOptions mesh;
   double tag_size_m = 0.0;  // 0: no tags, the model keeps an arbitrary scale

@@ -1,6 +1,7 @@
 #include "core/pipeline/stage_record.h"
 
 #include <cstdio>
+#include <set>
 #include <sstream>
 
 #include "core/base/atomic_file.h"
@@ -26,9 +27,16 @@ bool StageRecord::Finished(const std::string& stage, const std::string& settings
 Status StageRecord::Record(const std::string& stage, const std::string& settings) {
   stages_[stage] = settings;
   bool after = false;
+  std::set<std::string> replaced = {stage};
   for (const char* name : kStageOrder) {
-    if (after) stages_.erase(name);
+    if (after) {
+      stages_.erase(name);
+      replaced.insert(name);
+    }
     after |= stage == name;
+  }
+  for (const SideStage& side : kSideStages) {
+    if (side.stage != stage && replaced.count(side.input) != 0) stages_.erase(side.stage);
   }
   std::string text;
   for (const auto& [name, value] : stages_) text += name + " " + value + "\n";

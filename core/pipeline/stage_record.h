@@ -3,7 +3,8 @@
 // sfm`, or of `reconar reconstruct` after an interruption) reuses a stage only when it finished
 // with the same settings. A stage is recorded after its outputs are written (atomically), so a
 // killed run never records a stage it did not finish; recording a stage drops the record of every
-// stage after it in kStageOrder, whose inputs it has just replaced.
+// stage after it in kStageOrder, whose inputs it has just replaced, and of the side stages
+// (kSideStages) that read it or a dropped stage.
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -15,6 +16,20 @@
 namespace reconar {
 
 inline constexpr const char* kStageOrder[] = {"features", "matching", "tags", "mapping", "dense", "mesh"};
+
+// Stages off the chain: each reads one chain stage's outputs and no later stage reads its own.
+struct SideStage {
+  const char* stage;
+  const char* input;
+};
+inline constexpr SideStage kSideStages[] = {{"map", "mapping"}};
+
+inline bool IsSideStage(const std::string& stage) {
+  for (const SideStage& side : kSideStages) {
+    if (stage == side.stage) return true;
+  }
+  return false;
+}
 
 class StageRecord {
  public:

@@ -42,25 +42,6 @@ Result<ArProject> LoadArProject(const std::string& dir) {
   return scene;
 }
 
-Result<CameraIntrinsics> ScaleIntrinsicsToFrame(const CameraIntrinsics& photo, int width, int height) {
-  if (photo.width == width && photo.height == height) return photo;
-  if (photo.width <= 0 || std::abs(static_cast<double>(photo.width) * height -
-                                   static_cast<double>(photo.height) * width) > 0.01 * photo.width * height) {
-    return InvalidArgument("the project's photos are " + std::to_string(photo.width) + "x" +
-                           std::to_string(photo.height) + ", the video " + std::to_string(width) + "x" +
-                           std::to_string(height) + ": pass --intrinsics for this camera");
-  }
-  const double s = static_cast<double>(width) / photo.width;
-  CameraIntrinsics scaled = photo;
-  scaled.width = width;
-  scaled.height = height;
-  scaled.fx *= s;
-  scaled.fy *= s;
-  scaled.cx = (photo.cx + 0.5) * s - 0.5;  // pixel centres at integer coordinates
-  scaled.cy = (photo.cy + 0.5) * s - 0.5;
-  return scaled;
-}
-
 Result<ArModel> LoadArModel(const std::string& path, size_t max_faces) {
   ArModel model;
   RECONAR_ASSIGN_OR_RETURN(model.mesh, ReadMeshFile(path));

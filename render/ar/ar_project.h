@@ -27,10 +27,6 @@ struct ArProject {
 // tags.json and tags.layout.
 Result<ArProject> LoadArProject(const std::string& dir);
 
-// The photo camera for video of another size with the same aspect ratio (a phone's video mode);
-// InvalidArgument when the aspect ratios differ by more than 1 %.
-Result<CameraIntrinsics> ScaleIntrinsicsToFrame(const CameraIntrinsics& photo, int width, int height);
-
 struct ArModel {
   Mesh mesh;
   std::optional<SimplifyReport> simplified;  // set when the mesh was over the face budget

@@ -31,7 +31,7 @@ struct ArSessionOptions {
   FrameSourceOptions frames;
   TagPoseSourceOptions pose;
   // pose.tracker.intrinsics are the photos' camera: scale them to the video's frame size
-  // (ScaleIntrinsicsToFrame, render/ar/ar_project.h).
+  // (ScaleIntrinsicsToFrame, core/math/camera_intrinsics.h).
   bool scale_intrinsics_to_video = false;
   int max_frames = 0;  // Step() ends after this many frames (0: at the end of the stream)
 };

@@ -53,22 +53,62 @@ Clusters MakeClusters(int groups, int per_group, int points_per_cluster, double 
 
 int Count(const std::vector<uint8_t>& descriptors) { return static_cast<int>(descriptors.size() / kDescriptorSize); }
 
-std::string Bytes(const VocabularyTree& tree) {
+template <typename T>
+std::string Bytes(const T& value) {
   ByteWriter writer;
-  tree.Serialize(&writer);
+  value.Serialize(&writer);
   return writer.bytes();
 }
 
-std::string Bytes(const InvertedFile& file) {
-  ByteWriter writer;
-  file.Serialize(&writer);
-  return writer.bytes();
+// Deserialize(Serialize(value)) reads the whole record and writes it back byte for byte.
+template <typename T>
+T RoundTrip(const T& value) {
+  const std::string bytes = Bytes(value);
+  ByteReader reader(bytes);
+  Result<T> copy = T::Deserialize(&reader, "map.bin");
+  EXPECT_TRUE(copy.ok()) << copy.status().ToString();
+  if (!copy.ok()) return T();
+  EXPECT_EQ(reader.remaining(), 0u);
+  EXPECT_EQ(Bytes(*copy), bytes);
+  return std::move(copy).value();
+}
+
+// Every proper prefix of the record is refused with `what` and the record's name.
+template <typename T>
+void ExpectTruncationsRefused(const std::string& bytes, const std::string& prefix) {
+  for (size_t size = 0; size < bytes.size(); ++size) {
+    ByteReader reader(std::string_view(bytes.data(), size));
+    const Result<T> r = T::Deserialize(&reader, "map.bin");
+    ASSERT_FALSE(r.ok()) << size;
+    ASSERT_NE(r.status().ToString().find(prefix), std::string::npos) << r.status().ToString();
+  }
 }
 
 VocabularyTree TrainOrDie(const std::vector<uint8_t>& descriptors, const VocabularyTreeOptions& options) {
   Result<VocabularyTree> tree = VocabularyTree::Train(descriptors.data(), Count(descriptors), options);
   EXPECT_TRUE(tree.ok()) << tree.status().ToString();
   return std::move(tree).value();
+}
+
+VocabularyTreeOptions Shape(int branching, int depth) {
+  VocabularyTreeOptions options;
+  options.branching = branching;
+  options.depth = depth;
+  return options;
+}
+
+VocabularyTree TrainOrDie(const std::vector<uint8_t>& descriptors, int branching, int depth) {
+  return TrainOrDie(descriptors, Shape(branching, depth));
+}
+
+// Up to three bytes of `bytes` (within its first `limit`) changed at random.
+std::string Damage(const std::string& bytes, size_t limit, SplitMix64* rng) {
+  std::string damaged = bytes;
+  const int flips = 1 + static_cast<int>(rng->UniformInt(3));
+  for (int f = 0; f < flips; ++f) {
+    damaged[rng->UniformInt(static_cast<uint32_t>(limit))] ^= static_cast<char>(1 + rng->UniformInt(255));
+  }
+  return damaged;
 }
 
 // The record as Serialize documents it: branching, words, node count, (first_child,
@@ -173,6 +213,10 @@ TEST(VocabularyTreeTest, EmptyAndTinyTrees) {
   EXPECT_EQ(tiny.num_nodes(), 1);
   EXPECT_EQ(tiny.num_words(), 1);
   EXPECT_EQ(tiny.Quantize(d.data()), 0);
+  VocabularyTreeOptions wide;
+  wide.branching = 1 << 24;  // no buffer sized by the branching alone
+  wide.depth = 1;
+  EXPECT_EQ(TrainOrDie(std::vector<uint8_t>(5 * kDescriptorSize, 9), wide).num_words(), 1);
   // Identical descriptors cannot be split: a leaf however many there are.
   const VocabularyTree same = TrainOrDie(std::vector<uint8_t>(500 * kDescriptorSize, 9), VocabularyTreeOptions());
   EXPECT_EQ(same.num_words(), 1);
@@ -183,10 +227,7 @@ TEST(VocabularyTreeTest, EmptyAndTinyTrees) {
 // own cluster and the copy crossed that split.
 TEST(VocabularyTreeTest, NoisyCopiesShareTheWord) {
   const Clusters data = MakeClusters(10, 10, 60, 5.0, 11);
-  VocabularyTreeOptions options;
-  options.branching = 10;
-  options.depth = 2;
-  const VocabularyTree tree = TrainOrDie(data.descriptors, options);
+  const VocabularyTree tree = TrainOrDie(data.descriptors, 10, 2);
   EXPECT_GE(tree.num_words(), 90);
   SplitMix64 rng(5);
   int same = 0, total = 0;
@@ -220,10 +261,7 @@ TEST(VocabularyTreeTest, NoisyCopiesShareTheWord) {
 // final assignment is to the final centroids), and Quantize is the greedy descent of the record.
 TEST(VocabularyTreeTest, EveryWordIsUsedAndQuantizeFollowsTheRecord) {
   const Clusters data = MakeClusters(6, 8, 30, 20.0, 3);
-  VocabularyTreeOptions options;
-  options.branching = 5;
-  options.depth = 3;
-  const VocabularyTree tree = TrainOrDie(data.descriptors, options);
+  const VocabularyTree tree = TrainOrDie(data.descriptors, 5, 3);
   ASSERT_GT(tree.num_words(), 25);
   const TreeRecord record = Parse(Bytes(tree));
   EXPECT_EQ(record.branching, 5);
@@ -267,9 +305,7 @@ TEST(VocabularyTreeTest, EveryWordIsUsedAndQuantizeFollowsTheRecord) {
 TEST(VocabularyTreeTest, ThreadCountDoesNotChangeTheTree) {
   const Clusters data = MakeClusters(8, 8, 400, 15.0, 21);  // 25600: the parallel path is taken
   for (const int max_training : {100000, 17000}) {
-    VocabularyTreeOptions options;
-    options.branching = 8;
-    options.depth = 3;
+    VocabularyTreeOptions options = Shape(8, 3);
     options.max_training_descriptors = max_training;
     options.num_threads = 1;
     const std::string one = Bytes(TrainOrDie(data.descriptors, options));
@@ -284,57 +320,31 @@ TEST(VocabularyTreeTest, ThreadCountDoesNotChangeTheTree) {
 // (d) Serialize -> Deserialize keeps the bytes and the quantisation.
 TEST(VocabularyTreeTest, RoundTrip) {
   const Clusters data = MakeClusters(5, 5, 40, 10.0, 4);
-  VocabularyTreeOptions options;
-  options.branching = 6;
-  options.depth = 3;
-  const VocabularyTree tree = TrainOrDie(data.descriptors, options);
-  const std::string bytes = Bytes(tree);
-  ByteReader reader(bytes);
-  Result<VocabularyTree> copy = VocabularyTree::Deserialize(&reader, "map.bin");
-  ASSERT_TRUE(copy.ok()) << copy.status().ToString();
-  EXPECT_EQ(reader.remaining(), 0u);
-  EXPECT_EQ(Bytes(*copy), bytes);
-  EXPECT_EQ(copy->num_words(), tree.num_words());
-  EXPECT_EQ(copy->num_nodes(), tree.num_nodes());
-  EXPECT_EQ(copy->branching(), 6);
+  const VocabularyTree tree = TrainOrDie(data.descriptors, 6, 3);
+  const VocabularyTree copy = RoundTrip(tree);
+  EXPECT_EQ(copy.num_words(), tree.num_words());
+  EXPECT_EQ(copy.num_nodes(), tree.num_nodes());
+  EXPECT_EQ(copy.branching(), 6);
   for (int i = 0; i < Count(data.descriptors); ++i) {
     const uint8_t* d = &data.descriptors[static_cast<size_t>(i) * kDescriptorSize];
-    ASSERT_EQ(copy->Quantize(d), tree.Quantize(d));
+    ASSERT_EQ(copy.Quantize(d), tree.Quantize(d));
   }
-  // The empty tree too.
-  const std::string empty_bytes = Bytes(VocabularyTree());
-  ByteReader empty_reader(empty_bytes);
-  Result<VocabularyTree> empty = VocabularyTree::Deserialize(&empty_reader, "map.bin");
-  ASSERT_TRUE(empty.ok());
-  EXPECT_EQ(empty->num_nodes(), 0);
+  EXPECT_EQ(RoundTrip(VocabularyTree()).num_nodes(), 0);  // the empty tree too
 }
 
 // (e) Every truncation is refused; random damage never crashes and what is accepted is a
 // tree Quantize can walk.
 TEST(VocabularyTreeTest, DeserializeRefusesDamage) {
   const Clusters data = MakeClusters(3, 3, 20, 10.0, 8);
-  VocabularyTreeOptions options;
-  options.branching = 3;
-  options.depth = 2;
-  const VocabularyTree tree = TrainOrDie(data.descriptors, options);
+  const VocabularyTree tree = TrainOrDie(data.descriptors, 3, 2);
   const std::string bytes = Bytes(tree);
-  for (size_t size = 0; size < bytes.size(); ++size) {
-    ByteReader reader(std::string_view(bytes.data(), size));
-    const Result<VocabularyTree> r = VocabularyTree::Deserialize(&reader, "map.bin");
-    ASSERT_FALSE(r.ok()) << size;
-    ASSERT_NE(r.status().ToString().find("map.bin: vocabulary tree: "), std::string::npos);
-  }
+  ExpectTruncationsRefused<VocabularyTree>(bytes, "map.bin: vocabulary tree: ");
   const size_t structure = 12 + 12 * static_cast<size_t>(tree.num_nodes());  // header and nodes
   SplitMix64 rng(77);
   int accepted = 0;
   for (int m = 0; m < 4000; ++m) {
-    std::string damaged = bytes;
-    const int flips = 1 + static_cast<int>(rng.UniformInt(3));
-    for (int f = 0; f < flips; ++f) {
-      // Mostly the header and nodes, where damage matters.
-      const size_t limit = rng.UniformInt(4) == 0 ? damaged.size() : structure;
-      damaged[rng.UniformInt(static_cast<uint32_t>(limit))] ^= static_cast<char>(1 + rng.UniformInt(255));
-    }
+    // Mostly the header and nodes, where damage matters.
+    const std::string damaged = Damage(bytes, rng.UniformInt(4) == 0 ? bytes.size() : structure, &rng);
     ByteReader reader(damaged);
     const Result<VocabularyTree> r = VocabularyTree::Deserialize(&reader, "map.bin");
     if (!r.ok()) continue;
@@ -349,10 +359,7 @@ TEST(VocabularyTreeTest, DeserializeRefusesDamage) {
 
 TEST(VocabularyTreeTest, DeserializeNamesTheFault) {
   const Clusters data = MakeClusters(3, 3, 20, 10.0, 8);
-  VocabularyTreeOptions options;
-  options.branching = 3;
-  options.depth = 2;
-  const std::string bytes = Bytes(TrainOrDie(data.descriptors, options));
+  const std::string bytes = Bytes(TrainOrDie(data.descriptors, 3, 2));
   const TreeRecord record = Parse(bytes);
   ASSERT_GT(record.first_child[0], 0);
   const int child = record.first_child[0];
@@ -518,14 +525,10 @@ TEST(InvertedFileTest, RoundTripAndDamage) {
   const InvertedFile file = BuildOrDie(60, documents);
   const std::string bytes = Bytes(file);
   {
-    ByteReader reader(bytes);
-    Result<InvertedFile> copy = InvertedFile::Deserialize(&reader, "map.bin");
-    ASSERT_TRUE(copy.ok()) << copy.status().ToString();
-    EXPECT_EQ(reader.remaining(), 0u);
-    EXPECT_EQ(Bytes(*copy), bytes);
+    const InvertedFile copy = RoundTrip(file);
     for (const auto& d : documents) {
       const auto a = Query(file, d, 6);
-      const auto b = Query(*copy, d, 6);
+      const auto b = Query(copy, d, 6);
       ASSERT_EQ(a.size(), b.size());
       for (size_t k = 0; k < a.size(); ++k) {
         EXPECT_EQ(a[k].image, b[k].image);
@@ -533,25 +536,19 @@ TEST(InvertedFileTest, RoundTripAndDamage) {
       }
     }
   }
-  {
-    const std::string empty = Bytes(InvertedFile());
-    ByteReader reader(empty);
-    ASSERT_TRUE(InvertedFile::Deserialize(&reader, "map.bin").ok());
-  }
-  for (size_t size = 0; size < bytes.size(); ++size) {
-    ByteReader reader(std::string_view(bytes.data(), size));
-    const Result<InvertedFile> r = InvertedFile::Deserialize(&reader, "map.bin");
-    ASSERT_FALSE(r.ok()) << size;
-    ASSERT_NE(r.status().ToString().find("map.bin: inverted file: "), std::string::npos);
+  EXPECT_EQ(RoundTrip(InvertedFile()).num_images(), 0);
+  ExpectTruncationsRefused<InvertedFile>(bytes, "map.bin: inverted file: ");
+  // An idf beyond log(2^24 images) would overflow the query's float weights.
+  for (const float idf : {1e30f, -1.0f, std::nanf("")}) {
+    std::string damaged = bytes;
+    std::memcpy(&damaged[8], &idf, 4);  // word 0, after num_images and num_words
+    ByteReader reader(damaged);
+    EXPECT_FALSE(InvertedFile::Deserialize(&reader, "map.bin").ok()) << idf;
   }
   SplitMix64 rng(13);
   int accepted = 0;
   for (int m = 0; m < 4000; ++m) {
-    std::string damaged = bytes;
-    const int flips = 1 + static_cast<int>(rng.UniformInt(3));
-    for (int f = 0; f < flips; ++f) {
-      damaged[rng.UniformInt(static_cast<uint32_t>(damaged.size()))] ^= static_cast<char>(1 + rng.UniformInt(255));
-    }
+    const std::string damaged = Damage(bytes, bytes.size(), &rng);
     ByteReader reader(damaged);
     const Result<InvertedFile> r = InvertedFile::Deserialize(&reader, "map.bin");
     if (!r.ok()) continue;
@@ -565,10 +562,7 @@ TEST(InvertedFileTest, RoundTripAndDamage) {
 // (g) After Reserve, queries and quantisation make no heap allocation.
 TEST(RetrievalAllocationTest, QueryAndQuantizeDoNotAllocate) {
   const Clusters data = MakeClusters(4, 4, 30, 10.0, 6);
-  VocabularyTreeOptions options;
-  options.branching = 4;
-  options.depth = 3;
-  const VocabularyTree tree = TrainOrDie(data.descriptors, options);
+  const VocabularyTree tree = TrainOrDie(data.descriptors, 4, 3);
   std::vector<std::vector<int32_t>> documents(8);
   for (int i = 0; i < Count(data.descriptors); ++i) {
     documents[static_cast<size_t>(i % 8)].push_back(
@@ -597,6 +591,15 @@ TEST(RetrievalAllocationTest, QueryAndQuantizeDoNotAllocate) {
   }
   EXPECT_EQ(allocations, 0);
   EXPECT_EQ(found_first, 8);
+  // The counter does see operator new (so the zero above means something), e.g. a query whose
+  // `out` has no room.
+  std::vector<RetrievalCandidate> unreserved;
+  {
+    testing::NoAllocationScope scope;
+    file.Query(words.data(), query_size, 5, &scratch, &unreserved);
+    allocations = scope.allocations();
+  }
+  EXPECT_GT(allocations, 0);
 }
 
 }  // namespace

@@ -1,0 +1,220 @@
+// Relocalisation end to end through `reconar sfm` (which builds the localisation map) and `reconar
+// localize --json`, scored against independent ground truth: the Middlebury templeRing calibrations
+// (../shared/data/middlebury_templeRing, SOURCE.txt). Bars from issue 15: a project from the 24
+// odd-numbered views; every even view whose two ring neighbours are both in the map is localised;
+// the overlay error (mean pixel distance between the map's points projected with the estimated and
+// with the true camera) has a median of at most 2 px.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/base/json_reader.h"
+#include "core/sfm/model_io.h"
+#include "tests/support/ground_truth.h"
+#include "tests/support/run_command.h"
+#include "tests/support/sfm_evaluation.h"
+
+namespace reconar {
+namespace {
+
+namespace fs = std::filesystem;
+
+using testing::CommandRun;
+using testing::RunReconar;
+
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n == 0 ? 0.0 : (n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
+}
+
+double RotationAngleDeg(const Eigen::Matrix3d &a, const Eigen::Matrix3d &b) {
+  const double c = std::clamp(((a * b.transpose()).trace() - 1.0) / 2.0, -1.0, 1.0);
+  return std::acos(c) * 180.0 / M_PI;
+}
+
+// The views of `names` linked into a fresh directory.
+fs::path LinkViews(const fs::path &dir, const std::string &data, const std::vector<std::string> &names) {
+  fs::create_directories(dir);
+  for (const std::string &name : names) fs::create_symlink(data + "/" + name, dir / name);
+  return dir;
+}
+
+struct Localized {
+  bool registered = false;
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  double fx = 0, fy = 0, cx = 0, cy = 0, k1 = 0, k2 = 0;
+  std::string reason;
+};
+
+std::map<std::string, Localized> ParseLocalizeJson(const std::string &output) {
+  std::map<std::string, Localized> result;
+  std::istringstream lines(output);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] != '{') continue;
+    auto json = ParseJson(line, "localize --json");
+    EXPECT_TRUE(json.ok()) << json.status().ToString();
+    if (!json.ok()) continue;
+    Localized entry;
+    entry.registered = json->Find("registered")->bool_value();
+    entry.reason = json->Find("reason")->string();
+    if (entry.registered) {
+      const JsonValue &pose = *json->Find("cam_from_world");
+      for (int i = 0; i < 9; ++i) entry.R(i / 3, i % 3) = (*pose.Find("R"))[static_cast<size_t>(i)].number();
+      for (int i = 0; i < 3; ++i) entry.t(i) = (*pose.Find("t"))[static_cast<size_t>(i)].number();
+      const JsonValue &camera = *json->Find("camera");
+      entry.fx = camera.Find("fx")->number();
+      entry.fy = camera.Find("fy")->number();
+      entry.cx = camera.Find("cx")->number();
+      entry.cy = camera.Find("cy")->number();
+      entry.k1 = camera.Find("k1")->number();
+      entry.k2 = camera.Find("k2")->number();
+    }
+    result[json->Find("image")->string()] = entry;
+  }
+  return result;
+}
+
+Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eigen::Vector3d &X) {
+  const Eigen::Vector3d x = camera.K * (camera.cam_from_world_rotation * X + camera.cam_from_world_translation);
+  return x.head<2>() / x.z();
+}
+
+// Mean pixel distance between the points projected with the estimated camera (intrinsics,
+// rotation and centre in the ground truth's frame) and with the true one, over the points the
+// true camera sees in its 640 x 480 image.
+double OverlayError(const RadialCamera &camera, const Eigen::Matrix3d &rotation_gt, const Eigen::Vector3d &centre_gt,
+                    const testing::GroundTruthCamera &gt, const std::vector<Eigen::Vector3d> &points_gt, int *count) {
+  double sum = 0.0;
+  *count = 0;
+  for (const Eigen::Vector3d &X : points_gt) {
+    const Eigen::Vector3d in_true = gt.cam_from_world_rotation * X + gt.cam_from_world_translation;
+    const Eigen::Vector3d in_estimate = rotation_gt * (X - centre_gt);
+    if (in_true.z() <= 0.0 || in_estimate.z() <= 0.0) continue;
+    const Eigen::Vector2d true_pixel = ProjectTrue(gt, X);
+    if (true_pixel.x() < 0 || true_pixel.y() < 0 || true_pixel.x() > 639 || true_pixel.y() > 479) continue;
+    sum += (camera.Project(in_estimate) - true_pixel).norm();
+    ++*count;
+  }
+  return *count > 0 ? sum / *count : std::numeric_limits<double>::infinity();
+}
+
+TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
+  const std::string data = testing::SharedDataPath("middlebury_templeRing");
+  auto truth = testing::ReadMiddleburyParInOrder(data + "/templeR_par.txt");
+  ASSERT_TRUE(truth.ok()) << truth.status().ToString();
+  ASSERT_EQ(truth->size(), 47u);
+  std::vector<std::string> odd, even;
+  for (size_t i = 0; i < truth->size(); ++i) ((i % 2 == 0) ? odd : even).push_back((*truth)[i].name);
+  ASSERT_EQ(odd.size(), 24u);
+  const fs::path root = testing::MakeTestDirectory("localize_templering");
+  const fs::path odd_dir = LinkViews(root / "odd", data, odd);
+  const fs::path even_dir = LinkViews(root / "even", data, even);
+  const fs::path project = root / "project";
+
+  const CommandRun sfm =
+      RunReconar("sfm " + odd_dir.string() + " " + project.string() + " --fixed-distortion --threads 2");
+  ASSERT_EQ(sfm.exit_code, 0) << sfm.output;
+  ASSERT_TRUE(fs::exists(project / "map" / "map.rmap")) << sfm.output;
+  auto model = ReadColmapTextModel((project / "sparse").string());
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+
+  // The similarity that aligns the map's own cameras to the ground truth.
+  std::map<std::string, testing::GroundTruthCamera> truth_by_name;
+  for (const auto &named : *truth) truth_by_name[named.name] = named.camera;
+  std::vector<testing::CameraPose> estimated, reference;
+  std::set<std::string> in_map;
+  for (const SfmImage &image : model->images) {
+    if (!image.registered) continue;
+    in_map.insert(image.name);
+    estimated.push_back({image.cam_from_world.rotation, image.Center()});
+    reference.push_back(testing::PoseOf(truth_by_name.at(image.name)));
+  }
+  auto alignment = testing::CameraCenterErrors(estimated, reference);
+  ASSERT_TRUE(alignment.ok()) << alignment.status().ToString();
+  const Sim3 &gt_from_map = alignment->gt_from_estimate;
+  std::printf(
+      "map: %zu of 24 odd views registered, mean centre error of the "
+      "map's cameras %.3f mm\n",
+      in_map.size(), 1000.0 * alignment->centre_mean);
+
+  const CommandRun localize = RunReconar(
+      "localize " + project.string() + " " + even_dir.string() + " --json --threads 2", testing::StderrMode::kSeparate);
+  ASSERT_EQ(localize.exit_code, 0) << localize.output << localize.error;
+  const std::map<std::string, Localized> results = ParseLocalizeJson(localize.output);
+  ASSERT_EQ(results.size(), even.size()) << localize.output;
+
+  std::vector<Eigen::Vector3d> points_gt;
+  for (const SfmPoint &point : model->points) {
+    if (!point.deleted) points_gt.push_back(gt_from_map.Apply(point.position));
+  }
+  // The map's own cameras under the same alignment: what localisation cannot do better than.
+  std::vector<double> map_overlay_errors;
+  for (const SfmImage &image : model->images) {
+    if (!image.registered) continue;
+    int count = 0;
+    map_overlay_errors.push_back(OverlayError(model->cameras[static_cast<size_t>(image.camera_id)],
+                                              image.cam_from_world.rotation * gt_from_map.rotation.transpose(),
+                                              gt_from_map.Apply(image.Center()), truth_by_name.at(image.name),
+                                              points_gt, &count));
+  }
+  std::printf("map: median overlay error of its own cameras %.3f px\n", Median(map_overlay_errors));
+  std::vector<double> centre_errors, rotation_errors, overlay_errors;
+  int expected = 0, localized_expected = 0, localized = 0;
+  for (size_t i = 1; i < truth->size(); i += 2) {
+    const std::string &name = (*truth)[i].name;
+    const bool neighbours_in_map = in_map.count((*truth)[i - 1].name) != 0 && in_map.count((*truth)[i + 1].name) != 0;
+    expected += neighbours_in_map ? 1 : 0;
+    const Localized &result = results.at(name);
+    if (!result.registered) {
+      std::printf("%s: not localised (%s)%s\n", name.c_str(), result.reason.c_str(),
+                  neighbours_in_map ? " [both neighbours in the map]" : "");
+      continue;
+    }
+    ++localized;
+    localized_expected += neighbours_in_map ? 1 : 0;
+    // The localised camera in the ground truth's frame: X_map = (R_s^T (X_gt - t_s)) / s.
+    const Eigen::Vector3d centre_map = -result.R.transpose() * result.t;
+    const Eigen::Vector3d centre_gt = gt_from_map.Apply(centre_map);
+    const Eigen::Matrix3d rotation_gt = result.R * gt_from_map.rotation.transpose();
+    const testing::GroundTruthCamera &gt = truth_by_name.at(name);
+    centre_errors.push_back((centre_gt - gt.Centre()).norm());
+    rotation_errors.push_back(RotationAngleDeg(rotation_gt, gt.cam_from_world_rotation));
+    RadialCamera camera;
+    camera.focal = result.fx;
+    camera.aspect = result.fy / result.fx;
+    camera.cx = result.cx;
+    camera.cy = result.cy;
+    camera.k1 = result.k1;
+    camera.k2 = result.k2;
+    int count = 0;
+    overlay_errors.push_back(OverlayError(camera, rotation_gt, centre_gt, gt, points_gt, &count));
+    std::printf(
+        "%s: centre error %.3f mm, rotation %.3f deg, overlay %.2f px "
+        "over %d points\n",
+        name.c_str(), 1000.0 * centre_errors.back(), rotation_errors.back(), overlay_errors.back(), count);
+  }
+  std::printf(
+      "templeRing: %d of 23 even views localised; %d of the %d whose "
+      "neighbours are both in the map; median "
+      "centre error %.3f mm, rotation %.3f deg, overlay %.3f px\n",
+      localized, localized_expected, expected, 1000.0 * Median(centre_errors), Median(rotation_errors),
+      Median(overlay_errors));
+  EXPECT_EQ(localized_expected, expected);
+  EXPECT_GT(expected, 0);
+  EXPECT_LE(Median(overlay_errors), 2.0);
+  EXPECT_LE(Median(centre_errors), 2.0 * alignment->centre_mean);
+}
+
+}  // namespace
+}  // namespace reconar
