@@ -213,9 +213,22 @@ std::string BrokenInvariant(const LocalizationMap& map) {
     for (const int32_t id : keyframe.point_ids) {
       if (id < 0 || static_cast<size_t>(id) >= n) return "point id";
     }
+    // Retrieval with the keyframe's own words: valid images, finite scores.
+    std::vector<int32_t> words;
     for (size_t j = 0; j < keyframe.descriptors.size(); j += 128) {
       const int word = map.vocabulary.Quantize(&keyframe.descriptors[j]);
       if (word < -1 || word >= map.vocabulary.num_words()) return "word out of range";
+      words.push_back(word);
+    }
+    const int num_images = map.keyframe_index.num_images();
+    RetrievalScratch scratch;
+    scratch.Reserve(static_cast<int>(words.size()), num_images);
+    std::vector<RetrievalCandidate> ranked;
+    ranked.reserve(static_cast<size_t>(num_images));
+    map.keyframe_index.Query(words.data(), static_cast<int>(words.size()), num_images, &scratch, &ranked);
+    for (const RetrievalCandidate& candidate : ranked) {
+      if (candidate.image < 0 || candidate.image >= num_images) return "retrieved image out of range";
+      if (!std::isfinite(candidate.score)) return "retrieval score not finite";
     }
   }
   return "";
