@@ -25,6 +25,7 @@
 // LocalizationMap::memory_bytes(), in total and per keyframe.
 #include <time.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -35,8 +36,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "core/base/json_writer.h"
 #include "core/features/kdtree.h"
@@ -89,8 +88,8 @@ double Median(const std::vector<double>& values) { return Quantile(values, 0.5);
 // [i * s, (i + 1) * s) with s = in / out, edge pixels weighted by their covered fraction, so a point
 // x (pixel centres on integers) maps to (x + 0.5) / s - 0.5, as ScaledIntrinsics scales a camera.
 struct SpanWeights {
-  std::vector<int> first;              // per output pixel, the first input pixel
-  std::vector<std::vector<float>> w;   // per output pixel, the weights from `first` on (sum 1)
+  std::vector<int> first;             // per output pixel, the first input pixel
+  std::vector<std::vector<float>> w;  // per output pixel, the weights from `first` on (sum 1)
 };
 
 SpanWeights AreaWeights(int in, int out) {
@@ -121,7 +120,8 @@ Image<uint8_t> ResizeArea(const Image<uint8_t>& in, int width, int height) {
     for (int x = 0; x < width; ++x) {
       for (int c = 0; c < channels; ++c) {
         float sum = 0.0f;
-        for (size_t k = 0; k < xs.w[x].size(); ++k) sum += xs.w[x][k] * row[(xs.first[x] + static_cast<int>(k)) * channels + c];
+        for (size_t k = 0; k < xs.w[x].size(); ++k)
+          sum += xs.w[x][k] * row[(xs.first[x] + static_cast<int>(k)) * channels + c];
         out[x * channels + c] = sum;
       }
     }
@@ -142,7 +142,7 @@ Image<uint8_t> ResizeArea(const Image<uint8_t>& in, int width, int height) {
 struct Query {
   std::string name;
   int source_width = 0, source_height = 0;
-  Image<uint8_t> gray;            // kFrameWidth wide
+  Image<uint8_t> gray;              // kFrameWidth wide
   std::optional<Rigid3> reference;  // the keyframe of the same name
 };
 
@@ -208,7 +208,8 @@ Status TimeMatchingParts(const LocalizationMap& map, const LocalizerOptions& opt
   forest_options.max_leaf_checks = options.max_leaf_checks;
   double unused_wall = 0.0;
   const Stopwatch build_clock;
-  RECONAR_ASSIGN_OR_RETURN(const KdForest forest, KdForest::Build(descriptors.data(), o->forest_points, forest_options));
+  RECONAR_ASSIGN_OR_RETURN(const KdForest forest,
+                           KdForest::Build(descriptors.data(), o->forest_points, forest_options));
   build_clock.Stop(&unused_wall, &o->forest_build_cpu_ms);
   const Stopwatch search_clock;
   KdSearchScratch scratch(forest);
@@ -412,8 +413,8 @@ int Run(int argc, char** argv) {
     query.name = std::filesystem::path(path).filename().string();
     query.source_width = decoded->rgb.width();
     query.source_height = decoded->rgb.height();
-    const int height = static_cast<int>(std::lround(static_cast<double>(kFrameWidth) * query.source_height /
-                                                    query.source_width));
+    const int height =
+        static_cast<int>(std::lround(static_cast<double>(kFrameWidth) * query.source_height / query.source_width));
     query.gray = ToGray8(ResizeArea(decoded->rgb, kFrameWidth, height));
     if (auto it = keyframe_pose.find(query.name); it != keyframe_pose.end()) query.reference = it->second;
     queries.push_back(std::move(query));
@@ -429,8 +430,9 @@ int Run(int argc, char** argv) {
     if (cameras.count(size)) continue;
     auto camera = ResolveQueryCamera(*map, size.first, size.second, std::nullopt, 0.0);
     if (!camera.ok()) return Fail(camera.status());
-    if (!camera->known) return Fail(FailedPrecondition("the map has no camera for " + std::to_string(size.first) + "x" +
-                                                       std::to_string(size.second) + " frames"));
+    if (!camera->known)
+      return Fail(FailedPrecondition("the map has no camera for " + std::to_string(size.first) + "x" +
+                                     std::to_string(size.second) + " frames"));
     cameras[size] = *camera;
   }
 
@@ -468,7 +470,8 @@ int Run(int argc, char** argv) {
     json.Key("query_width").Int(first.gray.width()).Key("query_height").Int(first.gray.height());
     json.Key("source_width").Int(first.source_width).Key("source_height").Int(first.source_height);
     json.Key("camera").BeginObject().Key("fx").Double(camera.focal).Key("fy").Double(camera.fy());
-    json.Key("cx").Double(camera.cx).Key("cy").Double(camera.cy).Key("k1").Double(camera.k1).Key("k2").Double(camera.k2);
+    json.Key("cx").Double(camera.cx).Key("cy").Double(camera.cy).Key("k1").Double(camera.k1).Key("k2").Double(
+        camera.k2);
     json.EndObject();
     json.Key("map").BeginObject().Key("keyframes").Int(static_cast<int>(map->keyframes.size()));
     json.Key("points").Int(map->num_points()).Key("observations").Int(map->num_observations());
@@ -495,14 +498,15 @@ int Run(int argc, char** argv) {
     return 0;
   }
 
-  std::printf("map %s: %zu keyframes, %d points, %d observations; frame: %s\n", map_path.c_str(),
-              map->keyframes.size(), map->num_points(), map->num_observations(), map->frame.c_str());
+  std::printf("map %s: %zu keyframes, %d points, %d observations; frame: %s\n", map_path.c_str(), map->keyframes.size(),
+              map->num_points(), map->num_observations(), map->frame.c_str());
   std::printf("  on disk %.2f MiB (%.1f KiB per keyframe), in memory %.2f MiB (%.1f KiB per keyframe)\n",
               file_bytes / 1048576.0, file_bytes / 1024.0 / keyframes, map->memory_bytes() / 1048576.0,
               map->memory_bytes() / 1024.0 / keyframes);
-  std::printf("queries: %zu (%d of them keyframes of the map), %dx%d -> %dx%d grey (area filter), %d run(s), 1 thread\n",
-              queries.size(), with_reference, first.source_width, first.source_height, first.gray.width(),
-              first.gray.height(), runs);
+  std::printf(
+      "queries: %zu (%d of them keyframes of the map), %dx%d -> %dx%d grey (area filter), %d run(s), 1 thread\n",
+      queries.size(), with_reference, first.source_width, first.source_height, first.gray.width(), first.gray.height(),
+      runs);
   std::printf("camera (map, scaled): f %.2f/%.2f c %.2f,%.2f k1 %.4f k2 %.4f\n", camera.focal, camera.fy(), camera.cx,
               camera.cy, camera.k1, camera.k2);
   const auto print_accuracy = [&](const Summary& s) {
@@ -515,14 +519,16 @@ int Run(int argc, char** argv) {
               sift_options.first_octave, defaults.localizer.num_keyframes, defaults.localizer.max_leaf_checks,
               defaults.localizer.max_ratio);
   PrintRow("Localize() total", ours.pose_ms, ours.pose_cpu_ms);
-  std::printf("    retrieval %.2f / p95 %.2f ms, matching (forest build + search) %.2f / %.2f ms, "
-              "RANSAC + refinement %.2f / %.2f ms\n",
-              Median(ours.retrieval_ms), Quantile(ours.retrieval_ms, 0.95), Median(ours.matching_ms),
-              Quantile(ours.matching_ms, 0.95), Median(ours.ransac_ms), Quantile(ours.ransac_ms, 0.95));
-  std::printf("    matching re-run apart (thread CPU): kd-forest build over %.0f observations (median) %.2f / p95 %.2f ms, "
-              "search of every query descriptor %.2f / %.2f ms\n",
-              Median(ours.forest_points), Median(ours.forest_build_cpu_ms), Quantile(ours.forest_build_cpu_ms, 0.95),
-              Median(ours.forest_search_cpu_ms), Quantile(ours.forest_search_cpu_ms, 0.95));
+  std::printf(
+      "    retrieval %.2f / p95 %.2f ms, matching (forest build + search) %.2f / %.2f ms, "
+      "RANSAC + refinement %.2f / %.2f ms\n",
+      Median(ours.retrieval_ms), Quantile(ours.retrieval_ms, 0.95), Median(ours.matching_ms),
+      Quantile(ours.matching_ms, 0.95), Median(ours.ransac_ms), Quantile(ours.ransac_ms, 0.95));
+  std::printf(
+      "    matching re-run apart (thread CPU): kd-forest build over %.0f observations (median) %.2f / p95 %.2f ms, "
+      "search of every query descriptor %.2f / %.2f ms\n",
+      Median(ours.forest_points), Median(ours.forest_build_cpu_ms), Quantile(ours.forest_build_cpu_ms, 0.95),
+      Median(ours.forest_search_cpu_ms), Quantile(ours.forest_search_cpu_ms, 0.95));
   PrintRow("SIFT", ours.sift_ms, ours.sift_cpu_ms);
   print_accuracy(ours);
   if (!with_opencv) {
@@ -530,20 +536,21 @@ int Run(int argc, char** argv) {
     return 0;
   }
 #ifdef RECONAR_BENCH_WITH_OPENCV
-  std::printf("OpenCV %s (SIFT defaults; FLANN KD-tree 4 trees, 32 checks, over all %d map points, trained once in "
-              "%.1f ms; ratio 0.80; solvePnPRansac P3P 10000 it. 4 px 0.999 + solvePnPRefineLM):\n",
-              CV_VERSION, map->num_points(), opencv.train_ms);
+  std::printf(
+      "OpenCV %s (SIFT defaults; FLANN KD-tree 4 trees, 32 checks, over all %d map points, trained once in "
+      "%.1f ms; ratio 0.80; solvePnPRansac P3P 10000 it. 4 px 0.999 + solvePnPRefineLM):\n",
+      CV_VERSION, map->num_points(), opencv.train_ms);
 #endif
   PrintRow("match + PnP + refine", baseline.pose_ms, baseline.pose_cpu_ms);
   PrintRow("SIFT", baseline.sift_ms, baseline.sift_cpu_ms);
   print_accuracy(baseline);
-  std::printf("ratios ours/OpenCV: pose time median %.3f, p95 %.3f (thread CPU median %.3f); SIFT median %.3f; "
-              "registered %d/%d; median centre error %.3f, rotation error %.3f\n",
-              Median(ours.pose_ms) / Median(baseline.pose_ms),
-              Quantile(ours.pose_ms, 0.95) / Quantile(baseline.pose_ms, 0.95),
-              Median(ours.pose_cpu_ms) / Median(baseline.pose_cpu_ms), Median(ours.sift_ms) / Median(baseline.sift_ms),
-              ours.registered, baseline.registered, Median(ours.centre_error) / Median(baseline.centre_error),
-              Median(ours.rotation_error_deg) / Median(baseline.rotation_error_deg));
+  std::printf(
+      "ratios ours/OpenCV: pose time median %.3f, p95 %.3f (thread CPU median %.3f); SIFT median %.3f; "
+      "registered %d/%d; median centre error %.3f, rotation error %.3f\n",
+      Median(ours.pose_ms) / Median(baseline.pose_ms), Quantile(ours.pose_ms, 0.95) / Quantile(baseline.pose_ms, 0.95),
+      Median(ours.pose_cpu_ms) / Median(baseline.pose_cpu_ms), Median(ours.sift_ms) / Median(baseline.sift_ms),
+      ours.registered, baseline.registered, Median(ours.centre_error) / Median(baseline.centre_error),
+      Median(ours.rotation_error_deg) / Median(baseline.rotation_error_deg));
   return 0;
 }
 
