@@ -413,8 +413,8 @@ int Run(int argc, char** argv) {
     query.name = std::filesystem::path(path).filename().string();
     query.source_width = decoded->rgb.width();
     query.source_height = decoded->rgb.height();
-    const int height =
-        static_cast<int>(std::lround(static_cast<double>(kFrameWidth) * query.source_height / query.source_width));
+    const int height = std::max(
+        1, static_cast<int>(std::lround(static_cast<double>(kFrameWidth) * query.source_height / query.source_width)));
     query.gray = ToGray8(ResizeArea(decoded->rgb, kFrameWidth, height));
     if (auto it = keyframe_pose.find(query.name); it != keyframe_pose.end()) query.reference = it->second;
     queries.push_back(std::move(query));
