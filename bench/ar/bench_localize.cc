@@ -152,15 +152,12 @@ struct Outcome {
   int features = 0, matches = 0, inliers = 0;
   Rigid3 cam_from_world;
   double sift_ms = 0, sift_cpu_ms = 0, pose_ms = 0, pose_cpu_ms = 0;
-  // Ours only: the localizer's own split, and the matching step re-run apart (thread CPU).
+  // Ours only: the localizer's own split.
   double retrieval_ms = 0, matching_ms = 0, ransac_ms = 0;
-  double forest_build_cpu_ms = 0, forest_search_cpu_ms = 0;
-  int forest_points = 0;
 };
 
 struct Summary {
   std::vector<double> sift_ms, sift_cpu_ms, pose_ms, pose_cpu_ms, retrieval_ms, matching_ms, ransac_ms;
-  std::vector<double> forest_build_cpu_ms, forest_search_cpu_ms, forest_points;
   std::vector<double> features, matches, inliers;
   std::vector<double> centre_error, rotation_error_deg;  // last run, queries with a reference
   int registered = 0;                                    // last run
@@ -175,9 +172,6 @@ void Accumulate(const Outcome& o, const Query& query, bool last_run, Summary* s)
   s->retrieval_ms.push_back(o.retrieval_ms);
   s->matching_ms.push_back(o.matching_ms);
   s->ransac_ms.push_back(o.ransac_ms);
-  s->forest_build_cpu_ms.push_back(o.forest_build_cpu_ms);
-  s->forest_search_cpu_ms.push_back(o.forest_search_cpu_ms);
-  s->forest_points.push_back(o.forest_points);
   if (!last_run) return;
   s->features.push_back(o.features);
   s->matches.push_back(o.matches);
@@ -190,35 +184,6 @@ void Accumulate(const Outcome& o, const Query& query, bool last_run, Summary* s)
   s->centre_error.push_back((CameraCenterInWorld(o.cam_from_world) - CameraCenterInWorld(ref)).norm());
   const Eigen::AngleAxisd delta(Eigen::Matrix3d(o.cam_from_world.rotation * ref.rotation.transpose()));
   s->rotation_error_deg.push_back(std::abs(delta.angle()) * 180.0 / M_PI);
-}
-
-// Where Localize's matching time goes: the kd-forest over the retrieved keyframes' observations
-// built again and every query descriptor searched in it as Localize does (the same options and
-// neighbour count), each part timed apart in thread CPU. Not part of the reported Localize time.
-Status TimeMatchingParts(const LocalizationMap& map, const LocalizerOptions& options, const SiftFeatures& features,
-                         const std::vector<int>& keyframes, Outcome* o) {
-  constexpr int kNeighbours = 6;  // core/sfm/localizer.cc
-  std::vector<uint8_t> descriptors;
-  for (int f : keyframes) {
-    const MapKeyframe& keyframe = map.keyframes[static_cast<size_t>(f)];
-    descriptors.insert(descriptors.end(), keyframe.descriptors.begin(), keyframe.descriptors.end());
-  }
-  o->forest_points = static_cast<int>(descriptors.size() / 128);
-  KdForestOptions forest_options;
-  forest_options.max_leaf_checks = options.max_leaf_checks;
-  double unused_wall = 0.0;
-  const Stopwatch build_clock;
-  RECONAR_ASSIGN_OR_RETURN(const KdForest forest,
-                           KdForest::Build(descriptors.data(), o->forest_points, forest_options));
-  build_clock.Stop(&unused_wall, &o->forest_build_cpu_ms);
-  const Stopwatch search_clock;
-  KdSearchScratch scratch(forest);
-  int indices[kNeighbours], distances[kNeighbours];
-  for (size_t q = 0; q < features.keypoints.size(); ++q) {
-    forest.Search(features.descriptor(q), kNeighbours, options.max_leaf_checks, indices, distances, &scratch);
-  }
-  search_clock.Stop(&unused_wall, &o->forest_search_cpu_ms);
-  return Status::Ok();
 }
 
 Result<Outcome> RunOurs(const Query& query, SiftExtractor* extractor, const Localizer& localizer,
@@ -242,7 +207,6 @@ Result<Outcome> RunOurs(const Query& query, SiftExtractor* extractor, const Loca
   o.retrieval_ms = result.seconds_retrieval * 1000.0;
   o.matching_ms = result.seconds_matching * 1000.0;
   o.ransac_ms = result.seconds_pose * 1000.0;
-  RECONAR_RETURN_IF_ERROR(TimeMatchingParts(localizer.map(), localizer.options(), features, result.keyframes, &o));
   return o;
 }
 
@@ -369,9 +333,6 @@ void JsonSummary(JsonWriter* json, const std::string& key, const Summary& s, boo
     JsonTimes(json, "retrieval_ms", s.retrieval_ms);
     JsonTimes(json, "matching_ms", s.matching_ms);
     JsonTimes(json, "ransac_refine_ms", s.ransac_ms);
-    JsonTimes(json, "forest_build_cpu_ms", s.forest_build_cpu_ms);
-    JsonTimes(json, "forest_search_cpu_ms", s.forest_search_cpu_ms);
-    json->Key("median_forest_points").Double(Median(s.forest_points));
   }
   json->Key("registered").Int(s.registered).Key("registered_with_reference").Int(s.registered_with_reference);
   json->Key("median_features").Double(Median(s.features)).Key("median_matches").Double(Median(s.matches));
@@ -400,8 +361,11 @@ int Run(int argc, char** argv) {
   if (!map.ok()) return Fail(map.status());
   const uintmax_t file_bytes = std::filesystem::file_size(map_path);
   const LocalizePhotosOptions defaults;
+  const Stopwatch create_clock;
   auto localizer = Localizer::Create(&*map, defaults.localizer);
   if (!localizer.ok()) return Fail(localizer.status());
+  double create_ms = 0.0, create_cpu_ms = 0.0;
+  create_clock.Stop(&create_ms, &create_cpu_ms);
   std::map<std::string, Rigid3> keyframe_pose;
   for (const MapKeyframe& keyframe : map->keyframes) keyframe_pose[keyframe.name] = keyframe.cam_from_world;
 
@@ -520,15 +484,12 @@ int Run(int argc, char** argv) {
               defaults.localizer.max_ratio);
   PrintRow("Localize() total", ours.pose_ms, ours.pose_cpu_ms);
   std::printf(
-      "    retrieval %.2f / p95 %.2f ms, matching (forest build + search) %.2f / %.2f ms, "
+      "    retrieval %.2f / p95 %.2f ms, matching %.2f / %.2f ms, "
       "RANSAC + refinement %.2f / %.2f ms\n",
       Median(ours.retrieval_ms), Quantile(ours.retrieval_ms, 0.95), Median(ours.matching_ms),
       Quantile(ours.matching_ms, 0.95), Median(ours.ransac_ms), Quantile(ours.ransac_ms, 0.95));
-  std::printf(
-      "    matching re-run apart (thread CPU): kd-forest build over %.0f observations (median) %.2f / p95 %.2f ms, "
-      "search of every query descriptor %.2f / %.2f ms\n",
-      Median(ours.forest_points), Median(ours.forest_build_cpu_ms), Quantile(ours.forest_build_cpu_ms, 0.95),
-      Median(ours.forest_search_cpu_ms), Quantile(ours.forest_search_cpu_ms, 0.95));
+  std::printf("    the localizer's kd-forest over all %d observations, built once when it is made: %.1f ms\n",
+              map->num_observations(), create_ms);
   PrintRow("SIFT", ours.sift_ms, ours.sift_cpu_ms);
   print_accuracy(ours);
   if (!with_opencv) {
