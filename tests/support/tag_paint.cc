@@ -1,5 +1,6 @@
 #include "tests/support/tag_paint.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
@@ -63,11 +64,29 @@ std::vector<Eigen::Vector2d> PaintedQuad(const TagDetection& detection, const Ta
           detection.center + options.border_scale * (detection.corners[k] - detection.center);
     }
   }
-  for (Eigen::Vector2d& p : quad) {
-    const Eigen::Vector2d outward = p - detection.center;
-    const double length = outward.norm();
-    if (length > 0.0) p += options.margin_px * outward / length;
+  // Each edge moved outward by margin_px along its normal; the corners where the moved edges meet.
+  Eigen::Vector2d normals[4];
+  for (size_t k = 0; k < 4; ++k) {
+    const Eigen::Vector2d edge = quad[(k + 1) % 4] - quad[k];
+    Eigen::Vector2d normal(edge.y(), -edge.x());
+    if (normal.dot(quad[k] - detection.center) < 0.0) normal = -normal;
+    const double length = normal.norm();
+    normals[k] = length > 0.0 ? Eigen::Vector2d(normal / length) : Eigen::Vector2d::Zero();
   }
+  std::vector<Eigen::Vector2d> grown(4);
+  for (size_t k = 0; k < 4; ++k) {
+    // Corner k joins edge k - 1 (with normal a) and edge k (with normal b): x . a = p . a + m,
+    // x . b = p . b + m.
+    const Eigen::Vector2d& a = normals[(k + 3) % 4];
+    const Eigen::Vector2d& b = normals[k];
+    Eigen::Matrix2d lines;
+    lines << a.transpose(), b.transpose();
+    const Eigen::Vector2d offsets(quad[k].dot(a) + options.margin_px, quad[k].dot(b) + options.margin_px);
+    const double det = lines.determinant();
+    grown[k] = std::abs(det) > 1e-6 ? Eigen::Vector2d(lines.inverse() * offsets)
+                                    : Eigen::Vector2d(quad[k] + options.margin_px * (a + b).normalized());
+  }
+  quad = grown;
   return quad;
 }
 

@@ -5,9 +5,9 @@
 // Each detected tag is covered whole: libapriltag's quad is the tag's black border square (8 of
 // the tag36h11's 10 cells across); the printed tag is one white cell wider on every side. The
 // quad is therefore grown to the white border's square through the detection's homography
-// (tag coordinates (-1, -1)..(1, 1) scaled by 10/8, exact under perspective), then by a margin
-// of a few pixels outward from the tag's centre for blur and JPEG ringing, and filled with the
-// mean grey of the original pixels inside it.
+// (tag coordinates (-1, -1)..(1, 1) scaled by 10/8, exact under perspective), then each edge is
+// moved outward by a margin of a few pixels for blur and JPEG ringing, and the quad is filled with
+// the mean grey of the original pixels inside it.
 #include <string>
 #include <vector>
 
@@ -19,7 +19,7 @@ namespace reconar::testing {
 
 struct TagPaintOptions {
   double border_scale = 10.0 / 8.0;  // black-border square to the white border (tag36h11)
-  double margin_px = 2.0;            // beyond the white border
+  double margin_px = 2.0;            // beyond the white border, along each edge's normal
 };
 
 // The four corners (pixels, our convention) of the region PaintOutTags fills for `detection`.
