@@ -5,10 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <set>
 
 #include "tests/tracker/synthetic_tag_image.h"
@@ -17,18 +15,6 @@ namespace reconar {
 namespace {
 
 constexpr uint8_t kBackground = 170;
-
-testing::SyntheticTag TiltedTag(int id, const Eigen::Vector3d& translation, double angle_deg) {
-  testing::SyntheticTag tag;
-  tag.id = id;
-  tag.size = 0.1;
-  const Eigen::Matrix3d facing = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  tag.cam_from_tag.rotation =
-      Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d(0.3, 1.0, 0.2).normalized()).toRotationMatrix() *
-      facing;
-  tag.cam_from_tag.translation = translation;
-  return tag;
-}
 
 Image<uint8_t> ToRgb(const Image<uint8_t>& gray) {
   Image<uint8_t> rgb(gray.width(), gray.height(), 3);
@@ -73,8 +59,8 @@ std::set<int> Values(const Image<uint8_t>& rgb) {
 
 TEST(TagPaint, TiltedTagsLeaveNothingOfTheirPrint) {
   const CameraIntrinsics camera = testing::TestCamera();
-  const testing::SyntheticTag tags[2] = {TiltedTag(3, Eigen::Vector3d(-0.12, 0.0, 0.6), 35.0),
-                                         TiltedTag(11, Eigen::Vector3d(0.14, 0.03, 0.5), -40.0)};
+  const testing::SyntheticTag tags[2] = {testing::TiltedTag(3, Eigen::Vector3d(-0.12, 0.0, 0.6), 35.0),
+                                         testing::TiltedTag(11, Eigen::Vector3d(0.14, 0.03, 0.5), -40.0)};
   testing::SyntheticRenderOptions render;
   render.background = kBackground;
   render.blur_sigma = 0.8;
@@ -96,7 +82,7 @@ TEST(TagPaint, TiltedTagsLeaveNothingOfTheirPrint) {
 TEST(TagPaint, QuadsBeyondTheImageAndDegenerateDetectionsAreClipped) {
   const CameraIntrinsics camera = testing::TestCamera();
   // Detected in the whole frame, then painted on a crop that cuts through the tag.
-  const testing::SyntheticTag tag = TiltedTag(5, Eigen::Vector3d(0.0, 0.0, 0.5), 10.0);
+  const testing::SyntheticTag tag = testing::TiltedTag(5, Eigen::Vector3d(0.0, 0.0, 0.5), 10.0);
   testing::SyntheticRenderOptions render;
   render.background = kBackground;
   const Image<uint8_t> gray = testing::RenderTags(&tag, 1, camera, render);
