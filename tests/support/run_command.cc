@@ -18,6 +18,14 @@ std::string MakeTestDirectory(const std::string& prefix) {
   return dir.string();
 }
 
+std::string LinkFiles(const std::string& dir, const std::string& source_dir, const std::vector<std::string>& names) {
+  std::filesystem::create_directories(dir);
+  for (const std::string& name : names) {
+    std::filesystem::create_symlink(std::filesystem::path(source_dir) / name, std::filesystem::path(dir) / name);
+  }
+  return dir;
+}
+
 CommandRun RunCommand(const std::string& command, StderrMode stderr_mode) {
   CommandRun run;
   std::string err_path;

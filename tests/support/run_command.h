@@ -2,6 +2,7 @@
 // Runs a shell command and captures its output and exit code: the tests of the `reconar`
 // executable (tests/tools). Test support only.
 #include <string>
+#include <vector>
 
 namespace reconar::testing {
 
@@ -18,6 +19,10 @@ enum class StderrMode {
 
 // A fresh directory "<gtest temp dir>/<prefix>_<pid>" (created with its parents) for a test's files.
 std::string MakeTestDirectory(const std::string& prefix);
+
+// `dir` (created with its parents) holding a symlink to source_dir/NAME for each of `names`
+// (a subset of a dataset as a project's input); returns `dir`.
+std::string LinkFiles(const std::string& dir, const std::string& source_dir, const std::vector<std::string>& names);
 
 // `command` through /bin/sh (popen).
 CommandRun RunCommand(const std::string& command, StderrMode stderr_mode = StderrMode::kMerge);

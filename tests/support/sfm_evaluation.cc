@@ -11,8 +11,6 @@
 
 namespace reconar::testing {
 
-namespace {
-
 double Median(std::vector<double> values) {
   if (values.empty()) return 0.0;
   const size_t mid = values.size() / 2;
@@ -21,20 +19,22 @@ double Median(std::vector<double> values) {
   return 0.5 * (values[mid] + *std::max_element(values.begin(), values.begin() + mid));
 }
 
-double Mean(const std::vector<double>& values) {
-  return values.empty() ? 0.0 : std::accumulate(values.begin(), values.end(), 0.0) / values.size();
-}
-
-double Max(const std::vector<double>& values) {
-  return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
-}
-
 // atan2(|sin|, cos) from the skew and symmetric parts: accurate for small angles, where
 // acos((trace - 1) / 2) loses half the digits.
 double RotationAngleDeg(const Eigen::Matrix3d& rotation) {
   const Eigen::Vector3d axis_sin(rotation(2, 1) - rotation(1, 2), rotation(0, 2) - rotation(2, 0),
                                  rotation(1, 0) - rotation(0, 1));
   return std::atan2(0.5 * axis_sin.norm(), 0.5 * (rotation.trace() - 1.0)) * 180.0 / M_PI;
+}
+
+namespace {
+
+double Mean(const std::vector<double>& values) {
+  return values.empty() ? 0.0 : std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+}
+
+double Max(const std::vector<double>& values) {
+  return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
 }
 
 }  // namespace

@@ -12,13 +12,12 @@
 #include <limits>
 #include <map>
 #include <set>
-#include <sstream>
 #include <string>
 #include <vector>
 
-#include "core/base/json_reader.h"
 #include "core/sfm/model_io.h"
 #include "tests/support/ground_truth.h"
+#include "tests/support/localize_json.h"
 #include "tests/support/run_command.h"
 #include "tests/support/sfm_evaluation.h"
 
@@ -28,64 +27,15 @@ namespace {
 namespace fs = std::filesystem;
 
 using testing::CommandRun;
+using testing::LocalizedPhoto;
+using testing::Median;
 using testing::RunReconar;
 
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n == 0 ? 0.0 : (n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
+double RotationAngleDeg(const Eigen::Matrix3d &a, const Eigen::Matrix3d &b) {
+  return testing::RotationAngleDeg(a * b.transpose());
 }
 
-double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  const double c = std::clamp(((a * b.transpose()).trace() - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * 180.0 / M_PI;
-}
-
-// The views of `names` linked into a fresh directory.
-fs::path LinkViews(const fs::path& dir, const std::string& data, const std::vector<std::string>& names) {
-  fs::create_directories(dir);
-  for (const std::string& name : names) fs::create_symlink(data + "/" + name, dir / name);
-  return dir;
-}
-
-struct Localized {
-  bool registered = false;
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  double fx = 0, fy = 0, cx = 0, cy = 0, k1 = 0, k2 = 0;
-  std::string reason;
-};
-
-std::map<std::string, Localized> ParseLocalizeJson(const std::string& output) {
-  std::map<std::string, Localized> result;
-  std::istringstream lines(output);
-  std::string line;
-  while (std::getline(lines, line)) {
-    if (line.empty() || line[0] != '{') continue;
-    auto json = ParseJson(line, "localize --json");
-    EXPECT_TRUE(json.ok()) << json.status().ToString();
-    if (!json.ok()) continue;
-    Localized entry;
-    entry.registered = json->Find("registered")->bool_value();
-    entry.reason = json->Find("reason")->string();
-    if (entry.registered) {
-      const JsonValue& pose = *json->Find("cam_from_world");
-      for (int i = 0; i < 9; ++i) entry.R(i / 3, i % 3) = (*pose.Find("R"))[static_cast<size_t>(i)].number();
-      for (int i = 0; i < 3; ++i) entry.t(i) = (*pose.Find("t"))[static_cast<size_t>(i)].number();
-      const JsonValue& camera = *json->Find("camera");
-      entry.fx = camera.Find("fx")->number();
-      entry.fy = camera.Find("fy")->number();
-      entry.cx = camera.Find("cx")->number();
-      entry.cy = camera.Find("cy")->number();
-      entry.k1 = camera.Find("k1")->number();
-      entry.k2 = camera.Find("k2")->number();
-    }
-    result[json->Find("image")->string()] = entry;
-  }
-  return result;
-}
-
-Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera& camera, const Eigen::Vector3d& X) {
+Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eigen::Vector3d &X) {
   const Eigen::Vector3d x = camera.K * (camera.cam_from_world_rotation * X + camera.cam_from_world_translation);
   return x.head<2>() / x.z();
 }
@@ -93,11 +43,11 @@ Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera& camera, const Eige
 // Mean pixel distance between the points projected with the estimated camera (intrinsics,
 // rotation and centre in the ground truth's frame) and with the true one, over the points the
 // true camera sees in its 640 x 480 image.
-double OverlayError(const RadialCamera& camera, const Eigen::Matrix3d& rotation_gt, const Eigen::Vector3d& centre_gt,
-                    const testing::GroundTruthCamera& gt, const std::vector<Eigen::Vector3d>& points_gt, int* count) {
+double OverlayError(const RadialCamera &camera, const Eigen::Matrix3d &rotation_gt, const Eigen::Vector3d &centre_gt,
+                    const testing::GroundTruthCamera &gt, const std::vector<Eigen::Vector3d> &points_gt, int *count) {
   double sum = 0.0;
   *count = 0;
-  for (const Eigen::Vector3d& X : points_gt) {
+  for (const Eigen::Vector3d &X : points_gt) {
     const Eigen::Vector3d in_true = gt.cam_from_world_rotation * X + gt.cam_from_world_translation;
     const Eigen::Vector3d in_estimate = rotation_gt * (X - centre_gt);
     if (in_true.z() <= 0.0 || in_estimate.z() <= 0.0) continue;
@@ -118,8 +68,8 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   for (size_t i = 0; i < truth->size(); ++i) ((i % 2 == 0) ? odd : even).push_back((*truth)[i].name);
   ASSERT_EQ(odd.size(), 24u);
   const fs::path root = testing::MakeTestDirectory("localize_templering");
-  const fs::path odd_dir = LinkViews(root / "odd", data, odd);
-  const fs::path even_dir = LinkViews(root / "even", data, even);
+  const fs::path odd_dir = testing::LinkFiles(root / "odd", data, odd);
+  const fs::path even_dir = testing::LinkFiles(root / "even", data, even);
   const fs::path project = root / "project";
 
   const CommandRun sfm =
@@ -131,10 +81,10 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
 
   // The similarity that aligns the map's own cameras to the ground truth.
   std::map<std::string, testing::GroundTruthCamera> truth_by_name;
-  for (const auto& named : *truth) truth_by_name[named.name] = named.camera;
+  for (const auto &named : *truth) truth_by_name[named.name] = named.camera;
   std::vector<testing::CameraPose> estimated, reference;
   std::set<std::string> in_map;
-  for (const SfmImage& image : model->images) {
+  for (const SfmImage &image : model->images) {
     if (!image.registered) continue;
     in_map.insert(image.name);
     estimated.push_back({image.cam_from_world.rotation, image.Center()});
@@ -142,7 +92,7 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   }
   auto alignment = testing::CameraCenterErrors(estimated, reference);
   ASSERT_TRUE(alignment.ok()) << alignment.status().ToString();
-  const Sim3& gt_from_map = alignment->gt_from_estimate;
+  const Sim3 &gt_from_map = alignment->gt_from_estimate;
   std::printf(
       "map: %zu of 24 odd views registered, mean centre error of the "
       "map's cameras %.3f mm\n",
@@ -151,16 +101,18 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   const CommandRun localize = RunReconar(
       "localize " + project.string() + " " + even_dir.string() + " --json --threads 2", testing::StderrMode::kSeparate);
   ASSERT_EQ(localize.exit_code, 0) << localize.output << localize.error;
-  const std::map<std::string, Localized> results = ParseLocalizeJson(localize.output);
+  auto parsed = testing::ParseLocalizeJson(localize.output);
+  ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
+  const std::map<std::string, LocalizedPhoto> &results = *parsed;
   ASSERT_EQ(results.size(), even.size()) << localize.output;
 
   std::vector<Eigen::Vector3d> points_gt;
-  for (const SfmPoint& point : model->points) {
+  for (const SfmPoint &point : model->points) {
     if (!point.deleted) points_gt.push_back(gt_from_map.Apply(point.position));
   }
   // The map's own cameras under the same alignment: what localisation cannot do better than.
   std::vector<double> map_overlay_errors;
-  for (const SfmImage& image : model->images) {
+  for (const SfmImage &image : model->images) {
     if (!image.registered) continue;
     int count = 0;
     map_overlay_errors.push_back(OverlayError(model->cameras[static_cast<size_t>(image.camera_id)],
@@ -172,10 +124,10 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   std::vector<double> centre_errors, rotation_errors, overlay_errors;
   int expected = 0, localized_expected = 0, localized = 0;
   for (size_t i = 1; i < truth->size(); i += 2) {
-    const std::string& name = (*truth)[i].name;
+    const std::string &name = (*truth)[i].name;
     const bool neighbours_in_map = in_map.count((*truth)[i - 1].name) != 0 && in_map.count((*truth)[i + 1].name) != 0;
     expected += neighbours_in_map ? 1 : 0;
-    const Localized& result = results.at(name);
+    const LocalizedPhoto &result = results.at(name);
     if (!result.registered) {
       std::printf("%s: not localised (%s)%s\n", name.c_str(), result.reason.c_str(),
                   neighbours_in_map ? " [both neighbours in the map]" : "");
@@ -184,21 +136,14 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
     ++localized;
     localized_expected += neighbours_in_map ? 1 : 0;
     // The localised camera in the ground truth's frame: X_map = (R_s^T (X_gt - t_s)) / s.
-    const Eigen::Vector3d centre_map = -result.R.transpose() * result.t;
+    const Eigen::Vector3d centre_map = result.Centre();
     const Eigen::Vector3d centre_gt = gt_from_map.Apply(centre_map);
     const Eigen::Matrix3d rotation_gt = result.R * gt_from_map.rotation.transpose();
-    const testing::GroundTruthCamera& gt = truth_by_name.at(name);
+    const testing::GroundTruthCamera &gt = truth_by_name.at(name);
     centre_errors.push_back((centre_gt - gt.Centre()).norm());
     rotation_errors.push_back(RotationAngleDeg(rotation_gt, gt.cam_from_world_rotation));
-    RadialCamera camera;
-    camera.focal = result.fx;
-    camera.aspect = result.fy / result.fx;
-    camera.cx = result.cx;
-    camera.cy = result.cy;
-    camera.k1 = result.k1;
-    camera.k2 = result.k2;
     int count = 0;
-    overlay_errors.push_back(OverlayError(camera, rotation_gt, centre_gt, gt, points_gt, &count));
+    overlay_errors.push_back(OverlayError(result.camera, rotation_gt, centre_gt, gt, points_gt, &count));
     std::printf(
         "%s: centre error %.3f mm, rotation %.3f deg, overlay %.2f px "
         "over %d points\n",

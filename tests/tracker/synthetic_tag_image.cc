@@ -5,6 +5,7 @@
 #include <vector>
 
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include "tracker/tag_pose.h"
@@ -111,6 +112,18 @@ Image<uint8_t> RenderTags(const SyntheticTag* tags, int count, const CameraIntri
   for (int i = 0; i < count; ++i) DrawTag(tags[i], camera, options.supersampling, &image);
   if (options.blur_sigma > 0.0) GaussianBlur(options.blur_sigma, &image);
   return image;
+}
+
+SyntheticTag TiltedTag(int id, const Eigen::Vector3d& translation, double angle_deg) {
+  SyntheticTag tag;
+  tag.id = id;
+  tag.size = 0.1;
+  // The tag faces the camera: tag z toward the viewer = camera -z; tilted a little.
+  const Eigen::Matrix3d facing = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  tag.cam_from_tag.rotation = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d(0.3, 1.0, 0.2).normalized())
+                                  .toRotationMatrix() * facing;
+  tag.cam_from_tag.translation = translation;
+  return tag;
 }
 
 CameraIntrinsics TestCamera() {

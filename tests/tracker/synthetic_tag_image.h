@@ -34,6 +34,10 @@ struct SyntheticRenderOptions {
 // Returns false when the family cannot be rendered or the tag is not in front of the camera.
 bool DrawTag(const SyntheticTag& tag, const CameraIntrinsics& camera, int supersampling, Image<uint8_t>* image);
 
+// A 0.1 m tag facing the camera (tag z toward the viewer), rotated by angle_deg about a fixed
+// oblique axis, its centre at `translation` in the camera frame.
+SyntheticTag TiltedTag(int id, const Eigen::Vector3d& translation, double angle_deg);
+
 // The tests' camera: 640x480, f = 600 px, principal point (320, 240), no distortion.
 CameraIntrinsics TestCamera();
 // A camera.width x camera.height frame of the background with the tags drawn, then blurred.

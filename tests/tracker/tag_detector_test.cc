@@ -14,6 +14,7 @@ using testing::ProjectedCorners;
 using testing::RenderTags;
 using testing::SyntheticRenderOptions;
 using testing::SyntheticTag;
+using testing::TiltedTag;
 
 CameraIntrinsics TestCamera() {
   CameraIntrinsics camera;
@@ -23,18 +24,6 @@ CameraIntrinsics TestCamera() {
   camera.cx = 319.5;
   camera.cy = 239.5;
   return camera;
-}
-
-SyntheticTag TiltedTag(int id, const Eigen::Vector3d& translation, double angle_deg) {
-  SyntheticTag tag;
-  tag.id = id;
-  tag.size = 0.1;
-  // The tag faces the camera: tag z toward the viewer = camera -z; tilted a little.
-  const Eigen::Matrix3d facing = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  tag.cam_from_tag.rotation = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d(0.3, 1.0, 0.2).normalized())
-                                  .toRotationMatrix() * facing;
-  tag.cam_from_tag.translation = translation;
-  return tag;
 }
 
 double MeanCornerError(const TagDetection& detection, const std::array<Eigen::Vector2d, 4>& expected) {

@@ -1,0 +1,50 @@
+#include "tests/support/localize_json.h"
+
+#include <gtest/gtest.h>
+
+namespace reconar {
+namespace {
+
+constexpr char kRegistered[] =
+    R"({"image": "a.png", "registered": true, "cam_from_world": {"R": [1, 0, 0, 0, 1, 0, 0, 0, 1], )"
+    R"("t": [1, 2, 3]}, "camera": {"width": 640, "height": 480, "fx": 500, "fy": 510, "cx": 320, "cy": 240, )"
+    R"("k1": 0.1, "k2": -0.01, "source": "exif"}, "inliers": 55, "matches": 80, "features": 900, "ms": 12.5, )"
+    R"("reason": ""})";
+constexpr char kUnregistered[] =
+    R"({"image": "b.png", "registered": false, "inliers": 3, "matches": 9, "features": 700, "ms": 4, )"
+    R"("reason": "too few 2D-3D matches"})";
+
+TEST(LocalizeJson, ReadsRegisteredAndUnregisteredLines) {
+  auto parsed = testing::ParseLocalizeJson(std::string("progress line\n") + kRegistered + "\n" + kUnregistered + "\n");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
+  ASSERT_EQ(parsed->size(), 2u);
+  const testing::LocalizedPhoto& a = parsed->at("a.png");
+  EXPECT_TRUE(a.registered);
+  EXPECT_EQ(a.inliers, 55);
+  EXPECT_DOUBLE_EQ(a.ms, 12.5);
+  EXPECT_TRUE(a.Centre().isApprox(Eigen::Vector3d(-1, -2, -3)));
+  EXPECT_DOUBLE_EQ(a.camera.focal, 500.0);
+  EXPECT_DOUBLE_EQ(a.camera.fy(), 510.0);
+  EXPECT_DOUBLE_EQ(a.camera.k2, -0.01);
+  const testing::LocalizedPhoto& b = parsed->at("b.png");
+  EXPECT_FALSE(b.registered);
+  EXPECT_EQ(b.reason, "too few 2D-3D matches");
+}
+
+TEST(LocalizeJson, RefusesBrokenLines) {
+  for (const std::string& line :
+       {std::string("{\"image\": \"a.png\""), std::string("{\"registered\": false}"),
+        std::string(R"({"image": "a.png", "registered": true, "inliers": 1, "ms": 1, "reason": ""})"),
+        std::string(R"({"image": "a.png", "registered": "yes", "inliers": 1, "ms": 1, "reason": ""})"),
+        std::string(kRegistered).replace(std::string(kRegistered).find("[1, 2, 3]"), 9, "[1, 2]"),
+        std::string(kRegistered).replace(std::string(kRegistered).find("\"fx\": 500"), 9, "\"fx\": 0  ")}) {
+    const auto parsed = testing::ParseLocalizeJson(line);
+    EXPECT_FALSE(parsed.ok()) << line;
+    if (!parsed.ok()) {
+      EXPECT_EQ(parsed.status().code(), StatusCode::kCorruptData) << parsed.status().ToString();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace reconar
