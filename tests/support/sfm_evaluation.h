@@ -18,6 +18,12 @@ namespace reconar::testing {
 using Similarity3 = Sim3;
 using reconar::AlignSimilarity;
 
+// The median of `values` (mean of the middle two for an even count); 0 for none.
+double Median(std::vector<double> values);
+
+// The angle of the rotation a * b^T, in degrees.
+double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
+
 // A camera's orientation and position: X_cam = cam_from_world_rotation * (X_world - centre).
 struct CameraPose {
   Eigen::Matrix3d cam_from_world_rotation = Eigen::Matrix3d::Identity();

@@ -19,6 +19,7 @@
 #include "core/base/json_reader.h"
 #include "core/sfm/model_io.h"
 #include "tests/support/ground_truth.h"
+#include "tests/support/localization_evaluation.h"
 #include "tests/support/run_command.h"
 #include "tests/support/sfm_evaluation.h"
 
@@ -28,62 +29,9 @@ namespace {
 namespace fs = std::filesystem;
 
 using testing::CommandRun;
+using testing::Localized;
+using testing::Median;
 using testing::RunReconar;
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n == 0 ? 0.0 : (n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
-}
-
-double RotationAngleDeg(const Eigen::Matrix3d &a, const Eigen::Matrix3d &b) {
-  const double c = std::clamp(((a * b.transpose()).trace() - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * 180.0 / M_PI;
-}
-
-// The views of `names` linked into a fresh directory.
-fs::path LinkViews(const fs::path &dir, const std::string &data, const std::vector<std::string> &names) {
-  fs::create_directories(dir);
-  for (const std::string &name : names) fs::create_symlink(data + "/" + name, dir / name);
-  return dir;
-}
-
-struct Localized {
-  bool registered = false;
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  double fx = 0, fy = 0, cx = 0, cy = 0, k1 = 0, k2 = 0;
-  std::string reason;
-};
-
-std::map<std::string, Localized> ParseLocalizeJson(const std::string &output) {
-  std::map<std::string, Localized> result;
-  std::istringstream lines(output);
-  std::string line;
-  while (std::getline(lines, line)) {
-    if (line.empty() || line[0] != '{') continue;
-    auto json = ParseJson(line, "localize --json");
-    EXPECT_TRUE(json.ok()) << json.status().ToString();
-    if (!json.ok()) continue;
-    Localized entry;
-    entry.registered = json->Find("registered")->bool_value();
-    entry.reason = json->Find("reason")->string();
-    if (entry.registered) {
-      const JsonValue &pose = *json->Find("cam_from_world");
-      for (int i = 0; i < 9; ++i) entry.R(i / 3, i % 3) = (*pose.Find("R"))[static_cast<size_t>(i)].number();
-      for (int i = 0; i < 3; ++i) entry.t(i) = (*pose.Find("t"))[static_cast<size_t>(i)].number();
-      const JsonValue &camera = *json->Find("camera");
-      entry.fx = camera.Find("fx")->number();
-      entry.fy = camera.Find("fy")->number();
-      entry.cx = camera.Find("cx")->number();
-      entry.cy = camera.Find("cy")->number();
-      entry.k1 = camera.Find("k1")->number();
-      entry.k2 = camera.Find("k2")->number();
-    }
-    result[json->Find("image")->string()] = entry;
-  }
-  return result;
-}
 
 Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eigen::Vector3d &X) {
   const Eigen::Vector3d x = camera.K * (camera.cam_from_world_rotation * X + camera.cam_from_world_translation);
@@ -118,8 +66,8 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   for (size_t i = 0; i < truth->size(); ++i) ((i % 2 == 0) ? odd : even).push_back((*truth)[i].name);
   ASSERT_EQ(odd.size(), 24u);
   const fs::path root = testing::MakeTestDirectory("localize_templering");
-  const fs::path odd_dir = LinkViews(root / "odd", data, odd);
-  const fs::path even_dir = LinkViews(root / "even", data, even);
+  const fs::path odd_dir = testing::LinkViews(root / "odd", data, odd);
+  const fs::path even_dir = testing::LinkViews(root / "even", data, even);
   const fs::path project = root / "project";
 
   const CommandRun sfm =
@@ -132,26 +80,21 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   // The similarity that aligns the map's own cameras to the ground truth.
   std::map<std::string, testing::GroundTruthCamera> truth_by_name;
   for (const auto &named : *truth) truth_by_name[named.name] = named.camera;
-  std::vector<testing::CameraPose> estimated, reference;
-  std::set<std::string> in_map;
-  for (const SfmImage &image : model->images) {
-    if (!image.registered) continue;
-    in_map.insert(image.name);
-    estimated.push_back({image.cam_from_world.rotation, image.Center()});
-    reference.push_back(testing::PoseOf(truth_by_name.at(image.name)));
-  }
-  auto alignment = testing::CameraCenterErrors(estimated, reference);
+  auto alignment = testing::AlignMapToGroundTruth(*model, truth_by_name);
   ASSERT_TRUE(alignment.ok()) << alignment.status().ToString();
-  const Sim3 &gt_from_map = alignment->gt_from_estimate;
+  const std::set<std::string> &in_map = alignment->in_map;
+  const Sim3 &gt_from_map = alignment->errors.gt_from_estimate;
   std::printf(
       "map: %zu of 24 odd views registered, mean centre error of the "
       "map's cameras %.3f mm\n",
-      in_map.size(), 1000.0 * alignment->centre_mean);
+      in_map.size(), 1000.0 * alignment->errors.centre_mean);
 
   const CommandRun localize = RunReconar(
       "localize " + project.string() + " " + even_dir.string() + " --json --threads 2", testing::StderrMode::kSeparate);
   ASSERT_EQ(localize.exit_code, 0) << localize.output << localize.error;
-  const std::map<std::string, Localized> results = ParseLocalizeJson(localize.output);
+  auto parsed = testing::ParseLocalizeJson(localize.output);
+  ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
+  const std::map<std::string, Localized> &results = *parsed;
   ASSERT_EQ(results.size(), even.size()) << localize.output;
 
   std::vector<Eigen::Vector3d> points_gt;
@@ -183,13 +126,12 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
     }
     ++localized;
     localized_expected += neighbours_in_map ? 1 : 0;
-    // The localised camera in the ground truth's frame: X_map = (R_s^T (X_gt - t_s)) / s.
-    const Eigen::Vector3d centre_map = -result.R.transpose() * result.t;
-    const Eigen::Vector3d centre_gt = gt_from_map.Apply(centre_map);
-    const Eigen::Matrix3d rotation_gt = result.R * gt_from_map.rotation.transpose();
+    const testing::CameraPose in_truth = testing::InTruthFrame(gt_from_map, result.R, result.t);
+    const Eigen::Vector3d &centre_gt = in_truth.centre;
+    const Eigen::Matrix3d &rotation_gt = in_truth.cam_from_world_rotation;
     const testing::GroundTruthCamera &gt = truth_by_name.at(name);
     centre_errors.push_back((centre_gt - gt.Centre()).norm());
-    rotation_errors.push_back(RotationAngleDeg(rotation_gt, gt.cam_from_world_rotation));
+    rotation_errors.push_back(testing::RotationAngleDeg(rotation_gt, gt.cam_from_world_rotation));
     RadialCamera camera;
     camera.focal = result.fx;
     camera.aspect = result.fy / result.fx;
@@ -213,7 +155,7 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   EXPECT_EQ(localized_expected, expected);
   EXPECT_GT(expected, 0);
   EXPECT_LE(Median(overlay_errors), 2.0);
-  EXPECT_LE(Median(centre_errors), 2.0 * alignment->centre_mean);
+  EXPECT_LE(Median(centre_errors), 2.0 * alignment->errors.centre_mean);
 }
 
 }  // namespace
