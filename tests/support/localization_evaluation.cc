@@ -3,6 +3,8 @@
 #include <sstream>
 
 #include "core/base/json_reader.h"
+#include "core/sfm/model_io.h"
+#include "tests/support/run_command.h"
 
 namespace reconar::testing {
 
@@ -67,6 +69,29 @@ Result<std::map<std::string, Localized>> ParseLocalizeJson(const std::string& ou
     result[image] = std::move(entry);
   }
   return result;
+}
+
+Result<Reconstruction> BuildMapWithSfm(const std::string& reconar, const fs::path& images, const fs::path& project,
+                                       const std::string& options) {
+  const std::string command = reconar + " sfm " + images.string() + " " + project.string() + " " + options;
+  const CommandRun sfm = RunCommand(command);
+  if (sfm.exit_code != 0) {
+    return Internal(command + ": exit code " + std::to_string(sfm.exit_code) + "\n" + sfm.output);
+  }
+  if (!fs::exists(project / "map" / "map.rmap")) return Internal(command + ": no map/map.rmap\n" + sfm.output);
+  return ReadColmapTextModel((project / "sparse").string());
+}
+
+Result<std::map<std::string, Localized>> LocalizeWithJson(const std::string& reconar, const fs::path& project,
+                                                          const fs::path& queries) {
+  const std::string command =
+      reconar + " localize " + project.string() + " " + queries.string() + " --json --threads 2";
+  const CommandRun localize = RunCommand(command, StderrMode::kSeparate);
+  if (localize.exit_code != 0) {
+    return Internal(command + ": exit code " + std::to_string(localize.exit_code) + "\n" + localize.output +
+                    localize.error);
+  }
+  return ParseLocalizeJson(localize.output);
 }
 
 Result<MapAlignment> AlignMapToGroundTruth(const Reconstruction& model, const GroundTruthByName& truth) {

@@ -35,6 +35,17 @@ struct Localized {
 // line for a line that does not parse or lacks a field.
 Result<std::map<std::string, Localized>> ParseLocalizeJson(const std::string& output);
 
+// `RECONAR sfm IMAGES PROJECT OPTIONS` (RECONAR the executable), then PROJECT/sparse; Internal with
+// the command's output when it fails or leaves no PROJECT/map/map.rmap.
+Result<Reconstruction> BuildMapWithSfm(const std::string& reconar, const std::filesystem::path& images,
+                                       const std::filesystem::path& project, const std::string& options);
+
+// `RECONAR localize PROJECT QUERIES --json --threads 2`, parsed; Internal with the command's output
+// when it fails.
+Result<std::map<std::string, Localized>> LocalizeWithJson(const std::string& reconar,
+                                                          const std::filesystem::path& project,
+                                                          const std::filesystem::path& queries);
+
 // The map's registered cameras aligned to `truth` by their centres (CameraCenterErrors).
 struct MapAlignment {
   std::set<std::string> in_map;  // names of the registered images

@@ -15,7 +15,6 @@
 #include <string>
 #include <vector>
 
-#include "core/sfm/model_io.h"
 #include "tests/support/ground_truth.h"
 #include "tests/support/localization_evaluation.h"
 #include "tests/support/run_command.h"
@@ -26,10 +25,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using testing::CommandRun;
 using testing::Localized;
 using testing::Median;
-using testing::RunReconar;
 
 TEST(LocalizeCli, CastleP19OddPhotosAgainstAMapOfTheEvenOnes) {
   const std::string data = testing::SharedDataPath("strecha_castle-P19");
@@ -45,10 +42,7 @@ TEST(LocalizeCli, CastleP19OddPhotosAgainstAMapOfTheEvenOnes) {
   const fs::path odd_dir = testing::LinkViews(root / "odd", data + "/images", odd);
   const fs::path project = root / "project";
 
-  const CommandRun sfm = RunReconar("sfm " + even_dir.string() + " " + project.string() + " --threads 2");
-  ASSERT_EQ(sfm.exit_code, 0) << sfm.output;
-  ASSERT_TRUE(fs::exists(project / "map" / "map.rmap")) << sfm.output;
-  auto model = ReadColmapTextModel((project / "sparse").string());
+  auto model = testing::BuildMapWithSfm(RECONAR_BINARY, even_dir, project, "--threads 2");
   ASSERT_TRUE(model.ok()) << model.status().ToString();
   auto alignment = testing::AlignMapToGroundTruth(*model, *truth);
   ASSERT_TRUE(alignment.ok()) << alignment.status().ToString();
@@ -70,13 +64,10 @@ TEST(LocalizeCli, CastleP19OddPhotosAgainstAMapOfTheEvenOnes) {
     if (in_map.count(name) == 0) std::printf("map %s: not registered\n", name.c_str());
   }
 
-  const CommandRun localize = RunReconar(
-      "localize " + project.string() + " " + odd_dir.string() + " --json --threads 2", testing::StderrMode::kSeparate);
-  ASSERT_EQ(localize.exit_code, 0) << localize.output << localize.error;
-  auto parsed = testing::ParseLocalizeJson(localize.output);
+  auto parsed = testing::LocalizeWithJson(RECONAR_BINARY, project, odd_dir);
   ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
   const std::map<std::string, Localized> &results = *parsed;
-  ASSERT_EQ(results.size(), odd.size()) << localize.output;
+  ASSERT_EQ(results.size(), odd.size());
 
   std::vector<double> centre_errors, rotation_errors, times_ms;
   double max_rotation_error = 0.0;

@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "core/base/json_reader.h"
-#include "core/sfm/model_io.h"
 #include "tests/support/ground_truth.h"
 #include "tests/support/localization_evaluation.h"
 #include "tests/support/run_command.h"
@@ -28,10 +27,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using testing::CommandRun;
 using testing::Localized;
 using testing::Median;
-using testing::RunReconar;
 
 Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eigen::Vector3d &X) {
   const Eigen::Vector3d x = camera.K * (camera.cam_from_world_rotation * X + camera.cam_from_world_translation);
@@ -70,11 +67,7 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   const fs::path even_dir = testing::LinkViews(root / "even", data, even);
   const fs::path project = root / "project";
 
-  const CommandRun sfm =
-      RunReconar("sfm " + odd_dir.string() + " " + project.string() + " --fixed-distortion --threads 2");
-  ASSERT_EQ(sfm.exit_code, 0) << sfm.output;
-  ASSERT_TRUE(fs::exists(project / "map" / "map.rmap")) << sfm.output;
-  auto model = ReadColmapTextModel((project / "sparse").string());
+  auto model = testing::BuildMapWithSfm(RECONAR_BINARY, odd_dir, project, "--fixed-distortion --threads 2");
   ASSERT_TRUE(model.ok()) << model.status().ToString();
 
   // The similarity that aligns the map's own cameras to the ground truth.
@@ -89,13 +82,10 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
       "map's cameras %.3f mm\n",
       in_map.size(), 1000.0 * alignment->errors.centre_mean);
 
-  const CommandRun localize = RunReconar(
-      "localize " + project.string() + " " + even_dir.string() + " --json --threads 2", testing::StderrMode::kSeparate);
-  ASSERT_EQ(localize.exit_code, 0) << localize.output << localize.error;
-  auto parsed = testing::ParseLocalizeJson(localize.output);
+  auto parsed = testing::LocalizeWithJson(RECONAR_BINARY, project, even_dir);
   ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
   const std::map<std::string, Localized> &results = *parsed;
-  ASSERT_EQ(results.size(), even.size()) << localize.output;
+  ASSERT_EQ(results.size(), even.size());
 
   std::vector<Eigen::Vector3d> points_gt;
   for (const SfmPoint &point : model->points) {
