@@ -41,7 +41,7 @@ constexpr char kHelp[] =
 
 }  // namespace
 
-int RunLocalize(int argc, char **argv, int first) {
+int RunLocalize(int argc, char** argv, int first) {
   Args args({"intrinsics", "threads"}, {"json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
@@ -70,7 +70,7 @@ int RunLocalize(int argc, char **argv, int first) {
   auto photos = LocalizePhotos(*map, *paths, options);
   if (!photos.ok()) return Fail(photos.status());
   int registered = 0;
-  for (const PhotoLocalization &photo : *photos) {
+  for (const PhotoLocalization& photo : *photos) {
     registered += photo.result.registered ? 1 : 0;
     if (args.Has("json")) {
       std::printf("%s\n", PhotoLocalizationJson(photo).c_str());

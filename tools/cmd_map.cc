@@ -29,7 +29,7 @@ constexpr char kHelp[] =
 
 }  // namespace
 
-int RunMap(int argc, char **argv, int first) {
+int RunMap(int argc, char** argv, int first) {
   Args args({"threads"}, {"json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {

@@ -19,7 +19,7 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-std::string FileName(const std::string &path) {
+std::string FileName(const std::string& path) {
   const size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
@@ -35,8 +35,8 @@ Status LocalizePhotosOptions::Check() const {
   return Status::Ok();
 }
 
-Result<std::vector<PhotoLocalization>> LocalizePhotos(const LocalizationMap &map, const std::vector<std::string> &paths,
-                                                      const LocalizePhotosOptions &options) {
+Result<std::vector<PhotoLocalization>> LocalizePhotos(const LocalizationMap& map, const std::vector<std::string>& paths,
+                                                      const LocalizePhotosOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   RECONAR_ASSIGN_OR_RETURN(const Localizer localizer, Localizer::Create(&map, options.localizer));
   std::vector<PhotoLocalization> photos(paths.size());
@@ -49,7 +49,7 @@ Result<std::vector<PhotoLocalization>> LocalizePhotos(const LocalizationMap &map
   std::vector<Status> failures(paths.size());
   pool.ParallelFor(0, paths.size(), [&](size_t i, int worker) {
     const auto start = Clock::now();
-    PhotoLocalization &photo = photos[i];
+    PhotoLocalization& photo = photos[i];
     photo.path = paths[i];
     photo.image = FileName(paths[i]);
     auto decoded = ReadImage(paths[i]);
@@ -61,7 +61,7 @@ Result<std::vector<PhotoLocalization>> LocalizePhotos(const LocalizationMap &map
     const Image<float> gray = ToGrayFloat(decoded->rgb);
     photo.width = gray.width();
     photo.height = gray.height();
-    auto &extractor = extractors[static_cast<size_t>(worker)];
+    auto& extractor = extractors[static_cast<size_t>(worker)];
     if (!extractor) extractor = std::make_unique<SiftExtractor>(options.sift);
     auto features = extractor->Extract(gray.view());
     photo.seconds_features = SecondsSince(start);
@@ -84,12 +84,12 @@ Result<std::vector<PhotoLocalization>> LocalizePhotos(const LocalizationMap &map
     if (progress) progress->Advance();
   });
   if (progress) progress->Finish();
-  for (const Status &failure : failures) RECONAR_RETURN_IF_ERROR(failure);
+  for (const Status& failure : failures) RECONAR_RETURN_IF_ERROR(failure);
   return photos;
 }
 
-std::string PhotoLocalizationJson(const PhotoLocalization &photo) {
-  const LocalizationResult &r = photo.result;
+std::string PhotoLocalizationJson(const PhotoLocalization& photo) {
+  const LocalizationResult& r = photo.result;
   JsonWriter json;
   json.BeginObject().Key("image").String(photo.image).Key("registered").Bool(r.registered);
   if (r.registered) {

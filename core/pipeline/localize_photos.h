@@ -39,12 +39,12 @@ struct PhotoLocalization {
 
 // One result per path, in order; a photo that cannot be read is a result with `error`, not a failed
 // call. InvalidArgument on bad options.
-Result<std::vector<PhotoLocalization>> LocalizePhotos(const LocalizationMap &map, const std::vector<std::string> &paths,
-                                                      const LocalizePhotosOptions &options);
+Result<std::vector<PhotoLocalization>> LocalizePhotos(const LocalizationMap& map, const std::vector<std::string>& paths,
+                                                      const LocalizePhotosOptions& options);
 
 // The one-line JSON of `reconar localize --json`: {"image", "registered", "cam_from_world": {"R":
 // [9, row-major], "t": [3]}, "camera": {"width", "height", "fx", "fy", "cx", "cy", "k1", "k2",
 // "source"}, "inliers", "matches", "ms", "reason"}.
-std::string PhotoLocalizationJson(const PhotoLocalization &photo);
+std::string PhotoLocalizationJson(const PhotoLocalization& photo);
 
 }  // namespace reconar

@@ -15,11 +15,11 @@ namespace reconar {
 namespace {
 
 // "metres, world tag N" and true when tags.json says the model is metric.
-std::pair<std::string, bool> ModelFrame(const Project &project) {
+std::pair<std::string, bool> ModelFrame(const Project& project) {
   auto tags = ReadJsonFile(project.TagsJsonPath());
   if (!tags.ok()) return {"arbitrary", false};
-  const JsonValue *metric = tags->Find("metric");
-  const JsonValue *world_tag = tags->Find("world_tag");
+  const JsonValue* metric = tags->Find("metric");
+  const JsonValue* world_tag = tags->Find("world_tag");
   if (metric == nullptr || !metric->is_bool() || !metric->bool_value()) return {"arbitrary", false};
   const int tag = world_tag != nullptr && world_tag->is_number() ? static_cast<int>(world_tag->number()) : 0;
   return {"metres, world tag " + std::to_string(tag), true};
@@ -27,14 +27,14 @@ std::pair<std::string, bool> ModelFrame(const Project &project) {
 
 }  // namespace
 
-std::string MapStageSettings(const MapStageOptions &options) {
+std::string MapStageSettings(const MapStageOptions& options) {
   return StageRecord::Settings({{"version", 1},
                                 {"branching", options.build.vocabulary.branching},
                                 {"depth", options.build.vocabulary.depth},
                                 {"medoid_candidates", options.build.max_medoid_candidates}});
 }
 
-Result<MapStageReport> RunMapStage(const Project &project, const MapStageOptions &options) {
+Result<MapStageReport> RunMapStage(const Project& project, const MapStageOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   const auto start = std::chrono::steady_clock::now();
   struct stat info {};
@@ -43,7 +43,7 @@ Result<MapStageReport> RunMapStage(const Project &project, const MapStageOptions
                               ": no sparse model (run `reconar reconstruct` or `reconar sfm` first)");
   }
   RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(project.SparseDir()));
-  const ImageDescriptorLoader load = [&](const SfmImage &image) -> Result<std::vector<uint8_t>> {
+  const ImageDescriptorLoader load = [&](const SfmImage& image) -> Result<std::vector<uint8_t>> {
     RECONAR_ASSIGN_OR_RETURN(FeatureFile features, ReadFeatureFile(project.FeaturePath(image.name)));
     return std::move(features.features.descriptors);
   };

@@ -29,9 +29,9 @@ struct MapStageReport {
 };
 
 // The stage's settings as PROJECT/stages.txt records them.
-std::string MapStageSettings(const MapStageOptions &options);
+std::string MapStageSettings(const MapStageOptions& options);
 
 // FailedPrecondition when the project has no sparse model; errors of its files name the file.
-Result<MapStageReport> RunMapStage(const Project &project, const MapStageOptions &options);
+Result<MapStageReport> RunMapStage(const Project& project, const MapStageOptions& options);
 
 }  // namespace reconar

@@ -22,8 +22,8 @@ struct ObservationRef {
 
 // The candidate with the least summed distance to the others (distances, not squared: the L2
 // medoid); ties go to the earlier candidate.
-int MedoidOf(const std::vector<const uint8_t *> &candidates) {
-  const DescriptorDistanceKernel &kernel = ActiveDescriptorDistanceKernel();
+int MedoidOf(const std::vector<const uint8_t*>& candidates) {
+  const DescriptorDistanceKernel& kernel = ActiveDescriptorDistanceKernel();
   int best = 0;
   double best_sum = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < candidates.size(); ++i) {
@@ -49,23 +49,23 @@ Status MapBuildOptions::Check() const {
 
 int LocalizationMap::num_observations() const {
   int n = 0;
-  for (const MapKeyframe &keyframe : keyframes) n += keyframe.num_observations();
+  for (const MapKeyframe& keyframe : keyframes) n += keyframe.num_observations();
   return n;
 }
 
 size_t LocalizationMap::memory_bytes() const {
   size_t bytes = sizeof(*this) + points.capacity() * sizeof(Eigen::Vector3d) + colors.capacity() * sizeof(colors[0]) +
                  point_descriptors.capacity();
-  for (const MapKeyframe &keyframe : keyframes) {
+  for (const MapKeyframe& keyframe : keyframes) {
     bytes += sizeof(keyframe) + keyframe.name.capacity() + keyframe.keypoints.capacity() * sizeof(Eigen::Vector2f) +
              keyframe.point_ids.capacity() * sizeof(int32_t) + keyframe.descriptors.capacity();
   }
   return bytes + vocabulary.memory_bytes() + keyframe_index.memory_bytes();
 }
 
-Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const ImageDescriptorLoader &load_descriptors,
-                                             const std::string &frame, bool metric, const MapBuildOptions &options,
-                                             MapBuildReport *report) {
+Result<LocalizationMap> BuildLocalizationMap(const Reconstruction& model, const ImageDescriptorLoader& load_descriptors,
+                                             const std::string& frame, bool metric, const MapBuildOptions& options,
+                                             MapBuildReport* report) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   if (model.NumRegisteredImages() == 0)
     return FailedPrecondition("localisation map: the model has no registered image");
@@ -83,7 +83,7 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const 
   auto start = Clock::now();
   std::vector<int32_t> map_id_of(model.points.size(), -1);
   std::vector<int32_t> model_id_of;
-  for (const SfmImage &image : model.images) {
+  for (const SfmImage& image : model.images) {
     if (!image.registered) continue;
     if (image.camera_id < 0 || image.camera_id >= static_cast<int>(model.cameras.size())) {
       return InvalidArgument("localisation map: image " + image.name + " has no camera");
@@ -94,7 +94,7 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const 
       return InvalidArgument("localisation map: image " + image.name + " has " + std::to_string(num_described) +
                              " descriptors for " + std::to_string(image.keypoints.size()) + " keypoints");
     }
-    const SfmCamera &camera = model.cameras[static_cast<size_t>(image.camera_id)];
+    const SfmCamera& camera = model.cameras[static_cast<size_t>(image.camera_id)];
     MapKeyframe keyframe;
     keyframe.name = image.name;
     keyframe.width = camera.width;
@@ -107,7 +107,7 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const 
           model.points[static_cast<size_t>(point)].deleted) {
         continue;
       }
-      int32_t &map_id = map_id_of[static_cast<size_t>(point)];
+      int32_t& map_id = map_id_of[static_cast<size_t>(point)];
       if (map_id < 0) {
         map_id = static_cast<int32_t>(model_id_of.size());
         model_id_of.push_back(point);
@@ -128,12 +128,12 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const 
   map.points.resize(static_cast<size_t>(num_points));
   map.colors.resize(static_cast<size_t>(num_points));
   for (int i = 0; i < num_points; ++i) {
-    const SfmPoint &point = model.points[static_cast<size_t>(model_id_of[static_cast<size_t>(i)])];
+    const SfmPoint& point = model.points[static_cast<size_t>(model_id_of[static_cast<size_t>(i)])];
     map.points[static_cast<size_t>(i)] = point.position;
     map.colors[static_cast<size_t>(i)] = point.color;
   }
   std::vector<int32_t> first_ref(static_cast<size_t>(num_points) + 1, 0);
-  for (const MapKeyframe &keyframe : map.keyframes) {
+  for (const MapKeyframe& keyframe : map.keyframes) {
     for (int32_t id : keyframe.point_ids) ++first_ref[static_cast<size_t>(id) + 1];
   }
   for (int i = 0; i < num_points; ++i) first_ref[static_cast<size_t>(i) + 1] += first_ref[static_cast<size_t>(i)];
@@ -141,7 +141,7 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const 
   {
     std::vector<int32_t> fill(first_ref.begin(), first_ref.end() - 1);
     for (size_t f = 0; f < map.keyframes.size(); ++f) {
-      const MapKeyframe &keyframe = map.keyframes[f];
+      const MapKeyframe& keyframe = map.keyframes[f];
       for (int o = 0; o < keyframe.num_observations(); ++o) {
         refs[static_cast<size_t>(fill[static_cast<size_t>(keyframe.point_ids[static_cast<size_t>(o)])]++)] =
             ObservationRef{static_cast<int32_t>(f), o};
@@ -153,10 +153,10 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const 
   pool.ParallelFor(0, static_cast<size_t>(num_points), [&](size_t i, int) {
     const int begin = first_ref[i], count = first_ref[i + 1] - begin;
     const int taken = std::min(count, options.max_medoid_candidates);
-    std::vector<const uint8_t *> candidates;
+    std::vector<const uint8_t*> candidates;
     candidates.reserve(static_cast<size_t>(taken));
     for (int c = 0; c < taken; ++c) {
-      const ObservationRef &ref =
+      const ObservationRef& ref =
           refs[static_cast<size_t>(begin + static_cast<int>(static_cast<int64_t>(c) * count / taken))];
       candidates.push_back(&map.keyframes[static_cast<size_t>(ref.keyframe)]
                                 .descriptors[static_cast<size_t>(ref.observation) * kDescriptorSize]);
@@ -169,7 +169,7 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const 
   // The vocabulary, trained on every observation's descriptor.
   start = Clock::now();
   std::vector<uint8_t> all_descriptors;
-  for (const MapKeyframe &keyframe : map.keyframes) {
+  for (const MapKeyframe& keyframe : map.keyframes) {
     all_descriptors.insert(all_descriptors.end(), keyframe.descriptors.begin(), keyframe.descriptors.end());
   }
   VocabularyTreeOptions vocabulary_options = options.vocabulary;
@@ -183,7 +183,7 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction &model, const 
   start = Clock::now();
   std::vector<std::vector<int32_t>> keyframe_words(map.keyframes.size());
   pool.ParallelFor(0, map.keyframes.size(), [&](size_t f, int) {
-    const MapKeyframe &keyframe = map.keyframes[f];
+    const MapKeyframe& keyframe = map.keyframes[f];
     keyframe_words[f].resize(static_cast<size_t>(keyframe.num_observations()));
     for (int o = 0; o < keyframe.num_observations(); ++o) {
       keyframe_words[f][static_cast<size_t>(o)] =

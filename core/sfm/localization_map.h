@@ -12,7 +12,7 @@
 //
 // File format (little-endian, core/base/binary_io.h):
 //   char magic[8] = "RCNRMAP\0"; uint32 version = 1; uint64 payload_bytes; uint32 payload_crc32;
-//   payload: the header fields, points, keyframes, vocabulary, inverted file (localization_map.cc).
+//   payload: the header fields, points, keyframes, vocabulary, inverted file (localization_map_io.cc).
 // The reader checks magic, version, size and checksum before parsing, then checks every count and
 // index while parsing: a damaged, truncated or foreign file is an error naming the file and the
 // reason, never a crash (tests/core/sfm/localization_map_fuzz.cc).
@@ -97,7 +97,7 @@ Result<LocalizationMap> BuildLocalizationMap(const Reconstruction& model, const 
 // Atomic write (core/base/atomic_file.h).
 Status WriteLocalizationMap(const std::string& path, const LocalizationMap& map);
 // InvalidArgument naming the file and what is wrong for a foreign, damaged or truncated file;
-// IoError when it cannot be read.
+// NotFound / IoError naming it when it is missing or cannot be read.
 Result<LocalizationMap> ReadLocalizationMap(const std::string& path);
 // The same from bytes already in memory (`what` names them in errors): the fuzz target.
 Result<LocalizationMap> ParseLocalizationMap(std::string_view bytes, const std::string& what);

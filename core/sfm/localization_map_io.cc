@@ -195,8 +195,10 @@ class PayloadParser {
   Status ParseKeyframe(int index, int num_points, MapKeyframe* keyframe) {
     const std::string label = "keyframe " + std::to_string(index);
     if (!reader_.GetString(kMaxStringBytes, &keyframe->name)) return Truncated(label + "'s name");
-    if (keyframe->name.empty() || keyframe->name.find('\0') != std::string::npos) {
-      return Error(label + ": empty name or NUL in name");
+    // A photo's file name: no control characters (they would also garble the messages below).
+    const auto control = [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; };
+    if (keyframe->name.empty() || std::any_of(keyframe->name.begin(), keyframe->name.end(), control)) {
+      return Error(label + ": empty name or control character in name");
     }
     const std::string named = label + " (" + keyframe->name + ")";
     int32_t width = 0;

@@ -28,9 +28,9 @@ bool SameAspect(int width_a, int height_a, int width_b, int height_b) {
              0.01 * static_cast<double>(width_a) * height_b;
 }
 
-// Neighbours searched per query descriptor: the nearest and, among the rest, the nearest
-// observation of another map point (a point seen in several retrieved keyframes fills several).
-constexpr int kNeighbours = 6;
+// Neighbours searched per query descriptor, among which the nearest of a retrieved keyframe and
+// the nearest of another point there are sought.
+constexpr int kNeighbours = 16;
 
 }  // namespace
 
@@ -38,6 +38,7 @@ Status LocalizerOptions::Check() const {
   if (num_keyframes < 1) return InvalidArgument("LocalizerOptions: num_keyframes must be >= 1");
   if (!(max_ratio > 0.0 && max_ratio <= 1.0)) return InvalidArgument("LocalizerOptions: max_ratio must be in (0, 1]");
   if (max_leaf_checks < 1) return InvalidArgument("LocalizerOptions: max_leaf_checks must be >= 1");
+  if (leaf_size < 1) return InvalidArgument("LocalizerOptions: leaf_size must be >= 1");
   if (min_inliers < 4) return InvalidArgument("LocalizerOptions: min_inliers must be >= 4");
   if (!(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0)) {
     return InvalidArgument("LocalizerOptions: min_inlier_ratio must be in [0, 1]");
@@ -47,8 +48,8 @@ Status LocalizerOptions::Check() const {
   return pose_options.Check();
 }
 
-Result<QueryCamera> ResolveQueryCamera(const LocalizationMap &map, int width, int height,
-                                       const std::optional<CameraIntrinsics> &intrinsics, double exif_focal_px) {
+Result<QueryCamera> ResolveQueryCamera(const LocalizationMap& map, int width, int height,
+                                       const std::optional<CameraIntrinsics>& intrinsics, double exif_focal_px) {
   if (width <= 0 || height <= 0) return InvalidArgument("query image size must be positive");
   QueryCamera camera;
   camera.width = width;
@@ -66,7 +67,7 @@ Result<QueryCamera> ResolveQueryCamera(const LocalizationMap &map, int width, in
   }
   std::vector<double> focal, aspect, cx, cy, k1, k2;
   int reference_width = 0, reference_height = 0;
-  for (const MapKeyframe &keyframe : map.keyframes) {
+  for (const MapKeyframe& keyframe : map.keyframes) {
     if (!SameAspect(keyframe.width, keyframe.height, width, height)) continue;
     if (reference_width == 0) {
       reference_width = keyframe.width;
@@ -110,19 +111,35 @@ Result<QueryCamera> ResolveQueryCamera(const LocalizationMap &map, int width, in
   return camera;
 }
 
-Result<Localizer> Localizer::Create(const LocalizationMap *map, const LocalizerOptions &options) {
+Result<Localizer> Localizer::Create(const LocalizationMap* map, const LocalizerOptions& options) {
   if (map == nullptr) return InvalidArgument("Localizer: no map");
   RECONAR_RETURN_IF_ERROR(options.Check());
-  return Localizer(map, options);
+  auto index = std::make_unique<ObservationIndex>();
+  const size_t total = static_cast<size_t>(map->num_observations());
+  index->descriptors.reserve(total * kDescriptorSize);
+  index->point_of.reserve(total);
+  index->keyframe_of.reserve(total);
+  for (size_t f = 0; f < map->keyframes.size(); ++f) {
+    const MapKeyframe& keyframe = map->keyframes[f];
+    index->descriptors.insert(index->descriptors.end(), keyframe.descriptors.begin(), keyframe.descriptors.end());
+    index->point_of.insert(index->point_of.end(), keyframe.point_ids.begin(), keyframe.point_ids.end());
+    index->keyframe_of.insert(index->keyframe_of.end(), keyframe.point_ids.size(), static_cast<int32_t>(f));
+  }
+  KdForestOptions forest_options;
+  forest_options.max_leaf_checks = options.max_leaf_checks;
+  forest_options.leaf_size = options.leaf_size;
+  RECONAR_ASSIGN_OR_RETURN(index->forest, KdForest::Build(index->descriptors.data(),
+                                                          static_cast<int>(index->point_of.size()), forest_options));
+  return Localizer(map, options, std::move(index));
 }
 
-Result<LocalizationResult> Localizer::Localize(const SiftFeatures &features, const QueryCamera &camera) const {
+Result<LocalizationResult> Localizer::Localize(const SiftFeatures& features, const QueryCamera& camera) const {
   const int num_features = static_cast<int>(features.keypoints.size());
   if (features.descriptors.size() != features.keypoints.size() * kDescriptorSize) {
     return InvalidArgument("localize: " + std::to_string(features.descriptors.size()) + " descriptor bytes for " +
                            std::to_string(num_features) + " keypoints");
   }
-  const LocalizationMap &map = *map_;
+  const LocalizationMap& map = *map_;
   LocalizationResult result;
   result.num_features = num_features;
   result.camera_source = camera.source;
@@ -142,7 +159,7 @@ Result<LocalizationResult> Localizer::Localize(const SiftFeatures &features, con
   std::vector<RetrievalCandidate> candidates;
   candidates.reserve(static_cast<size_t>(options_.num_keyframes));
   map.keyframe_index.Query(words.data(), num_features, options_.num_keyframes, &retrieval_scratch, &candidates);
-  for (const RetrievalCandidate &candidate : candidates) {
+  for (const RetrievalCandidate& candidate : candidates) {
     if (candidate.score > 0.0f) result.keyframes.push_back(candidate.image);
   }
   result.seconds_retrieval = SecondsSince(start);
@@ -153,22 +170,10 @@ Result<LocalizationResult> Localizer::Localize(const SiftFeatures &features, con
 
   // 2. 2D-3D matching against the retrieved keyframes' observations.
   start = Clock::now();
-  size_t total = 0;
-  for (int f : result.keyframes) total += static_cast<size_t>(map.keyframes[static_cast<size_t>(f)].num_observations());
-  std::vector<uint8_t> descriptors;
-  std::vector<int32_t> point_of;
-  descriptors.reserve(total * kDescriptorSize);
-  point_of.reserve(total);
-  for (int f : result.keyframes) {
-    const MapKeyframe &keyframe = map.keyframes[static_cast<size_t>(f)];
-    descriptors.insert(descriptors.end(), keyframe.descriptors.begin(), keyframe.descriptors.end());
-    point_of.insert(point_of.end(), keyframe.point_ids.begin(), keyframe.point_ids.end());
-  }
-  KdForestOptions forest_options;
-  forest_options.max_leaf_checks = options_.max_leaf_checks;
-  RECONAR_ASSIGN_OR_RETURN(const KdForest forest,
-                           KdForest::Build(descriptors.data(), static_cast<int>(point_of.size()), forest_options));
-  KdSearchScratch search_scratch(forest);
+  const ObservationIndex& index = *index_;
+  std::vector<char> retrieved(map.keyframes.size(), 0);
+  for (int f : result.keyframes) retrieved[static_cast<size_t>(f)] = 1;
+  KdSearchScratch search_scratch(index.forest);
   // Per map point, the closest query keypoint that passed the ratio test and its distance.
   std::vector<int> best_query(map.points.size(), -1);
   std::vector<int> best_distance(map.points.size(), std::numeric_limits<int>::max());
@@ -176,24 +181,30 @@ Result<LocalizationResult> Localizer::Localize(const SiftFeatures &features, con
   const double ratio_squared = options_.max_ratio * options_.max_ratio;
   for (int q = 0; q < num_features; ++q) {
     int indices[kNeighbours], distances[kNeighbours];
-    const int found = forest.Search(features.descriptor(static_cast<size_t>(q)), kNeighbours, options_.max_leaf_checks,
-                                    indices, distances, &search_scratch);
-    if (found < 2) continue;
-    const int point = point_of[static_cast<size_t>(indices[0])];
-    // The nearest observation of another point; when all found share the point, the farthest found
-    // bounds it from below.
-    int second = distances[found - 1];
-    for (int k = 1; k < found; ++k) {
-      if (point_of[static_cast<size_t>(indices[k])] != point) {
-        second = distances[k];
+    const int found = index.forest.Search(features.descriptor(static_cast<size_t>(q)), kNeighbours,
+                                          options_.max_leaf_checks, indices, distances, &search_scratch);
+    // The nearest observation in a retrieved keyframe; the ratio test compares it with the nearest
+    // observation of any other point (ambiguity does not depend on retrieval), and passes when
+    // every neighbour found is of the same point.
+    int nearest = -1;
+    for (int k = 0; k < found && nearest < 0; ++k) {
+      if (retrieved[static_cast<size_t>(index.keyframe_of[static_cast<size_t>(indices[k])])]) nearest = k;
+    }
+    if (nearest < 0) continue;
+    const int point = index.point_of[static_cast<size_t>(indices[nearest])];
+    const int distance = distances[nearest];
+    int second_distance = std::numeric_limits<int>::max();
+    for (int k = 0; k < found; ++k) {
+      if (index.point_of[static_cast<size_t>(indices[k])] != point) {
+        second_distance = distances[k];
         break;
       }
     }
-    if (!(static_cast<double>(distances[0]) < ratio_squared * static_cast<double>(second))) continue;
-    int &best = best_distance[static_cast<size_t>(point)];
-    if (distances[0] < best) {
+    if (!(static_cast<double>(distance) < ratio_squared * static_cast<double>(second_distance))) continue;
+    int& best = best_distance[static_cast<size_t>(point)];
+    if (distance < best) {
       if (best_query[static_cast<size_t>(point)] < 0) touched.push_back(point);
-      best = distances[0];
+      best = distance;
       best_query[static_cast<size_t>(point)] = q;
     }
   }
@@ -205,7 +216,7 @@ Result<LocalizationResult> Localizer::Localize(const SiftFeatures &features, con
   world.reserve(touched.size());
   for (int point : touched) {
     const int q = best_query[static_cast<size_t>(point)];
-    const SiftKeypoint &keypoint = features.keypoints[static_cast<size_t>(q)];
+    const SiftKeypoint& keypoint = features.keypoints[static_cast<size_t>(q)];
     pixels.emplace_back(keypoint.x, keypoint.y);
     world.push_back(map.points[static_cast<size_t>(point)]);
     match_keypoint.push_back(q);

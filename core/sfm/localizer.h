@@ -4,7 +4,8 @@
 //   1. retrieval: the query's SIFT descriptors are quantised in the map's vocabulary and the
 //      inverted file ranks the keyframes; the best `num_keyframes` are kept;
 //   2. 2D-3D matching: each query descriptor's nearest neighbours among the retrieved keyframes'
-//      observations (a kd-forest built over them), Lowe's ratio test against the nearest
+//      observations (one kd-forest over every observation, built with the localizer, whose
+//      neighbours from other keyframes are skipped), Lowe's ratio test against the nearest
 //      observation of a different map point, then one query per map point (the closest);
 //   3. pose: P3P in LO-RANSAC and robust LM refinement for a known camera, DLT in RANSAC with the
 //      focal refined for an unknown one (core/geometry/absolute_pose.h);
@@ -13,11 +14,13 @@
 //      unrelated scene gives few matches, and RANSAC's best pose among them few inliers in a
 //      small share of them: it is reported as not registered, with the reason.
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/features/kdtree.h"
 #include "core/features/sift/sift.h"
 #include "core/geometry/absolute_pose.h"
 #include "core/math/camera_intrinsics.h"
@@ -29,6 +32,7 @@ struct LocalizerOptions {
   int num_keyframes = 10;     // retrieved keyframes matched against
   double max_ratio = 0.8;     // Lowe's ratio (distances, not squared)
   int max_leaf_checks = 128;  // kd-forest search budget per query descriptor
+  int leaf_size = 4;          // of the kd-forest (KdForestOptions::leaf_size: recall for speed)
   int min_inliers = 30;
   double min_inlier_ratio = 0.25;
   AbsolutePoseOptions pose;  // its min_inliers is replaced by min_inliers
@@ -51,8 +55,8 @@ struct QueryCamera {
 // keyframes' parameters, scaled), unless an EXIF focal of the query disagrees with it by more than
 // the mapper's EXIF trust window (0.7-1.4); else the EXIF focal, else 1.2 max(width, height), as a
 // prior. InvalidArgument when `intrinsics` has another aspect ratio.
-Result<QueryCamera> ResolveQueryCamera(const LocalizationMap &map, int width, int height,
-                                       const std::optional<CameraIntrinsics> &intrinsics, double exif_focal_px);
+Result<QueryCamera> ResolveQueryCamera(const LocalizationMap& map, int width, int height,
+                                       const std::optional<CameraIntrinsics>& intrinsics, double exif_focal_px);
 
 struct LocalizationResult {
   bool registered = false;
@@ -75,19 +79,29 @@ struct LocalizationResult {
 class Localizer {
  public:
   // Borrows the map, which must outlive the localizer. InvalidArgument on bad options.
-  static Result<Localizer> Create(const LocalizationMap *map, const LocalizerOptions &options);
+  static Result<Localizer> Create(const LocalizationMap* map, const LocalizerOptions& options);
 
   // Safe to call from several threads at once. InvalidArgument for inconsistent features; every
   // localisation failure is a result with registered = false and the reason.
-  Result<LocalizationResult> Localize(const SiftFeatures &features, const QueryCamera &camera) const;
+  Result<LocalizationResult> Localize(const SiftFeatures& features, const QueryCamera& camera) const;
 
-  const LocalizationMap &map() const { return *map_; }
-  const LocalizerOptions &options() const { return options_; }
+  const LocalizationMap& map() const { return *map_; }
+  const LocalizerOptions& options() const { return options_; }
 
  private:
-  Localizer(const LocalizationMap *map, const LocalizerOptions &options) : map_(map), options_(options) {}
-  const LocalizationMap *map_;
+  // Every keyframe observation's descriptor in one kd-forest, built once: a query searches it and
+  // keeps only the neighbours of the retrieved keyframes.
+  struct ObservationIndex {
+    std::vector<uint8_t> descriptors;  // 128 bytes per observation, keyframe by keyframe
+    std::vector<int32_t> point_of;
+    std::vector<int32_t> keyframe_of;
+    KdForest forest;  // borrows `descriptors`
+  };
+  Localizer(const LocalizationMap* map, const LocalizerOptions& options, std::unique_ptr<ObservationIndex> index)
+      : map_(map), options_(options), index_(std::move(index)) {}
+  const LocalizationMap* map_;
   LocalizerOptions options_;
+  std::unique_ptr<ObservationIndex> index_;
 };
 
 }  // namespace reconar

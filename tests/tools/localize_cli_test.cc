@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 using testing::Localized;
 using testing::Median;
 
-Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eigen::Vector3d &X) {
+Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera& camera, const Eigen::Vector3d& X) {
   const Eigen::Vector3d x = camera.K * (camera.cam_from_world_rotation * X + camera.cam_from_world_translation);
   return x.head<2>() / x.z();
 }
@@ -38,11 +38,11 @@ Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eige
 // Mean pixel distance between the points projected with the estimated camera (intrinsics,
 // rotation and centre in the ground truth's frame) and with the true one, over the points the
 // true camera sees in its 640 x 480 image.
-double OverlayError(const RadialCamera &camera, const Eigen::Matrix3d &rotation_gt, const Eigen::Vector3d &centre_gt,
-                    const testing::GroundTruthCamera &gt, const std::vector<Eigen::Vector3d> &points_gt, int *count) {
+double OverlayError(const RadialCamera& camera, const Eigen::Matrix3d& rotation_gt, const Eigen::Vector3d& centre_gt,
+                    const testing::GroundTruthCamera& gt, const std::vector<Eigen::Vector3d>& points_gt, int* count) {
   double sum = 0.0;
   *count = 0;
-  for (const Eigen::Vector3d &X : points_gt) {
+  for (const Eigen::Vector3d& X : points_gt) {
     const Eigen::Vector3d in_true = gt.cam_from_world_rotation * X + gt.cam_from_world_translation;
     const Eigen::Vector3d in_estimate = rotation_gt * (X - centre_gt);
     if (in_true.z() <= 0.0 || in_estimate.z() <= 0.0) continue;
@@ -72,11 +72,11 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
 
   // The similarity that aligns the map's own cameras to the ground truth.
   std::map<std::string, testing::GroundTruthCamera> truth_by_name;
-  for (const auto &named : *truth) truth_by_name[named.name] = named.camera;
+  for (const auto& named : *truth) truth_by_name[named.name] = named.camera;
   auto alignment = testing::AlignMapToGroundTruth(*model, truth_by_name);
   ASSERT_TRUE(alignment.ok()) << alignment.status().ToString();
-  const std::set<std::string> &in_map = alignment->in_map;
-  const Sim3 &gt_from_map = alignment->errors.gt_from_estimate;
+  const std::set<std::string>& in_map = alignment->in_map;
+  const Sim3& gt_from_map = alignment->errors.gt_from_estimate;
   std::printf(
       "map: %zu of 24 odd views registered, mean centre error of the "
       "map's cameras %.3f mm\n",
@@ -84,16 +84,16 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
 
   auto parsed = testing::LocalizeWithJson(RECONAR_BINARY, project, even_dir);
   ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
-  const std::map<std::string, Localized> &results = *parsed;
+  const std::map<std::string, Localized>& results = *parsed;
   ASSERT_EQ(results.size(), even.size());
 
   std::vector<Eigen::Vector3d> points_gt;
-  for (const SfmPoint &point : model->points) {
+  for (const SfmPoint& point : model->points) {
     if (!point.deleted) points_gt.push_back(gt_from_map.Apply(point.position));
   }
   // The map's own cameras under the same alignment: what localisation cannot do better than.
   std::vector<double> map_overlay_errors;
-  for (const SfmImage &image : model->images) {
+  for (const SfmImage& image : model->images) {
     if (!image.registered) continue;
     int count = 0;
     map_overlay_errors.push_back(OverlayError(model->cameras[static_cast<size_t>(image.camera_id)],
@@ -105,10 +105,10 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   std::vector<double> centre_errors, rotation_errors, overlay_errors;
   int expected = 0, localized_expected = 0, localized = 0;
   for (size_t i = 1; i < truth->size(); i += 2) {
-    const std::string &name = (*truth)[i].name;
+    const std::string& name = (*truth)[i].name;
     const bool neighbours_in_map = in_map.count((*truth)[i - 1].name) != 0 && in_map.count((*truth)[i + 1].name) != 0;
     expected += neighbours_in_map ? 1 : 0;
-    const Localized &result = results.at(name);
+    const Localized& result = results.at(name);
     if (!result.registered) {
       std::printf("%s: not localised (%s)%s\n", name.c_str(), result.reason.c_str(),
                   neighbours_in_map ? " [both neighbours in the map]" : "");
@@ -117,9 +117,9 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
     ++localized;
     localized_expected += neighbours_in_map ? 1 : 0;
     const testing::CameraPose in_truth = testing::InTruthFrame(gt_from_map, result.R, result.t);
-    const Eigen::Vector3d &centre_gt = in_truth.centre;
-    const Eigen::Matrix3d &rotation_gt = in_truth.cam_from_world_rotation;
-    const testing::GroundTruthCamera &gt = truth_by_name.at(name);
+    const Eigen::Vector3d& centre_gt = in_truth.centre;
+    const Eigen::Matrix3d& rotation_gt = in_truth.cam_from_world_rotation;
+    const testing::GroundTruthCamera& gt = truth_by_name.at(name);
     centre_errors.push_back((centre_gt - gt.Centre()).norm());
     rotation_errors.push_back(testing::RotationAngleDeg(rotation_gt, gt.cam_from_world_rotation));
     RadialCamera camera;

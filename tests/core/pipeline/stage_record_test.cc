@@ -56,5 +56,26 @@ TEST(StageRecord, RecordingAStageDropsTheStagesAfterIt) {
   }
 }
 
+// The map is a side stage: it reads the model and nothing reads it.
+TEST(StageRecord, TheMapIsDroppedWithTheModelButNotWithTheDenseStages) {
+  const Project project(testing::MakeTestDirectory("reconar_stage_record_side"));
+  StageRecord record(project);
+  for (const char* stage : {"features", "matching", "mapping", "map", "dense", "mesh"}) {
+    ASSERT_TRUE(record.Record(stage, "x=1").ok());
+  }
+  ASSERT_TRUE(record.Record("dense", "x=2").ok());
+  EXPECT_TRUE(record.Finished("map", "x=1")) << "the map does not read the dense points";
+  EXPECT_FALSE(record.Finished("mesh", "x=1"));
+  ASSERT_TRUE(record.Record("map", "x=2").ok());
+  EXPECT_TRUE(record.Finished("dense", "x=2")) << "recording the map drops nothing";
+  ASSERT_TRUE(record.Record("mapping", "x=2").ok());
+  EXPECT_FALSE(record.Finished("map", "x=2")) << "a new model needs a new map";
+  ASSERT_TRUE(record.Record("map", "x=3").ok());
+  ASSERT_TRUE(record.Record("features", "x=2").ok());
+  EXPECT_FALSE(StageRecord(project).Finished("map", "x=3"));
+  EXPECT_TRUE(IsSideStage("map"));
+  EXPECT_FALSE(IsSideStage("mapping"));
+}
+
 }  // namespace
 }  // namespace reconar

@@ -204,14 +204,31 @@ std::string BrokenInvariant(const LocalizationMap& map) {
     if (keyframe.keypoints.size() != m || keyframe.descriptors.size() != 128 * m) return "observation arrays";
     if (!(keyframe.camera.focal > 0.0) || !(keyframe.camera.aspect > 0.0)) return "camera";
     if (keyframe.width <= 0 || keyframe.height <= 0) return "image size";
+    for (const char c : keyframe.name) {
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "control character in a name";
+    }
+    if (keyframe.name.empty()) return "empty name";
     const Eigen::Matrix3d& r = keyframe.cam_from_world.rotation;
     if (!((r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-6)) return "rotation";
     for (const int32_t id : keyframe.point_ids) {
       if (id < 0 || static_cast<size_t>(id) >= n) return "point id";
     }
+    // Retrieval with the keyframe's own words: valid images, finite scores.
+    std::vector<int32_t> words;
     for (size_t j = 0; j < keyframe.descriptors.size(); j += 128) {
       const int word = map.vocabulary.Quantize(&keyframe.descriptors[j]);
       if (word < -1 || word >= map.vocabulary.num_words()) return "word out of range";
+      words.push_back(word);
+    }
+    const int num_images = map.keyframe_index.num_images();
+    RetrievalScratch scratch;
+    scratch.Reserve(static_cast<int>(words.size()), num_images);
+    std::vector<RetrievalCandidate> ranked;
+    ranked.reserve(static_cast<size_t>(num_images));
+    map.keyframe_index.Query(words.data(), static_cast<int>(words.size()), num_images, &scratch, &ranked);
+    for (const RetrievalCandidate& candidate : ranked) {
+      if (candidate.image < 0 || candidate.image >= num_images) return "retrieved image out of range";
+      if (!std::isfinite(candidate.score)) return "retrieval score not finite";
     }
   }
   return "";
@@ -222,6 +239,10 @@ std::string RefusalKind(const std::string& message) {
   std::string kind = message.substr(std::min(message.size(), sizeof(kWhat) + 1));
   const size_t at_byte = kind.find(" at byte");
   if (at_byte != std::string::npos) kind.resize(at_byte);
+  // "keyframe N (NAME): reason": the name may hold anything but control characters.
+  const size_t name_begin = kind.rfind("keyframe ", 0) == 0 ? kind.find(" (") : std::string::npos;
+  const size_t name_end = name_begin == std::string::npos ? name_begin : kind.find("): ", name_begin);
+  if (name_end != std::string::npos) kind.erase(name_begin, name_end + 1 - name_begin);
   std::string out;
   int depth = 0;
   for (const char c : kind) {
