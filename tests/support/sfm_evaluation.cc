@@ -21,7 +21,8 @@ double Median(std::vector<double> values) {
 
 // atan2(|sin|, cos) from the skew and symmetric parts: accurate for small angles, where
 // acos((trace - 1) / 2) loses half the digits.
-double RotationAngleDeg(const Eigen::Matrix3d& rotation) {
+double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  const Eigen::Matrix3d rotation = a * b.transpose();
   const Eigen::Vector3d axis_sin(rotation(2, 1) - rotation(1, 2), rotation(0, 2) - rotation(2, 0),
                                  rotation(1, 0) - rotation(0, 1));
   return std::atan2(0.5 * axis_sin.norm(), 0.5 * (rotation.trace() - 1.0)) * 180.0 / M_PI;
@@ -58,7 +59,7 @@ Result<CameraPoseErrors> CameraCenterErrors(const std::vector<CameraPose>& estim
     // The estimate's camera in the ground-truth world: cam_from_gt = cam_from_estimate * estimate_from_gt.
     const Eigen::Matrix3d cam_from_gt = estimated[i].cam_from_world_rotation * similarity.rotation.transpose();
     errors.rotation_errors_deg.push_back(
-        RotationAngleDeg(cam_from_gt * ground_truth[i].cam_from_world_rotation.transpose()));
+        RotationAngleDeg(cam_from_gt, ground_truth[i].cam_from_world_rotation));
   }
   errors.centre_mean = Mean(errors.centre_errors);
   errors.centre_median = Median(errors.centre_errors);
@@ -73,7 +74,7 @@ Result<CameraPoseErrors> CameraCenterErrors(const std::vector<CameraPose>& estim
           estimated[i].cam_from_world_rotation * estimated[j].cam_from_world_rotation.transpose();
       const Eigen::Matrix3d true_i_from_j =
           ground_truth[i].cam_from_world_rotation * ground_truth[j].cam_from_world_rotation.transpose();
-      relative_errors.push_back(RotationAngleDeg(estimated_i_from_j * true_i_from_j.transpose()));
+      relative_errors.push_back(RotationAngleDeg(estimated_i_from_j, true_i_from_j));
     }
   }
   errors.relative_rotation_mean_deg = Mean(relative_errors);

@@ -21,8 +21,8 @@ using reconar::AlignSimilarity;
 // The median of `values` (the mean of the middle two for an even count); 0 for none.
 double Median(std::vector<double> values);
 
-// The angle of a rotation matrix, degrees (from its skew and symmetric parts: accurate near 0).
-double RotationAngleDeg(const Eigen::Matrix3d& rotation);
+// The angle of the rotation a * b^T, in degrees.
+double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
 
 // A camera's orientation and position: X_cam = cam_from_world_rotation * (X_world - centre).
 struct CameraPose {

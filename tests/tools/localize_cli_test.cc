@@ -12,12 +12,13 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
-#include "core/sfm/model_io.h"
+#include "core/base/json_reader.h"
 #include "tests/support/ground_truth.h"
-#include "tests/support/localize_json.h"
+#include "tests/support/localization_evaluation.h"
 #include "tests/support/run_command.h"
 #include "tests/support/sfm_evaluation.h"
 
@@ -26,16 +27,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using testing::CommandRun;
 using testing::LocalizedPhoto;
 using testing::Median;
-using testing::RunReconar;
 
-double RotationAngleDeg(const Eigen::Matrix3d &a, const Eigen::Matrix3d &b) {
-  return testing::RotationAngleDeg(a * b.transpose());
-}
-
-Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eigen::Vector3d &X) {
+Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera& camera, const Eigen::Vector3d& X) {
   const Eigen::Vector3d x = camera.K * (camera.cam_from_world_rotation * X + camera.cam_from_world_translation);
   return x.head<2>() / x.z();
 }
@@ -43,11 +38,11 @@ Eigen::Vector2d ProjectTrue(const testing::GroundTruthCamera &camera, const Eige
 // Mean pixel distance between the points projected with the estimated camera (intrinsics,
 // rotation and centre in the ground truth's frame) and with the true one, over the points the
 // true camera sees in its 640 x 480 image.
-double OverlayError(const RadialCamera &camera, const Eigen::Matrix3d &rotation_gt, const Eigen::Vector3d &centre_gt,
-                    const testing::GroundTruthCamera &gt, const std::vector<Eigen::Vector3d> &points_gt, int *count) {
+double OverlayError(const RadialCamera& camera, const Eigen::Matrix3d& rotation_gt, const Eigen::Vector3d& centre_gt,
+                    const testing::GroundTruthCamera& gt, const std::vector<Eigen::Vector3d>& points_gt, int* count) {
   double sum = 0.0;
   *count = 0;
-  for (const Eigen::Vector3d &X : points_gt) {
+  for (const Eigen::Vector3d& X : points_gt) {
     const Eigen::Vector3d in_true = gt.cam_from_world_rotation * X + gt.cam_from_world_translation;
     const Eigen::Vector3d in_estimate = rotation_gt * (X - centre_gt);
     if (in_true.z() <= 0.0 || in_estimate.z() <= 0.0) continue;
@@ -68,51 +63,37 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   for (size_t i = 0; i < truth->size(); ++i) ((i % 2 == 0) ? odd : even).push_back((*truth)[i].name);
   ASSERT_EQ(odd.size(), 24u);
   const fs::path root = testing::MakeTestDirectory("localize_templering");
-  const fs::path odd_dir = testing::LinkFiles(root / "odd", data, odd);
-  const fs::path even_dir = testing::LinkFiles(root / "even", data, even);
+  const fs::path odd_dir = fs::path(testing::LinkFiles((root / "odd").string(), data, odd));
+  const fs::path even_dir = fs::path(testing::LinkFiles((root / "even").string(), data, even));
   const fs::path project = root / "project";
 
-  const CommandRun sfm =
-      RunReconar("sfm " + odd_dir.string() + " " + project.string() + " --fixed-distortion --threads 2");
-  ASSERT_EQ(sfm.exit_code, 0) << sfm.output;
-  ASSERT_TRUE(fs::exists(project / "map" / "map.rmap")) << sfm.output;
-  auto model = ReadColmapTextModel((project / "sparse").string());
+  auto model = testing::BuildMapWithSfm(RECONAR_BINARY, odd_dir, project, "--fixed-distortion --threads 2");
   ASSERT_TRUE(model.ok()) << model.status().ToString();
 
   // The similarity that aligns the map's own cameras to the ground truth.
   std::map<std::string, testing::GroundTruthCamera> truth_by_name;
-  for (const auto &named : *truth) truth_by_name[named.name] = named.camera;
-  std::vector<testing::CameraPose> estimated, reference;
-  std::set<std::string> in_map;
-  for (const SfmImage &image : model->images) {
-    if (!image.registered) continue;
-    in_map.insert(image.name);
-    estimated.push_back({image.cam_from_world.rotation, image.Center()});
-    reference.push_back(testing::PoseOf(truth_by_name.at(image.name)));
-  }
-  auto alignment = testing::CameraCenterErrors(estimated, reference);
+  for (const auto& named : *truth) truth_by_name[named.name] = named.camera;
+  auto alignment = testing::AlignMapToGroundTruth(*model, truth_by_name);
   ASSERT_TRUE(alignment.ok()) << alignment.status().ToString();
-  const Sim3 &gt_from_map = alignment->gt_from_estimate;
+  const std::set<std::string>& in_map = alignment->in_map;
+  const Sim3& gt_from_map = alignment->errors.gt_from_estimate;
   std::printf(
       "map: %zu of 24 odd views registered, mean centre error of the "
       "map's cameras %.3f mm\n",
-      in_map.size(), 1000.0 * alignment->centre_mean);
+      in_map.size(), 1000.0 * alignment->errors.centre_mean);
 
-  const CommandRun localize = RunReconar(
-      "localize " + project.string() + " " + even_dir.string() + " --json --threads 2", testing::StderrMode::kSeparate);
-  ASSERT_EQ(localize.exit_code, 0) << localize.output << localize.error;
-  auto parsed = testing::ParseLocalizeJson(localize.output);
+  auto parsed = testing::LocalizeWithJson(RECONAR_BINARY, project, even_dir);
   ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
-  const std::map<std::string, LocalizedPhoto> &results = *parsed;
-  ASSERT_EQ(results.size(), even.size()) << localize.output;
+  const std::map<std::string, LocalizedPhoto>& results = *parsed;
+  ASSERT_EQ(results.size(), even.size());
 
   std::vector<Eigen::Vector3d> points_gt;
-  for (const SfmPoint &point : model->points) {
+  for (const SfmPoint& point : model->points) {
     if (!point.deleted) points_gt.push_back(gt_from_map.Apply(point.position));
   }
   // The map's own cameras under the same alignment: what localisation cannot do better than.
   std::vector<double> map_overlay_errors;
-  for (const SfmImage &image : model->images) {
+  for (const SfmImage& image : model->images) {
     if (!image.registered) continue;
     int count = 0;
     map_overlay_errors.push_back(OverlayError(model->cameras[static_cast<size_t>(image.camera_id)],
@@ -124,10 +105,10 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   std::vector<double> centre_errors, rotation_errors, overlay_errors;
   int expected = 0, localized_expected = 0, localized = 0;
   for (size_t i = 1; i < truth->size(); i += 2) {
-    const std::string &name = (*truth)[i].name;
+    const std::string& name = (*truth)[i].name;
     const bool neighbours_in_map = in_map.count((*truth)[i - 1].name) != 0 && in_map.count((*truth)[i + 1].name) != 0;
     expected += neighbours_in_map ? 1 : 0;
-    const LocalizedPhoto &result = results.at(name);
+    const LocalizedPhoto& result = results.at(name);
     if (!result.registered) {
       std::printf("%s: not localised (%s)%s\n", name.c_str(), result.reason.c_str(),
                   neighbours_in_map ? " [both neighbours in the map]" : "");
@@ -135,15 +116,15 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
     }
     ++localized;
     localized_expected += neighbours_in_map ? 1 : 0;
-    // The localised camera in the ground truth's frame: X_map = (R_s^T (X_gt - t_s)) / s.
-    const Eigen::Vector3d centre_map = result.Centre();
-    const Eigen::Vector3d centre_gt = gt_from_map.Apply(centre_map);
-    const Eigen::Matrix3d rotation_gt = result.R * gt_from_map.rotation.transpose();
-    const testing::GroundTruthCamera &gt = truth_by_name.at(name);
+    const testing::CameraPose in_truth = testing::InTruthFrame(gt_from_map, result.R, result.t);
+    const Eigen::Vector3d& centre_gt = in_truth.centre;
+    const Eigen::Matrix3d& rotation_gt = in_truth.cam_from_world_rotation;
+    const testing::GroundTruthCamera& gt = truth_by_name.at(name);
     centre_errors.push_back((centre_gt - gt.Centre()).norm());
-    rotation_errors.push_back(RotationAngleDeg(rotation_gt, gt.cam_from_world_rotation));
+    rotation_errors.push_back(testing::RotationAngleDeg(rotation_gt, gt.cam_from_world_rotation));
+    const RadialCamera& camera = result.camera;
     int count = 0;
-    overlay_errors.push_back(OverlayError(result.camera, rotation_gt, centre_gt, gt, points_gt, &count));
+    overlay_errors.push_back(OverlayError(camera, rotation_gt, centre_gt, gt, points_gt, &count));
     std::printf(
         "%s: centre error %.3f mm, rotation %.3f deg, overlay %.2f px "
         "over %d points\n",
@@ -158,7 +139,7 @@ TEST(LocalizeCli, TempleRingEvenViewsAgainstAMapOfTheOddOnes) {
   EXPECT_EQ(localized_expected, expected);
   EXPECT_GT(expected, 0);
   EXPECT_LE(Median(overlay_errors), 2.0);
-  EXPECT_LE(Median(centre_errors), 2.0 * alignment->centre_mean);
+  EXPECT_LE(Median(centre_errors), 2.0 * alignment->errors.centre_mean);
 }
 
 }  // namespace

@@ -44,21 +44,21 @@ constexpr double kMaxCentreErrorM = 0.05;
 constexpr double kMaxRotationErrorDeg = 2.0;
 constexpr double kMaxCornerErrorPx = 5.0;
 
-double MaxOf(const std::vector<double> &values) {
+double MaxOf(const std::vector<double>& values) {
   return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
 }
 
 // Root mean square distance between the fitted points and their targets.
-double FitRms(const Sim3 &to_from, const std::vector<Eigen::Vector3d> &from, const std::vector<Eigen::Vector3d> &to) {
+double FitRms(const Sim3& to_from, const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to) {
   double sum = 0.0;
   for (size_t i = 0; i < from.size(); ++i) sum += (to_from.Apply(from[i]) - to[i]).squaredNorm();
   return from.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(from.size()));
 }
 
-std::string Stem(const std::string &name) { return fs::path(name).stem().string(); }
+std::string Stem(const std::string& name) { return fs::path(name).stem().string(); }
 
 // A command and its wall-clock time.
-testing::CommandRun TimedReconar(const std::string &arguments, const char *what, testing::StderrMode mode) {
+testing::CommandRun TimedReconar(const std::string& arguments, const char* what, testing::StderrMode mode) {
   const auto start = std::chrono::steady_clock::now();
   testing::CommandRun run = testing::RunReconar(arguments, mode);
   std::printf("%s: %.1f s\n", what, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -76,22 +76,22 @@ struct ProjectTags {
   std::map<int, std::array<Eigen::Vector3d, 4>> corners;
 };
 
-Result<ProjectTags> ReadProjectTags(const std::string &path) {
+Result<ProjectTags> ReadProjectTags(const std::string& path) {
   RECONAR_ASSIGN_OR_RETURN(const JsonValue json, ReadJsonFile(path));
-  const JsonValue *metric = json.Find("metric");
-  const JsonValue *world_tag = json.Find("world_tag");
-  const JsonValue *tags = json.Find("tags");
+  const JsonValue* metric = json.Find("metric");
+  const JsonValue* world_tag = json.Find("world_tag");
+  const JsonValue* tags = json.Find("tags");
   if (metric == nullptr || world_tag == nullptr || tags == nullptr || !tags->is_array())
     return CorruptData(path + ": no \"metric\", \"world_tag\" or \"tags\"");
   ProjectTags result;
   result.metric = metric->bool_value();
   result.world_tag = static_cast<int>(world_tag->number());
   for (size_t i = 0; i < tags->size(); ++i) {
-    const JsonValue &tag = (*tags)[i];
-    const JsonValue *corners = tag.Find("corners");
+    const JsonValue& tag = (*tags)[i];
+    const JsonValue* corners = tag.Find("corners");
     if (tag.Find("id") == nullptr || corners == nullptr || corners->size() != 4)
       return CorruptData(path + ": a tag without \"id\" or four \"corners\"");
-    std::array<Eigen::Vector3d, 4> &out = result.corners[static_cast<int>(tag.Find("id")->number())];
+    std::array<Eigen::Vector3d, 4>& out = result.corners[static_cast<int>(tag.Find("id")->number())];
     for (size_t k = 0; k < 4; ++k) {
       if ((*corners)[k].size() != 3) return CorruptData(path + ": a corner without three coordinates");
       for (size_t c = 0; c < 3; ++c) out[k](static_cast<Eigen::Index>(c)) = (*corners)[k][c].number();
@@ -103,7 +103,7 @@ Result<ProjectTags> ReadProjectTags(const std::string &path) {
 TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   const std::string data = std::string(RECONAR_SOURCE_DIR) + "/data/swatbotics_room";
   std::vector<std::string> names;
-  for (const auto &entry : fs::directory_iterator(data)) {
+  for (const auto& entry : fs::directory_iterator(data)) {
     if (entry.path().extension() == ".JPG") names.push_back(entry.path().filename().string());
   }
   std::sort(names.begin(), names.end());
@@ -121,7 +121,7 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   std::map<std::string, std::vector<TagDetection>> original_tags;  // by stem
   std::vector<std::string> painted_paths;
   int tags_painted = 0;
-  for (const std::string &name : query_names) {
+  for (const std::string& name : query_names) {
     const std::string png = (painted_dir / (Stem(name) + ".png")).string();
     auto detections = testing::PaintOutTagsInPhoto(data + "/" + name, png);
     ASSERT_TRUE(detections.ok()) << detections.status().ToString();
@@ -134,7 +134,7 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   redetect.num_threads = 2;
   auto left = DetectAllTagsInPhotos(painted_paths, redetect);
   ASSERT_TRUE(left.ok()) << left.status().ToString();
-  for (const PhotoDetections &photo : *left) EXPECT_EQ(photo.detections.size(), 0u) << photo.image_name;
+  for (const PhotoDetections& photo : *left) EXPECT_EQ(photo.detections.size(), 0u) << photo.image_name;
   std::printf("painted out %d tags in the %zu query photos; re-detection finds none\n", tags_painted,
               query_names.size());
 
@@ -163,9 +163,9 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   auto reference = ReadColmapTextModel((full_project / "sparse").string());
   ASSERT_TRUE(reference.ok()) << reference.status().ToString();
   int in_map = 0, in_reference = 0;
-  for (const SfmImage &image : map_model->images) in_map += image.registered ? 1 : 0;
-  std::map<std::string, const SfmImage *> reference_by_stem;
-  for (const SfmImage &image : reference->images) {
+  for (const SfmImage& image : map_model->images) in_map += image.registered ? 1 : 0;
+  std::map<std::string, const SfmImage*> reference_by_stem;
+  for (const SfmImage& image : reference->images) {
     if (!image.registered) continue;
     ++in_reference;
     reference_by_stem[Stem(image.name)] = &image;
@@ -178,7 +178,7 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   // reference's on all their common tags' corners rather than on the one world tag.
   std::vector<Eigen::Vector3d> map_corners, reference_corners;
   std::vector<double> tag_corner_offsets;
-  for (const auto &[id, corners] : map_tags->corners) {
+  for (const auto& [id, corners] : map_tags->corners) {
     const auto other = full_tags->corners.find(id);
     if (other == full_tags->corners.end()) continue;
     for (size_t k = 0; k < 4; ++k) {
@@ -189,18 +189,18 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   }
   auto fitted = testing::AlignSimilarity(map_corners, reference_corners, 1.0);
   ASSERT_TRUE(fitted.ok()) << fitted.status().ToString();
-  const Sim3 &reference_from_map = *fitted;
+  const Sim3& reference_from_map = *fitted;
   std::vector<double> map_centre_errors, map_rotation_errors, map_fitted_centre_errors, map_fitted_rotation_errors;
-  for (const SfmImage &image : map_model->images) {
+  for (const SfmImage& image : map_model->images) {
     const auto truth = reference_by_stem.find(Stem(image.name));
     if (!image.registered || truth == reference_by_stem.end()) continue;
-    const Eigen::Matrix3d &rotation = image.cam_from_world.rotation;
-    const Eigen::Matrix3d &true_rotation = truth->second->cam_from_world.rotation;
+    const Eigen::Matrix3d& rotation = image.cam_from_world.rotation;
+    const Eigen::Matrix3d& true_rotation = truth->second->cam_from_world.rotation;
     map_centre_errors.push_back((image.Center() - truth->second->Center()).norm());
-    map_rotation_errors.push_back(testing::RotationAngleDeg(rotation * true_rotation.transpose()));
+    map_rotation_errors.push_back(testing::RotationAngleDeg(rotation, true_rotation));
     map_fitted_centre_errors.push_back((reference_from_map.Apply(image.Center()) - truth->second->Center()).norm());
     map_fitted_rotation_errors.push_back(
-        testing::RotationAngleDeg(rotation * reference_from_map.rotation.transpose() * true_rotation.transpose()));
+        testing::RotationAngleDeg(rotation * reference_from_map.rotation.transpose(), true_rotation));
   }
   std::printf(
       "map vs reference frame: the map's %zu cameras differ by median %.1f mm, max %.1f mm, rotation median %.3f "
@@ -226,7 +226,7 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   std::vector<double> centre_errors, rotation_errors, corner_errors, times_ms;
   int localized = 0, scored = 0;
   std::vector<std::string> corners_beyond_bar;
-  for (const auto &[image, result] : *parsed) {
+  for (const auto& [image, result] : *parsed) {
     times_ms.push_back(result.ms);
     if (!result.registered) {
       std::printf("%s: not localised (%s)\n", image.c_str(), result.reason.c_str());
@@ -240,8 +240,7 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
     } else {
       ++scored;
       const double centre_error = (result.Centre() - truth->second->Center()).norm();
-      const double rotation_error =
-          testing::RotationAngleDeg(result.R * truth->second->cam_from_world.rotation.transpose());
+      const double rotation_error = testing::RotationAngleDeg(result.R, truth->second->cam_from_world.rotation);
       centre_errors.push_back(centre_error);
       rotation_errors.push_back(rotation_error);
       std::printf(
@@ -249,8 +248,8 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
           "%.1f mm, %.3f deg)\n",
           image.c_str(), result.inliers, result.ms, 1000.0 * centre_error, rotation_error,
           1000.0 * (reference_from_map.Apply(result.Centre()) - truth->second->Center()).norm(),
-          testing::RotationAngleDeg(result.R * reference_from_map.rotation.transpose() *
-                                    truth->second->cam_from_world.rotation.transpose()));
+          testing::RotationAngleDeg(result.R * reference_from_map.rotation.transpose(),
+                                    truth->second->cam_from_world.rotation));
       // Issue 15's bar (5 cm, 2 degrees of the reference) is printed, not asserted, until the map
       // itself meets it: from 36 photos structure from motion registers 12, whose own cameras are
       // 6-17 cm from the 72-photo reference while their tags agree within millimetres (printed
@@ -264,8 +263,8 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
     double worst = 0.0;
     int corners = 0;
     std::map<int, int> seen;
-    for (const TagDetection &tag : original_tags.at(Stem(image))) ++seen[tag.id];
-    for (const TagDetection &tag : original_tags.at(Stem(image))) {
+    for (const TagDetection& tag : original_tags.at(Stem(image))) ++seen[tag.id];
+    for (const TagDetection& tag : original_tags.at(Stem(image))) {
       const auto world = map_tags->corners.find(tag.id);
       if (seen[tag.id] != 1 || world == map_tags->corners.end()) continue;
       for (size_t k = 0; k < 4; ++k) {
@@ -288,7 +287,7 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   std::printf("AR: %zu tag corners; median distance %.2f px, max %.2f px; %zu photo(s) beyond %.0f px\n",
               corner_errors.size(), testing::Median(corner_errors), MaxOf(corner_errors), corners_beyond_bar.size(),
               kMaxCornerErrorPx);
-  for (const std::string &image : corners_beyond_bar) ADD_FAILURE() << image << ": a tag corner beyond 5 px";
+  for (const std::string& image : corners_beyond_bar) ADD_FAILURE() << image << ": a tag corner beyond 5 px";
   EXPECT_GE(localized, 1);
 
   // A wrong scene: none of fountain-P11's photos may register against the room's map.
@@ -300,7 +299,7 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
   auto wrong = testing::ParseLocalizeJson(fountain.output);
   ASSERT_TRUE(wrong.ok()) << wrong.status().ToString();
   ASSERT_EQ(wrong->size(), 11u) << fountain.output;
-  for (const auto &[image, result] : *wrong) {
+  for (const auto& [image, result] : *wrong) {
     std::printf("fountain %s: %s (%s)\n", image.c_str(), result.registered ? "REGISTERED" : "not registered",
                 result.reason.c_str());
     EXPECT_FALSE(result.registered) << image << ": a fountain photo registered against the room's map";
