@@ -131,4 +131,19 @@ int Fail(const Status& status) {
   return ExitCodeFor(status);
 }
 
+std::optional<int> ParseCommand(Args* args, int argc, char** argv, int first, const char* help,
+                                size_t min_positionals, size_t max_positionals) {
+  if (Status s = args->Parse(argc, argv, first); !s.ok()) return Fail(s);
+  if (args->Has("help")) {
+    std::fputs(help, stdout);
+    return 0;
+  }
+  const size_t count = args->positionals().size();
+  if (count < min_positionals || count > max_positionals) {
+    std::fputs(help, stderr);
+    return 2;
+  }
+  return std::nullopt;
+}
+
 }  // namespace reconar::tools

@@ -9,6 +9,7 @@
 //   --json                 the command's result as JSON on stdout instead of its summary
 //   --help, -h             the command's usage on stdout
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -49,5 +50,11 @@ std::string LowercaseExtension(const std::string& path);
 // Exit codes (DESIGN.md): 0 ok, 1 failed run, 2 bad usage or input.
 int ExitCodeFor(const Status& status);
 int Fail(const Status& status);  // prints "reconar: error: ..." and returns the exit code
+
+// The start of every command: parses; with --help prints `help` on stdout (exit code 0); with a
+// parse error or a positional count outside [min_positionals, max_positionals] prints the error
+// or `help` on stderr (exit code 2). Returns the exit code to stop with, or nullopt to go on.
+std::optional<int> ParseCommand(Args* args, int argc, char** argv, int first, const char* help,
+                                size_t min_positionals, size_t max_positionals);
 
 }  // namespace reconar::tools

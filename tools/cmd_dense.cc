@@ -66,15 +66,7 @@ void PrintSummary(const DenseStageReport& r) {
 
 int RunDense(int argc, char** argv, int first) {
   Args args({"level", "max-cluster-size", "threads", "memory-budget"}, {"json", "keep-outliers"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().size() != 1) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 1, 1)) return *exit_code;
   const Project project(args.positionals()[0]);
   if (!IsDirectory(project.root())) {
     return Fail(NotFound(project.root() + ": no such project directory (make one with `reconar sfm`)"));

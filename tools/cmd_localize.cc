@@ -1,5 +1,6 @@
 // reconar localize PROJECT IMAGE|DIR...: the pose of each photo against the project's localisation
 // map.
+#include <cstdint>
 #include <cstdio>
 
 #include "core/pipeline/localize_photos.h"
@@ -43,15 +44,7 @@ constexpr char kHelp[] =
 
 int RunLocalize(int argc, char** argv, int first) {
   Args args({"intrinsics", "threads"}, {"json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().size() < 2) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, SIZE_MAX)) return *exit_code;
   LocalizePhotosOptions options;
   if (args.Has("intrinsics")) {
     auto intrinsics = IntrinsicsFromArg(args.Get("intrinsics"));

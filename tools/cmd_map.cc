@@ -31,15 +31,7 @@ constexpr char kHelp[] =
 
 int RunMap(int argc, char** argv, int first) {
   Args args({"threads"}, {"json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().size() != 1) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 1, 1)) return *exit_code;
   auto threads = args.GetThreads();
   if (!threads.ok()) return Fail(threads.status());
   const Project project(args.positionals()[0]);
