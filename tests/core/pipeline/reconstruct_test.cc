@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/base/atomic_file.h"
+#include "core/sfm/localization_map.h"
 #include "tests/support/run_command.h"
 
 namespace reconar {
@@ -69,7 +70,7 @@ TEST(RunReconstruct, ASecondRunReusesEveryStageAndAChangedSettingRedoesTheStages
   };
   auto first = RunReconstruct(TemplePhotos(), project, options);
   ASSERT_TRUE(first.ok()) << first.status().ToString();
-  const std::map<std::string, bool> all_run = {{"features", false}, {"matching", false}, {"mapping", false}};
+  const std::map<std::string, bool> all_run = {{"features", false}, {"matching", false}, {"mapping", false}, {"map", false}};
   EXPECT_EQ(Reused(*first), all_run);
   EXPECT_GE(first->table1.registered, 2) << "of 4 photos";
   EXPECT_EQ(first->table1.images, 4);
@@ -82,15 +83,16 @@ TEST(RunReconstruct, ASecondRunReusesEveryStageAndAChangedSettingRedoesTheStages
 
   auto second = RunReconstruct(TemplePhotos(), project, options);
   ASSERT_TRUE(second.ok()) << second.status().ToString();
-  const std::map<std::string, bool> all_reused = {{"features", true}, {"matching", true}, {"mapping", true}};
+  const std::map<std::string, bool> all_reused = {{"features", true}, {"matching", true}, {"mapping", true}, {"map", true}};
   EXPECT_EQ(Reused(*second), all_reused);
   EXPECT_EQ(second->table1.registered, first->table1.registered) << "Table 1 of the reused model";
   EXPECT_EQ(Contents(project.SparseDir() + "/points3D.txt"), model);
+  EXPECT_TRUE(ReadLocalizationMap(project.MapPath()).ok()) << "the sparse stages end with the localisation map";
 
   options.matching.two_view.min_inliers = 31;
   auto third = RunReconstruct(TemplePhotos(), project, options);
   ASSERT_TRUE(third.ok()) << third.status().ToString();
-  const std::map<std::string, bool> from_matching = {{"features", true}, {"matching", false}, {"mapping", false}};
+  const std::map<std::string, bool> from_matching = {{"features", true}, {"matching", false}, {"mapping", false}, {"map", false}};
   EXPECT_EQ(Reused(*third), from_matching);
   const std::string third_model = Contents(project.SparseDir() + "/points3D.txt");
 
