@@ -24,8 +24,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/base/prng.h"
 #include "core/base/status.h"
-#include "core/geometry/prng.h"
 #include "core/geometry/ransac_options.h"
 
 namespace reconar {

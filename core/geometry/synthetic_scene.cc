@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
-#include "core/geometry/prng.h"
+#include "core/base/prng.h"
 #include "core/geometry/residuals.h"
 
 namespace reconar {

@@ -9,8 +9,8 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include "core/base/prng.h"
 #include "core/geometry/absolute_pose.h"
-#include "core/geometry/prng.h"
 
 namespace reconar {
 namespace {

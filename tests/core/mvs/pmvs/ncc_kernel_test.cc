@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "core/geometry/prng.h"
+#include "core/base/prng.h"
 
 namespace reconar {
 namespace {
