@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/base/arena.h"
+#include "core/base/elapsed.h"
 #include "core/base/thread_pool.h"
 
 namespace reconar {
@@ -74,10 +75,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 // Returns the forest to search (nullptr: brute force). Adds its build time to the report.
 using ForestProvider = std::function<Result<const KdForest*>(MatchReport*)>;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 Status CheckInput(const char* name, const uint8_t* descriptors, int count) {
   if (count < 0) return InvalidArgument(std::string("matching: negative descriptor count for ") + name);

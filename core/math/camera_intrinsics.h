@@ -69,12 +69,19 @@ inline CameraIntrinsics ScaledIntrinsics(const CameraIntrinsics& intrinsics, int
   return scaled;
 }
 
+// Whether images of width_a x height_a and width_b x height_b have the same aspect ratio, within 1 %
+// (false when the first size is not positive).
+inline bool SameAspectRatio(int width_a, int height_a, int width_b, int height_b) {
+  return width_a > 0 && height_a > 0 &&
+         std::abs(static_cast<double>(width_a) * height_b - static_cast<double>(height_a) * width_b) <=
+             0.01 * static_cast<double>(width_a) * height_b;
+}
+
 // ScaledIntrinsics for video or photos of another size with the same aspect ratio (a phone's
 // video mode); InvalidArgument when the aspect ratios differ by more than 1 %.
 inline Result<CameraIntrinsics> ScaleIntrinsicsToFrame(const CameraIntrinsics& photo, int width, int height) {
   if (photo.width == width && photo.height == height) return photo;
-  if (photo.width <= 0 || std::abs(static_cast<double>(photo.width) * height -
-                                   static_cast<double>(photo.height) * width) > 0.01 * photo.width * height) {
+  if (!SameAspectRatio(photo.width, photo.height, width, height)) {
     return InvalidArgument("the project's photos are " + std::to_string(photo.width) + "x" +
                            std::to_string(photo.height) + ", the images " + std::to_string(width) + "x" +
                            std::to_string(height) + ": pass --intrinsics for this camera");

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "core/base/elapsed.h"
 #include "core/base/json_writer.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
@@ -16,13 +17,6 @@ namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-std::string FileName(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
 
 }  // namespace
 
@@ -51,7 +45,7 @@ Result<std::vector<PhotoLocalization>> LocalizePhotos(const LocalizationMap& map
     const auto start = Clock::now();
     PhotoLocalization& photo = photos[i];
     photo.path = paths[i];
-    photo.image = FileName(paths[i]);
+    photo.image = std::filesystem::path(paths[i]).filename().string();
     auto decoded = ReadImage(paths[i]);
     if (!decoded.ok()) {
       photo.error = decoded.status().message();

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "core/base/atomic_file.h"
+#include "core/base/elapsed.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/features/sift/sift_io.h"
@@ -18,10 +19,6 @@ namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Each point takes the colour of the pixel under its first observation.
 Status ColourPoints(const std::vector<ProjectImage>& list, int num_threads, Reconstruction* rec) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/base/elapsed.h"
 #include "core/base/thread_pool.h"
 #include "core/features/descriptor_distance.h"
 
@@ -12,8 +13,6 @@ namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 struct ObservationRef {
   int32_t keyframe;

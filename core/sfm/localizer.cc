@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/base/elapsed.h"
 #include "core/features/descriptor_distance.h"
 #include "core/features/kdtree.h"
 #include "core/sfm/mapper.h"
@@ -14,18 +15,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
 double Median(std::vector<double> values) {
   const size_t middle = values.size() / 2;
   std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle), values.end());
   return values[middle];
-}
-
-bool SameAspect(int width_a, int height_a, int width_b, int height_b) {
-  return width_a > 0 && height_a > 0 &&
-         std::abs(static_cast<double>(width_a) * height_b - static_cast<double>(height_a) * width_b) <=
-             0.01 * static_cast<double>(width_a) * height_b;
 }
 
 // Neighbours searched per query descriptor, among which the nearest of a retrieved keyframe and
@@ -68,17 +61,24 @@ Result<QueryCamera> ResolveQueryCamera(const LocalizationMap& map, int width, in
   std::vector<double> focal, aspect, cx, cy, k1, k2;
   int reference_width = 0, reference_height = 0;
   for (const MapKeyframe& keyframe : map.keyframes) {
-    if (!SameAspect(keyframe.width, keyframe.height, width, height)) continue;
+    if (!SameAspectRatio(keyframe.width, keyframe.height, width, height)) continue;
     if (reference_width == 0) {
       reference_width = keyframe.width;
       reference_height = keyframe.height;
     }
     // Keyframes of another resolution with this aspect ratio are brought to the first's size.
-    const double s = static_cast<double>(reference_width) / keyframe.width;
-    focal.push_back(keyframe.camera.focal * s);
+    CameraIntrinsics own;
+    own.width = keyframe.width;
+    own.height = keyframe.height;
+    own.fx = keyframe.camera.focal;
+    own.fy = keyframe.camera.fy();
+    own.cx = keyframe.camera.cx;
+    own.cy = keyframe.camera.cy;
+    const CameraIntrinsics at_reference = ScaledIntrinsics(own, reference_width, reference_height);
+    focal.push_back(at_reference.fx);
     aspect.push_back(keyframe.camera.aspect);
-    cx.push_back((keyframe.camera.cx + 0.5) * s - 0.5);
-    cy.push_back((keyframe.camera.cy + 0.5) * s - 0.5);
+    cx.push_back(at_reference.cx);
+    cy.push_back(at_reference.cy);
     k1.push_back(keyframe.camera.k1);
     k2.push_back(keyframe.camera.k2);
   }

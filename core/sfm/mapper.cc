@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "core/base/elapsed.h"
 #include "core/sfm/image_registration.h"
 #include "core/sfm/initial_pair.h"
 #include "core/sfm/intrinsics_selection.h"
@@ -17,8 +18,6 @@ namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // The orchestration: setup, the initial pair, the growth loop (next image, registration,
 // triangulation, local or global adjustment, filtering), the global refinements and the report.

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <string>
 
+#include "core/base/elapsed.h"
 #include "core/features/sift/kernels.h"
 
 namespace reconar {
@@ -27,10 +28,6 @@ constexpr float kDescriptorQuantisation = 512.0f;
 constexpr float kTwoPi = 2.0f * sift_internal::kPi;
 
 using Clock = std::chrono::steady_clock;
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 int Reflect101(int i, int n) {
   if (n == 1) return 0;
   while (i < 0 || i >= n) {

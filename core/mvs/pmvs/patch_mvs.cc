@@ -7,6 +7,7 @@
 #include <numeric>
 #include <string>
 
+#include "core/base/elapsed.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/mvs/pmvs/image_features.h"
@@ -19,10 +20,6 @@
 
 namespace reconar {
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 Status CheckViews(const std::vector<const DenseView*>& views, int min_views) {
   if (static_cast<int>(views.size()) < min_views) {
