@@ -1,0 +1,174 @@
+// MapTracker on a real photo turned into a video with exact ground truth (rotation_video.h): a
+// camera rotating about its centre over Strecha fountain-P11's photo 0005, a jump to an unrelated
+// photo (castle-P19) and back. Checks the poses against the truth and the state sequence:
+// tracking; relocalising, then lost, on the unrelated photo; relocalised and tracking on return.
+#include "tracker/map_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "tests/tracker/rotation_video.h"
+
+namespace reconar {
+namespace {
+
+struct PoseError {
+  double rotation_deg = 0.0;
+  double centre = 0.0;
+};
+
+PoseError Compare(const Rigid3& estimate, const Rigid3& truth) {
+  PoseError error;
+  error.rotation_deg =
+      Eigen::AngleAxisd(Eigen::Matrix3d(estimate.rotation * truth.rotation.transpose())).angle() * 180.0 / M_PI;
+  error.centre = (CameraCenterInWorld(estimate) - CameraCenterInWorld(truth)).norm();
+  return error;
+}
+
+// The sweep's rotation at step i (degrees: yaw -5 .. +10, a little pitch and roll).
+Eigen::Matrix3d Sweep(int i) {
+  return testing::YawPitchRoll(-5.0 + 0.3 * i, 1.5 * std::sin(i / 8.0), 1.0 * std::sin(i / 13.0));
+}
+
+class MapTrackerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const std::string data = RECONAR_SHARED_DATA_DIR;
+    auto scene = testing::MakeRotationScene(data + "/strecha_fountain-P11/images/0005.jpg", 4, 640, 480);
+    ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+    scene_ = new testing::RotationScene(std::move(*scene));
+    auto other = testing::MakeRotationScene(data + "/strecha_castle-P19/images/0000.jpg", 4, 640, 480);
+    ASSERT_TRUE(other.ok()) << other.status().ToString();
+    unrelated_ = new Image<uint8_t>(testing::RenderRotatedView(*other, Eigen::Matrix3d::Identity()));
+    auto map = testing::BuildRotationSceneMap(
+        *scene_, {testing::YawPitchRoll(-4, 0, 0), testing::YawPitchRoll(0, 0, 0), testing::YawPitchRoll(4, 0, 0)});
+    ASSERT_TRUE(map.ok()) << map.status().ToString();
+    map_ = new LocalizationMap(std::move(*map));
+  }
+  static void TearDownTestSuite() {
+    delete scene_;
+    delete unrelated_;
+    delete map_;
+  }
+
+  static MapTrackerOptions Options() {
+    MapTrackerOptions options;
+    options.intrinsics = scene_->frame_camera;
+    options.lost_after_frames = 4;
+    options.lost_relocalise_interval = 2;
+    return options;
+  }
+
+  static testing::RotationScene* scene_;
+  static Image<uint8_t>* unrelated_;
+  static LocalizationMap* map_;
+};
+
+testing::RotationScene* MapTrackerTest::scene_ = nullptr;
+Image<uint8_t>* MapTrackerTest::unrelated_ = nullptr;
+LocalizationMap* MapTrackerTest::map_ = nullptr;
+
+TEST_F(MapTrackerTest, FollowsARotatingCameraLosesItOnAnUnrelatedViewAndRelocalisesOnReturn) {
+  auto tracker = MapTracker::Create(map_, Options());
+  ASSERT_TRUE(tracker.ok()) << tracker.status().ToString();
+  MapTrackerFrameReport report;
+  std::vector<double> rotation_errors, centre_errors, track_ms;
+  std::string states;
+  int relocalisations = 0, tracked_frames = 0;
+  // 0..39 the sweep, 40..49 the unrelated photo, 50..69 the sweep again from where it was.
+  for (int frame = 0; frame < 70; ++frame) {
+    const bool away = frame >= 40 && frame < 50;
+    const int step = frame < 40 ? frame : frame - 10;
+    const Image<uint8_t> image = away ? *unrelated_ : testing::RenderRotatedView(*scene_, Sweep(step));
+    ASSERT_TRUE((*tracker)->Track(image.view(), nullptr, &report).ok());
+    EXPECT_EQ(report.frame_index, frame);
+    states += MapTrackingStateName(report.state)[0];
+    if (away) {
+      EXPECT_FALSE(report.found) << "frame " << frame;  // never a pose on an unrelated view
+      continue;
+    }
+    if (!report.found) continue;
+    relocalisations += report.relocalised;
+    const PoseError error = Compare(report.cam_from_world, testing::RotatedViewPose(*scene_, Sweep(step)));
+    rotation_errors.push_back(error.rotation_deg);
+    centre_errors.push_back(error.centre);
+    EXPECT_LT(error.rotation_deg, 0.05) << "frame " << frame;
+    EXPECT_LT(error.centre, 0.005) << "frame " << frame;
+    EXPECT_EQ(report.inlier_pixels.size(), static_cast<size_t>(report.inliers));
+    EXPECT_EQ(report.inlier_world_points.size(), static_cast<size_t>(report.inliers));
+    if (!report.relocalised) {
+      ++tracked_frames;
+      track_ms.push_back(report.track_ms);
+    }
+  }
+  std::sort(rotation_errors.begin(), rotation_errors.end());
+  std::sort(centre_errors.begin(), centre_errors.end());
+  std::sort(track_ms.begin(), track_ms.end());
+  ASSERT_FALSE(rotation_errors.empty());
+  ASSERT_FALSE(track_ms.empty());
+  std::printf("states: %s\n", states.c_str());
+  std::printf(
+      "posed %zu of 60 frames on the scene (%d tracked, %d relocalised); rotation error median %.4f max %.4f deg; "
+      "centre error median %.5f max %.5f (depths 2-4); tracked frame median %.2f ms\n",
+      rotation_errors.size(), tracked_frames, relocalisations, rotation_errors[rotation_errors.size() / 2],
+      rotation_errors.back(), centre_errors[centre_errors.size() / 2], centre_errors.back(),
+      track_ms[track_ms.size() / 2]);
+  // The state sequence: relocalised at once, tracked through the sweep; on the unrelated photo
+  // relocalising for lost_after_frames - 1 frames, then lost; back on the scene, relocalised within
+  // lost_relocalise_interval frames and tracked again.
+  EXPECT_EQ(states.substr(0, 40), std::string(40, 't'));
+  EXPECT_EQ(states.substr(40, 10), "rrrlllllll");
+  EXPECT_TRUE(states.substr(50, 2) == "tt" || states.substr(50, 2) == "lt") << states.substr(50, 2);
+  EXPECT_EQ(states.substr(52), std::string(18, 't'));
+  EXPECT_EQ(relocalisations, 2);
+  EXPECT_GE(static_cast<int>(rotation_errors.size()), 59);
+}
+
+TEST_F(MapTrackerTest, APriorRestartsTrackingWithoutRelocalisation) {
+  auto tracker = MapTracker::Create(map_, Options());
+  ASSERT_TRUE(tracker.ok()) << tracker.status().ToString();
+  MapTrackerFrameReport report;
+  // First frame with a prior: tracking starts from the prior's projection of the map (no pose yet).
+  const Rigid3 prior = testing::RotatedViewPose(*scene_, Sweep(0));
+  ASSERT_TRUE((*tracker)->Track(testing::RenderRotatedView(*scene_, Sweep(0)).view(), &prior, &report).ok());
+  EXPECT_TRUE(report.from_prior);
+  EXPECT_FALSE(report.found);
+  EXPECT_FALSE(report.relocalisation_tried);
+  EXPECT_GT(report.seeded_points, 100);
+  for (int step = 1; step < 12; ++step) {
+    ASSERT_TRUE((*tracker)->Track(testing::RenderRotatedView(*scene_, Sweep(step)).view(), nullptr, &report).ok());
+    EXPECT_TRUE(report.found) << step;
+    EXPECT_FALSE(report.relocalised) << step;
+    EXPECT_FALSE(report.relocalisation_tried) << step;
+    EXPECT_EQ(report.state, MapTrackingState::kTracking);
+    const PoseError error = Compare(report.cam_from_world, testing::RotatedViewPose(*scene_, Sweep(step)));
+    EXPECT_LT(error.rotation_deg, 0.05) << step;
+    EXPECT_LT(error.centre, 0.005) << step;
+  }
+}
+
+TEST_F(MapTrackerTest, RejectsBadOptionsAndInputs) {
+  MapTrackerOptions options = Options();
+  options.intrinsics.fx = 0.0;
+  EXPECT_FALSE(MapTracker::Create(map_, options).ok());
+  options = Options();
+  options.min_inliers = options.max_tracked_points + 1;
+  EXPECT_FALSE(MapTracker::Create(map_, options).ok());
+  EXPECT_FALSE(MapTracker::Create(nullptr, Options()).ok());
+  auto tracker = MapTracker::Create(map_, Options());
+  ASSERT_TRUE(tracker.ok());
+  MapTrackerFrameReport report;
+  EXPECT_FALSE((*tracker)->Track(ImageView<const uint8_t>(), nullptr, &report).ok());
+  // A frame of another aspect ratio than the intrinsics.
+  Image<uint8_t> square(300, 300);
+  EXPECT_FALSE((*tracker)->Track(square.view(), nullptr, &report).ok());
+  EXPECT_STREQ(MapTrackingStateName(MapTrackingState::kRelocalising), "relocalising");
+}
+
+}  // namespace
+}  // namespace reconar

@@ -1,0 +1,180 @@
+#pragma once
+// MapTracker: the pose of every video frame against a localisation map (core/sfm/localization_map.h),
+// by frame-to-frame tracking of map points between relocalisations (core/sfm/localizer.h).
+//
+// Per frame while tracking (the steady state):
+//  1. predict the pose: the prior when the caller gives one (the tags' pose), else constant
+//     velocity on the last two poses (the last pose when only one is known);
+//  2. guided matching: every followed map point is tracked from its pixel in the previous frame
+//     by pyramidal Lucas-Kanade (core/features/optical_flow.h), the search seeded at the point's
+//     projection under the predicted pose, so the window only has to absorb the prediction's error;
+//  3. pose: robust LM refinement (core/geometry/absolute_pose.h, Cauchy loss) of the predicted pose
+//     on all tracked points, the inliers (error < max_error_px) kept, a second refinement on them
+//     alone; the pose counts when it has min_inliers inliers that are min_inlier_ratio of the
+//     tracked points. A failed gate tries P3P LO-RANSAC on the same correspondences before giving up
+//     (a frame on that path may allocate);
+//  4. new points: when fewer than replenish_fraction of max_tracked_points are followed, the map
+//     points the posed camera should see (in front of it, inside the frame, seen by the map's
+//     keyframes from within max_view_angle_deg of this view direction) are projected with the
+//     frame's pose and followed from their projection on, at most one per grid_cell_px cell. Their
+//     first measurement is the next frame's flow: a projection landing on the wrong texture (an
+//     occluded point, a point the pose puts a pixel off) is dropped there by the flow's texture
+//     and error checks or by the pose's inlier gate.
+// Why this design: descriptor matching per frame needs SIFT per frame (tens of milliseconds on a
+// 640x480 frame, and allocation); the map holds no keyframe images to cache patches from. Flow
+// from the previous frame is cheap (a 13x13 window, a few levels), accurate to a few hundredths of
+// a pixel, and robust to the slow appearance change of a video; the map's 3D points keep the pose
+// from drifting as long as points measured at relocalisation stay in view, and the inlier gate
+// keeps points whose track slides off their feature out of the pose.
+// Limits: followed points that are all born from projections inherit the pose error of the frame
+// that seeded them (a slow drift of the order of that error, corrected at the next
+// relocalisation); texture-poor views give too few windows with texture in two directions (the
+// frame is lost, not misposed); on repeated structure a poor prediction can let flow lock onto the
+// next repetition: the inlier gate rejects it when few points do, the relocalisation's ratio test
+// when the whole view repeats.
+//
+// States: kTracking (this or the last frame had a pose), kRelocalising (the last pose is fewer than
+// lost_after_frames frames old: every frame is relocalised), kLost (older: relocalisation every
+// lost_relocalise_interval frames). A frame without tracks or whose tracking fails is relocalised
+// in the same frame (SIFT on the frame, Localizer::Localize with the known camera), unless a prior
+// is given: tracking then restarts from the prior's projection of the map (no pose for that frame).
+//
+// Memory: every per-frame buffer (tracks, flow results, correspondences, the report's inlier lists)
+// has capacity max_tracked_points, reserved at Create; the image pyramids, the seeding grid and the
+// relocalisation buffers are sized by the first frame of a size. Tracked frames make no heap
+// allocation after that (tests/tracker/map_tracker_allocation_test.cc); relocalisation frames and
+// the RANSAC fallback do.
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/base/status.h"
+#include "core/features/optical_flow.h"
+#include "core/features/sift/sift.h"
+#include "core/math/camera_intrinsics.h"
+#include "core/math/rigid3.h"
+#include "core/sfm/localization_map.h"
+#include "core/sfm/localizer.h"
+
+namespace reconar {
+
+enum class MapTrackingState { kTracking, kRelocalising, kLost };
+const char* MapTrackingStateName(MapTrackingState state);  // "tracking", "relocalising", "lost"
+
+struct MapTrackerOptions {
+  CameraIntrinsics intrinsics;   // of the video frames (valid() required); scaled to the frame size
+  LocalizerOptions localizer;    // relocalisation
+  SiftOptions sift;              // for relocalisation frames (its arena is sized for the frame)
+  int max_tracked_points = 300;  // capacity of every per-frame buffer
+  int lost_after_frames = 10;    // consecutive frames without a pose before kRelocalising becomes kLost
+
+  OpticalFlowOptions flow;           // window radius, pyramid levels, texture and error checks
+  double max_error_px = 3.0;         // inlier threshold of the tracked pose
+  int min_inliers = 20;              // a tracked pose needs this many inliers
+  double min_inlier_ratio = 0.5;     // ... that are at least this share of the tracked points
+  double loss_scale_px = 2.0;        // Cauchy scale of the first refinement
+  int lost_relocalise_interval = 5;  // while kLost, relocalise every this many frames (1: every frame)
+  double replenish_fraction = 0.8;   // seed new points when fewer than this share of the capacity are followed
+  int grid_cell_px = 16;             // at most one followed point per cell of this size
+  double max_view_angle_deg = 60.0;  // seed a point only when seen from within this angle of its keyframes
+  int border_px = 8;                 // seed a point only this far inside the frame
+
+  // InvalidArgument naming the first offending field.
+  Status Check() const;
+};
+
+struct MapTrackerFrameReport {
+  int64_t frame_index = -1;
+  MapTrackingState state = MapTrackingState::kLost;
+  bool found = false;        // cam_from_world valid for this frame
+  bool relocalised = false;  // this frame's pose came from relocalisation (not frame-to-frame)
+  Rigid3 cam_from_world;
+  int inliers = 0;
+  double rms_reprojection_px = 0.0;
+  double track_ms = 0.0;
+  // The inliers of this frame's pose: pixel (frame pixels, centre of the top-left pixel at (0,0)) and
+  // its map point in the world frame. Capacity reserved once (max_tracked_points).
+  std::vector<Eigen::Vector2d> inlier_pixels;
+  std::vector<Eigen::Vector3d> inlier_world_points;
+
+  // Details.
+  int tracked_points = 0;  // map points the flow followed into this frame
+  int seeded_points = 0;   // new map points projected into this frame to follow from here
+  bool relocalisation_tried = false;
+  bool ransac_fallback = false;  // the tracked pose came from P3P RANSAC, not the prediction
+  bool from_prior = false;       // tracking (re)started from the prior's projection this frame
+  double relocalise_ms = 0.0;    // SIFT + Localize, when tried
+};
+
+class MapTracker {
+ public:
+  // Borrows the map (must outlive the tracker). InvalidArgument for bad options or a map without
+  // points; errors of Localizer::Create.
+  static Result<std::unique_ptr<MapTracker>> Create(const LocalizationMap* map, const MapTrackerOptions& options);
+  ~MapTracker();
+
+  // The next frame. prior_cam_from_world: this frame's pose from another source (the tags) when
+  // known, used instead of the motion prediction (and to (re)start tracking without a
+  // relocalisation); may be nullptr. *report is overwritten; keep one report object across frames
+  // so its storage is reused. A frame of another size than the previous one restarts tracking.
+  // InvalidArgument for an empty frame or intrinsics of another aspect ratio; errors of SIFT.
+  Status Track(ImageView<const uint8_t> gray, const Rigid3* prior_cam_from_world, MapTrackerFrameReport* report);
+
+  MapTrackingState state() const { return state_; }
+  const MapTrackerOptions& options() const { return options_; }
+
+ private:
+  MapTracker(const LocalizationMap* map, const MapTrackerOptions& options, Localizer localizer);
+  Status StartFrameSize(int width, int height);
+  // Flow + pose from the prediction; true when the pose passes the gate.
+  bool TrackFrame(const Rigid3& predicted, MapTrackerFrameReport* report);
+  // Refines *pose on correspondences [0, count); returns the inliers, compacted to the front.
+  int RefineAndGate(int count, Rigid3* pose, double* rms);
+  Status Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameReport* report);
+  // Follows the visible map points not yet followed, projected with cam_from_world.
+  int Seed(const Rigid3& cam_from_world);
+
+  const LocalizationMap* map_;
+  MapTrackerOptions options_;
+  Localizer localizer_;
+  std::vector<Eigen::Vector3f> view_direction_;  // per map point: unit mean direction toward its keyframes
+  std::vector<int32_t> seed_order_;              // map points in a fixed shuffled order
+  std::vector<int64_t> followed_in_frame_;       // per map point: the frame it was last followed in
+
+  // Frame size state.
+  int width_ = 0, height_ = 0;
+  RadialCamera camera_;
+  QueryCamera query_camera_;
+  std::unique_ptr<SiftExtractor> sift_;
+  Image<float> sift_image_;
+  ImagePyramid pyramids_[2];
+  int current_ = 0;  // pyramids_[current_] is this frame's
+  bool have_previous_frame_ = false;
+  int grid_columns_ = 0, grid_rows_ = 0;
+  std::vector<uint8_t> grid_;
+
+  // Followed points (capacity max_tracked_points): map point and pixel in the previous frame.
+  int num_tracks_ = 0;
+  std::vector<int32_t> track_point_;
+  std::vector<Eigen::Vector2f> track_pixel_;
+  // Per-frame scratch of the same capacity.
+  std::vector<Eigen::Vector2f> guesses_;
+  std::vector<FlowResult> flow_;
+  std::vector<Eigen::Vector2d> pixels_;
+  std::vector<Eigen::Vector3d> world_;
+  std::vector<int32_t> corr_point_;
+  std::vector<int> indices_;
+
+  // Motion model and state.
+  MapTrackingState state_ = MapTrackingState::kRelocalising;
+  int64_t frame_index_ = -1;
+  int frames_without_pose_ = 0;
+  int frames_since_relocalisation_try_ = 0;
+  bool have_last_pose_ = false, have_previous_pose_ = false;
+  Rigid3 last_pose_, previous_pose_;
+};
+
+}  // namespace reconar
