@@ -23,6 +23,12 @@
 // of the project itself (same file name as a keyframe) are compared with that keyframe's pose:
 // median camera-centre distance (map units) and rotation angle. Memory: the map file's size and
 // LocalizationMap::memory_bytes(), in total and per keyframe.
+// Tracked frames (MapTracker, tracker/map_tracker.h): each query our localizer registers becomes
+// a short video with exact ground truth, a camera rotating about its localised centre (yaw and
+// pitch sweeps of a few degrees: every frame is a homography of the query frame,
+// tests/tracker/rotation_video.h); the tracker relocalises on its first frame and tracks the rest
+// against the same map. Median and 95th percentile of the tracked frames' time (wall and thread
+// CPU, 1 thread), and their rotation / centre error against the rendered truth.
 #include <time.h>
 
 #include <Eigen/Geometry>
@@ -44,6 +50,8 @@
 #include "core/pipeline/localize_photos.h"
 #include "core/sfm/localization_map.h"
 #include "core/sfm/localizer.h"
+#include "tests/tracker/rotation_video.h"
+#include "tracker/map_tracker.h"
 
 #ifdef RECONAR_BENCH_WITH_OPENCV
 #include <opencv2/calib3d.hpp>
@@ -288,6 +296,66 @@ struct OpenCvBaseline {
 };
 #endif
 
+constexpr int kTrackedVideoFrames = 40;
+
+struct TrackingSummary {
+  int videos = 0;
+  int lost_frames = 0;  // frames after the first without a pose
+  int max_tracked_points = 0;
+  std::vector<double> ms, cpu_ms, inliers, rotation_error_deg, centre_error;
+};
+
+// A rotating-camera video of kTrackedVideoFrames frames around the query's localised pose, tracked
+// against the map; the frames after the first (relocalised) are timed.
+Status TrackRotatingView(const LocalizationMap& map, const Query& query, const RadialCamera& camera,
+                         const Rigid3& cam_from_world, TrackingSummary* summary) {
+  testing::RotationScene scene;
+  scene.photo = Image<uint8_t>(query.gray.width(), query.gray.height());
+  std::copy(query.gray.data(), query.gray.data() + query.gray.width() * query.gray.height(), scene.photo.data());
+  CameraIntrinsics intrinsics;
+  intrinsics.width = query.gray.width();
+  intrinsics.height = query.gray.height();
+  intrinsics.fx = camera.focal;
+  intrinsics.fy = camera.fy();
+  intrinsics.cx = camera.cx;
+  intrinsics.cy = camera.cy;
+  // The rendering is a pinhole homography; the tracker is given the same pinhole camera.
+  scene.photo_camera = scene.frame_camera = intrinsics;
+  scene.photo_cam_from_world = cam_from_world;
+  MapTrackerOptions options;
+  options.intrinsics = intrinsics;
+  options.localizer = LocalizePhotosOptions().localizer;
+  options.sift = LocalizePhotosOptions().sift;
+  summary->max_tracked_points = options.max_tracked_points;
+  RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<MapTracker> tracker, MapTracker::Create(&map, options));
+  MapTrackerFrameReport report;
+  ++summary->videos;
+  for (int i = 0; i < kTrackedVideoFrames; ++i) {
+    // Yaw 0 -> 4 deg -> 0, pitch 0 -> 2 deg: up to ~0.4 deg (~4 px at 640 px) per frame.
+    const double phase = static_cast<double>(i) / (kTrackedVideoFrames - 1);
+    const Eigen::Matrix3d rotation = testing::YawPitchRoll(4.0 * std::sin(M_PI * phase), 2.0 * phase, 0.0);
+    const Image<uint8_t> frame = testing::RenderRotatedView(scene, rotation);
+    const Stopwatch clock;
+    RECONAR_RETURN_IF_ERROR(tracker->Track(frame.view(), nullptr, &report));
+    double wall_ms = 0.0, cpu_ms = 0.0;
+    clock.Stop(&wall_ms, &cpu_ms);
+    if (i == 0) continue;
+    if (!report.found) {
+      ++summary->lost_frames;
+      continue;
+    }
+    if (report.relocalised) continue;  // not a tracked frame
+    summary->ms.push_back(wall_ms);
+    summary->cpu_ms.push_back(cpu_ms);
+    summary->inliers.push_back(report.inliers);
+    const Rigid3 truth = testing::RotatedViewPose(scene, rotation);
+    const Eigen::AngleAxisd delta(Eigen::Matrix3d(report.cam_from_world.rotation * truth.rotation.transpose()));
+    summary->rotation_error_deg.push_back(std::abs(delta.angle()) * 180.0 / M_PI);
+    summary->centre_error.push_back((CameraCenterInWorld(report.cam_from_world) - CameraCenterInWorld(truth)).norm());
+  }
+  return Status::Ok();
+}
+
 std::vector<std::string> ImagePaths(const std::vector<std::string>& arguments) {
   std::vector<std::string> paths;
   for (const std::string& argument : arguments) {
@@ -401,6 +469,7 @@ int Run(int argc, char** argv) {
   }
 
   Summary ours, baseline;
+  std::vector<std::optional<Rigid3>> localised(queries.size());
 #ifdef RECONAR_BENCH_WITH_OPENCV
   cv::setNumThreads(1);
   OpenCvBaseline opencv(*map);
@@ -410,15 +479,26 @@ int Run(int argc, char** argv) {
 #endif
   for (int run = 0; run < runs; ++run) {
     const bool last = run == runs - 1;
-    for (const Query& query : queries) {
+    for (size_t q = 0; q < queries.size(); ++q) {
+      const Query& query = queries[q];
       const QueryCamera& camera = cameras[{query.gray.width(), query.gray.height()}];
       auto outcome = RunOurs(query, &extractor, *localizer, camera);
       if (!outcome.ok()) return Fail(outcome.status().WithContext(query.name));
       Accumulate(*outcome, query, last, &ours);
+      if (last && outcome->registered) localised[q] = outcome->cam_from_world;
 #ifdef RECONAR_BENCH_WITH_OPENCV
       Accumulate(opencv.Run(query, *camera.known, defaults.localizer), query, last, &baseline);
 #endif
     }
+  }
+
+  TrackingSummary tracking;
+  for (size_t q = 0; q < queries.size(); ++q) {
+    if (!localised[q]) continue;
+    const Status status =
+        TrackRotatingView(*map, queries[q], *cameras[{queries[q].gray.width(), queries[q].gray.height()}].known,
+                          *localised[q], &tracking);
+    if (!status.ok()) return Fail(status.WithContext(queries[q].name));
   }
 
   int with_reference = 0;
@@ -445,6 +525,20 @@ int Run(int argc, char** argv) {
     json.Key("memory_bytes_per_keyframe").Double(static_cast<double>(map->memory_bytes()) / keyframes);
     json.EndObject();
     JsonSummary(&json, "ours", ours, true);
+    json.Key("tracked")
+        .BeginObject()
+        .Key("videos")
+        .Int(tracking.videos)
+        .Key("frames")
+        .Int(static_cast<int>(tracking.ms.size()));
+    json.Key("lost_frames").Int(tracking.lost_frames).Key("max_tracked_points").Int(tracking.max_tracked_points);
+    JsonTimes(&json, "frame_ms", tracking.ms);
+    JsonTimes(&json, "frame_cpu_ms", tracking.cpu_ms);
+    json.Key("median_inliers").Double(Median(tracking.inliers));
+    json.Key("median_rotation_error_deg").Double(Median(tracking.rotation_error_deg));
+    json.Key("p95_rotation_error_deg").Double(Quantile(tracking.rotation_error_deg, 0.95));
+    json.Key("median_centre_error").Double(Median(tracking.centre_error));
+    json.EndObject();
     if (with_opencv) {
       JsonSummary(&json, "opencv", baseline, false);
 #ifdef RECONAR_BENCH_WITH_OPENCV
@@ -492,6 +586,16 @@ int Run(int argc, char** argv) {
               map->num_observations(), create_ms);
   PrintRow("SIFT", ours.sift_ms, ours.sift_cpu_ms);
   print_accuracy(ours);
+  std::printf(
+      "tracked frames (MapTracker, %d points max; %d rotating-camera videos of %d frames around the registered "
+      "queries' poses, the first frame relocalised):\n",
+      tracking.max_tracked_points, tracking.videos, kTrackedVideoFrames);
+  PrintRow("tracked frame", tracking.ms, tracking.cpu_ms);
+  std::printf(
+      "    %zu tracked frames, %d without a pose; median inliers %.0f; vs the rendered truth: rotation median "
+      "%.4f / p95 %.4f deg, centre median %.5f (map units)\n",
+      tracking.ms.size(), tracking.lost_frames, Median(tracking.inliers), Median(tracking.rotation_error_deg),
+      Quantile(tracking.rotation_error_deg, 0.95), Median(tracking.centre_error));
   if (!with_opencv) {
     std::printf("OpenCV baseline: not built (OpenCV not found)\n");
     return 0;
