@@ -8,37 +8,24 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 #include <string>
 
 #include "core/base/json_reader.h"
+#include "tests/support/ground_truth.h"
 #include "tests/support/run_command.h"
 
 namespace reconar {
 namespace {
 
-const std::string kData = std::string(RECONAR_SHARED_DATA_DIR) + "/apriltag_swatbotics_mapping";
+const std::string kData = testing::SharedDataPath("apriltag_swatbotics_mapping");
 const std::string kLayout = std::string(RECONAR_SOURCE_DIR) + "/tests/tools/data/swatbotics_room.layout";
 // The camera of the project the layout comes from (data/README.txt).
 const std::string kCamera =
     "--intrinsics 764.2655238584713,764.2655238584713,397.35271562486867,308.09664930117196,"
     "0.12598508305480108,-0.26366177412089753 --tag-size 0.127";
-
-std::map<std::string, std::set<int>> ListedTags() {
-  std::map<std::string, std::set<int>> listed;
-  std::ifstream in(kData + "/groundtruth.txt");
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream fields(line);
-    std::string image;
-    if (!(fields >> image)) continue;
-    for (int id; fields >> id;) listed[image].insert(id);
-  }
-  return listed;
-}
 
 struct Count {
   int found = 0;  // listed instances found
@@ -52,7 +39,9 @@ Count TrackRoom(const std::string& extra) {
   const testing::CommandRun run = testing::RunReconar(
       "track " + kData + " --layout " + kLayout + " " + kCamera + " --json " + extra, testing::StderrMode::kSeparate);
   EXPECT_EQ(run.exit_code, 0) << run.error;
-  const std::map<std::string, std::set<int>> listed = ListedTags();
+  const auto read = testing::ReadListedTagIds(kData + "/groundtruth.txt");
+  EXPECT_TRUE(read.ok()) << read.status().ToString();
+  const std::map<std::string, std::set<int>> listed = read.ok() ? *read : std::map<std::string, std::set<int>>();
   Count count;
   for (const auto& [image, ids] : listed) count.listed += static_cast<int>(ids.size());
   std::istringstream lines(run.output);
