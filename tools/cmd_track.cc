@@ -27,6 +27,9 @@ constexpr char kHelp[] =
     "z out of the tag toward the viewer; t is in metres. \"ms\" is the tracking time of the frame.\n"
     "Without --json, prints a short line per frame. A summary goes to stderr.\n"
     "  --layout FILE         multi-tag layout (tag_layout.h format): also prints the layout's pose\n"
+    "                        (\"cam_from_layout\"), and searches the layout's tags not found yet where\n"
+    "                        that pose puts them (\"predicted\": regions searched, tags found;\n"
+    "                        \"predicted\": true on a tag found so)\n"
     "  --max-frames N        stop after N frames\n"
     "  --json                JSON lines on stdout\n";
 
@@ -40,7 +43,8 @@ void WritePose(JsonWriter& json, const Rigid3& pose) {
   json.EndArray().EndObject();
 }
 
-std::string FrameJson(const Frame& frame, const TagTrackerFrameReport& report, const BoardPose* board) {
+std::string FrameJson(const Frame& frame, const TagTrackerFrameReport& report, bool with_layout,
+                      const BoardPose* board) {
   JsonWriter json;
   json.BeginObject().Key("frame").String(std::string(frame.name)).Key("tags").BeginArray();
   for (const TrackedTag& tag : report.tags) {
@@ -52,6 +56,7 @@ std::string FrameJson(const Frame& frame, const TagTrackerFrameReport& report, c
     json.EndArray().Key("cam_from_tag");
     WritePose(json, tag.cam_from_tag);
     json.Key("rms_px").Double(tag.pose.rms_reprojection_px).Key("reacquired").Bool(tag.reacquired);
+    if (with_layout) json.Key("predicted").Bool(tag.found_by_prediction);
     json.EndObject();
   }
   json.EndArray();
@@ -59,6 +64,10 @@ std::string FrameJson(const Frame& frame, const TagTrackerFrameReport& report, c
     json.Key("cam_from_layout");
     WritePose(json, board->cam_from_layout);
     json.Key("layout_tags").Int(board->tags_used).Key("layout_rms_px").Double(board->rms_reprojection_px);
+  }
+  if (with_layout) {
+    json.Key("predicted").BeginObject().Key("searched").Int(report.predicted_searched);
+    json.Key("found").Int(report.predicted_found).EndObject();
   }
   json.Key("search").String(SearchName(report.search)).Key("ms").Double(report.total_ms).EndObject();
   return json.str();
@@ -102,6 +111,10 @@ int RunTrack(int argc, char** argv, int first) {
 
   std::vector<double> frame_ms;
   long frames_with_tags = 0;
+  long instances = 0;
+  long predicted_found = 0;
+  long predicted_searched = 0;
+  const bool with_layout = !options.pose.layout.empty();
   for (;;) {
     auto more = (*session)->Step();
     if (!more.ok()) return Fail(more.status());
@@ -111,9 +124,12 @@ int RunTrack(int argc, char** argv, int first) {
     int measured = 0;
     for (const TrackedTag& tag : report.tags) measured += tag.measured ? 1 : 0;
     frames_with_tags += measured > 0 ? 1 : 0;
+    instances += measured;
+    predicted_found += report.predicted_found;
+    predicted_searched += report.predicted_searched;
     frame_ms.push_back(report.total_ms);
     if (json) {
-      std::printf("%s\n", FrameJson(frame, report, (*session)->tags().board()).c_str());
+      std::printf("%s\n", FrameJson(frame, report, with_layout, (*session)->tags().board()).c_str());
     } else {
       std::printf("%.*s: %d tag(s)", static_cast<int>(frame.name.size()), frame.name.data(), measured);
       for (const TrackedTag& tag : report.tags) {
@@ -122,7 +138,12 @@ int RunTrack(int argc, char** argv, int first) {
         std::printf("  id %d at (%.3f, %.3f, %.3f) m, %.2f px", tag.id, t.x(), t.y(), t.z(),
                     tag.pose.rms_reprojection_px);
       }
-      std::printf("  [%s, %.2f ms]\n", SearchName(report.search), report.total_ms);
+      if (report.predicted_searched > 0) {
+        std::printf("  [%s + %d predicted (%d found), %.2f ms]\n", SearchName(report.search), report.predicted_searched,
+                    report.predicted_found, report.total_ms);
+      } else {
+        std::printf("  [%s, %.2f ms]\n", SearchName(report.search), report.total_ms);
+      }
     }
     std::fflush(stdout);
   }
@@ -133,6 +154,10 @@ int RunTrack(int argc, char** argv, int first) {
   for (double ms : frame_ms) total += ms;
   std::fprintf(stderr, "reconar track: %ld frames, tags in %ld; tracking %.2f ms/frame mean, %.2f median, %.2f max\n",
                frames, frames_with_tags, total / frames, sorted[sorted.size() / 2], sorted.back());
+  if (with_layout) {
+    std::fprintf(stderr, "reconar track: %ld tag instances, %ld of them found by prediction (%ld predicted regions)\n",
+                 instances, predicted_found, predicted_searched);
+  }
   return 0;
 }
 

@@ -25,6 +25,10 @@ struct TagTracker::FollowedTag {
   bool measured = false;
   bool reacquired = false;
   bool found_in_region = false;
+  bool found_by_prediction = false;
+  // State and missed count at the start of the frame (SearchPredicted undoes the frame's miss).
+  TagTrackState state_at_start = TagTrackState::kSearching;
+  int missed_at_start = 0;
   // Raw measurements: the last one and, when has_previous, the one in the frame just before it.
   Rigid3 last;
   Rigid3 previous;
@@ -70,6 +74,9 @@ Status TagTrackerOptions::Check() const {
   if (!(region_margin >= 0.0) || region_margin_px < 0) {
     return InvalidArgument("TagTrackerOptions.region_margin and region_margin_px must be >= 0");
   }
+  if (!(predicted_min_edge_px >= 0.0) || !std::isfinite(predicted_min_edge_px)) {
+    return InvalidArgument("TagTrackerOptions.predicted_min_edge_px must be >= 0");
+  }
   if (lost_after_missed_frames < 1) return InvalidArgument("TagTrackerOptions.lost_after_missed_frames must be >= 1");
   if (full_frame_interval < 0) return InvalidArgument("TagTrackerOptions.full_frame_interval must be >= 0");
   const auto in_unit = [](double v) { return v > 0.0 && v <= 1.0; };
@@ -108,27 +115,34 @@ bool TagTracker::PredictRegion(FollowedTag& track, int width, int height, int re
     const Rigid3 motion = track.last * track.previous.Inverse();  // per frame, in the camera frame
     for (int i = 0; i <= track.missed_frames; ++i) predicted = motion * predicted;
   }
-  const std::array<Eigen::Vector3d, 4> corners = TagCornersInTagFrame(options_.tag_size);
   // The box holds the predicted square and the last detected one.
-  Eigen::Vector2d lo = track.detection.corners[0];
-  Eigen::Vector2d hi = lo;
+  return SquareRegion(predicted, track.detection.corners, width, height, region, shortest_edge_px);
+}
+
+bool TagTracker::SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d* last_corners, int width, int height,
+                              int region[4], double* shortest_edge_px) const {
+  const std::array<Eigen::Vector3d, 4> corners = TagCornersInTagFrame(options_.tag_size);
   Eigen::Vector2d projected[4];
   for (int k = 0; k < 4; ++k) {
-    lo = lo.cwiseMin(track.detection.corners[k]);
-    hi = hi.cwiseMax(track.detection.corners[k]);
-    const Eigen::Vector3d X = predicted * corners[k];
+    const Eigen::Vector3d X = cam_from_tag * corners[k];
     if (!(X.z() > 0.0)) return false;
     projected[k] = options_.intrinsics.Project(X);
     if (!projected[k].allFinite()) return false;
-    lo = lo.cwiseMin(projected[k]);
-    hi = hi.cwiseMax(projected[k]);
   }
+  Eigen::Vector2d lo = projected[0];
+  Eigen::Vector2d hi = lo;
   *shortest_edge_px = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 4; ++k) {
-    *shortest_edge_px = std::min({*shortest_edge_px, (projected[(k + 1) % 4] - projected[k]).norm(),
-                                  (track.detection.corners[(k + 1) % 4] - track.detection.corners[k]).norm()});
+    lo = lo.cwiseMin(projected[k]);
+    hi = hi.cwiseMax(projected[k]);
+    *shortest_edge_px = std::min(*shortest_edge_px, (projected[(k + 1) % 4] - projected[k]).norm());
+    if (last_corners != nullptr) {
+      lo = lo.cwiseMin(last_corners[k]);
+      hi = hi.cwiseMax(last_corners[k]);
+      *shortest_edge_px = std::min(*shortest_edge_px, (last_corners[(k + 1) % 4] - last_corners[k]).norm());
+    }
   }
-  const double margin = options_.region_margin * (hi - lo).maxCoeff() + options_.region_margin_px;
+  const double margin = RegionMargin((hi - lo).maxCoeff());
   // Pixel centres sit on integers, so pixel i covers [i - 0.5, i + 0.5]: the box's pixel edges are
   // lo + 0.5 and hi + 0.5 in pixel-index units.
   const double x0 = std::max(0.0, std::floor(lo.x() + 0.5 - margin));
@@ -143,6 +157,53 @@ bool TagTracker::PredictRegion(FollowedTag& track, int width, int height, int re
   region[2] = static_cast<int>(x1 - x0);
   region[3] = static_cast<int>(y1 - y0);
   return true;
+}
+
+double TagTracker::RegionMargin(double box_side_px) const {
+  return options_.region_margin * box_side_px + options_.region_margin_px;
+}
+
+bool TagTracker::PredictedInView(const Rigid3& cam_from_tag, int width, int height) const {
+  // The printed side faces the camera: its z axis points back toward the camera centre.
+  if (!(cam_from_tag.rotation.col(2).dot(cam_from_tag.translation) < 0.0)) return false;
+  const std::array<Eigen::Vector3d, 4> corners = TagCornersInTagFrame(options_.tag_size);
+  Eigen::Vector2d projected[4];
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d X = cam_from_tag * corners[k];
+    if (!(X.z() > 0.0)) return false;
+    projected[k] = options_.intrinsics.Project(X);
+    // Beyond the radius where the distortion polynomial turns back, a point far outside the field
+    // of view projects into the frame: the pixel must undistort to the point's own direction.
+    const Eigen::Vector2d back = options_.intrinsics.Unproject(projected[k]);
+    if (!back.allFinite() || !projected[k].allFinite() ||
+        !(options_.intrinsics.fx * (back - X.head<2>() / X.z()).norm() < 0.5)) {
+      return false;
+    }
+    lo = lo.cwiseMin(projected[k]);
+    hi = hi.cwiseMax(projected[k]);
+  }
+  // The whole square in the frame, up to the region's margin (the error the prediction may have).
+  const double margin = RegionMargin((hi - lo).maxCoeff());
+  return lo.x() >= -0.5 - margin && lo.y() >= -0.5 - margin && hi.x() <= width - 0.5 + margin &&
+         hi.y() <= height - 0.5 + margin;
+}
+
+float TagTracker::RegionDecimate(double shortest_edge_px, float min_decimate) const {
+  return std::clamp(static_cast<float>(std::floor(shortest_edge_px / options_.region_min_decimated_edge_px)),
+                    min_decimate, std::max(min_decimate, options_.region_max_quad_decimate));
+}
+
+Status TagTracker::DetectRegion(ImageView<const uint8_t> image, const int region[4], float decimate,
+                                TagTrackerFrameReport* report) {
+  region_detector_->SetQuadDecimate(decimate);
+  const Clock::time_point detect_start = Clock::now();
+  RECONAR_RETURN_IF_ERROR(
+      region_detector_->DetectInRegion(image, region[0], region[1], region[2], region[3], &scratch_));
+  report->detect_ms += MillisecondsSince(detect_start);
+  report->detections += scratch_.size();
+  return Status::Ok();
 }
 
 void TagTracker::Measure(FollowedTag& track, const TagDetection& detection, bool in_region, double* pose_ms) {
@@ -191,6 +252,8 @@ Status TagTracker::Track(ImageView<const uint8_t> image, TagTrackerFrameReport* 
   report->regions_searched = 0;
   report->detections = 0;
   report->tags_dropped = 0;
+  report->predicted_searched = 0;
+  report->predicted_found = 0;
   report->detect_ms = 0.0;
   report->pose_ms = 0.0;
 
@@ -199,6 +262,9 @@ Status TagTracker::Track(ImageView<const uint8_t> image, TagTrackerFrameReport* 
     track.measured = false;
     track.reacquired = false;
     track.found_in_region = false;
+    track.found_by_prediction = false;
+    track.state_at_start = track.state;
+    track.missed_at_start = track.missed_frames;
     if (track.state != TagTrackState::kLost) {
       any_followed = true;
       track.smoothed.translation += track.velocity;  // alpha-beta prediction
@@ -214,16 +280,9 @@ Status TagTracker::Track(ImageView<const uint8_t> image, TagTrackerFrameReport* 
       int region[4];
       double shortest_edge_px = 0.0;
       if (PredictRegion(track, image.width, image.height, region, &shortest_edge_px)) {
-        const float decimate = std::clamp(
-            static_cast<float>(std::floor(shortest_edge_px / options_.region_min_decimated_edge_px)),
-            options_.detector.quad_decimate, std::max(options_.detector.quad_decimate, options_.region_max_quad_decimate));
-        region_detector_->SetQuadDecimate(decimate);
-        const Clock::time_point detect_start = Clock::now();
         RECONAR_RETURN_IF_ERROR(
-            region_detector_->DetectInRegion(image, region[0], region[1], region[2], region[3], &scratch_));
-        report->detect_ms += MillisecondsSince(detect_start);
+            DetectRegion(image, region, RegionDecimate(shortest_edge_px, options_.detector.quad_decimate), report));
         ++report->regions_searched;
-        report->detections += scratch_.size();
         for (const TagDetection& detection : scratch_) {
           FollowedTag* owner = FindTrack(detection.id);
           if (owner != nullptr && !owner->measured && owner->state != TagTrackState::kLost) {
@@ -243,29 +302,13 @@ Status TagTracker::Track(ImageView<const uint8_t> image, TagTrackerFrameReport* 
     for (const TagDetection& detection : scratch_) {
       FollowedTag* track = FindTrack(detection.id);
       if (track == nullptr) {
-        if (static_cast<int>(tracks_.size()) >= options_.max_tags) {
-          ++report->tags_dropped;
-          continue;
-        }
-        tracks_.emplace_back();
-        track = &tracks_.back();
-        track->detection.id = -1;  // marks a new track for Measure
-      }
-      if (!track->measured) Measure(*track, detection, false, &report->pose_ms);
-      if (track->id < 0) {
-        if (track->measured) {
-          track->id = detection.id;
-        } else {
-          tracks_.pop_back();  // its pose failed: not followed
-        }
+        StartTrack(detection, false, report);
+      } else if (!track->measured) {
+        Measure(*track, detection, false, &report->pose_ms);
       }
     }
   }
 
-  report->tags.clear();
-  if (report->tags.capacity() < static_cast<size_t>(options_.max_tags)) {
-    report->tags.reserve(static_cast<size_t>(options_.max_tags));
-  }
   for (FollowedTag& track : tracks_) {
     if (!track.measured) {
       ++track.missed_frames;
@@ -274,12 +317,59 @@ Status TagTracker::Track(ImageView<const uint8_t> image, TagTrackerFrameReport* 
                                                                                : TagTrackState::kSearching;
       }
     }
+  }
+  FillReport(report);
+  report->total_ms = MillisecondsSince(start);
+  return Status::Ok();
+}
+
+TagTracker::FollowedTag* TagTracker::StartTrack(const TagDetection& detection, bool in_region,
+                                                TagTrackerFrameReport* report) {
+  FollowedTag* slot = nullptr;
+  if (static_cast<int>(tracks_.size()) < options_.max_tags) {
+    tracks_.emplace_back();
+    slot = &tracks_.back();
+  } else {
+    for (FollowedTag& track : tracks_) {
+      if (track.state == TagTrackState::kLost && (slot == nullptr || track.missed_frames > slot->missed_frames)) {
+        slot = &track;
+      }
+    }
+    if (slot == nullptr) {
+      ++report->tags_dropped;
+      return nullptr;
+    }
+  }
+  const FollowedTag replaced = *slot;  // fixed-size, no heap
+  *slot = FollowedTag();
+  slot->detection.id = -1;  // marks a new track for Measure
+  Measure(*slot, detection, in_region, &report->pose_ms);
+  if (slot->measured) {
+    slot->id = detection.id;
+    return slot;
+  }
+  // Its pose failed: not followed.
+  if (replaced.id < 0) {
+    tracks_.pop_back();
+  } else {
+    *slot = replaced;
+  }
+  return nullptr;
+}
+
+void TagTracker::FillReport(TagTrackerFrameReport* report) const {
+  report->tags.clear();
+  if (report->tags.capacity() < static_cast<size_t>(options_.max_tags)) {
+    report->tags.reserve(static_cast<size_t>(options_.max_tags));
+  }
+  for (const FollowedTag& track : tracks_) {
     TrackedTag out;
     out.id = track.id;
     out.state = track.state;
     out.measured = track.measured;
     out.reacquired = track.reacquired;
     out.found_in_region = track.found_in_region;
+    out.found_by_prediction = track.found_by_prediction;
     out.missed_frames = track.missed_frames;
     out.detection = track.detection;
     out.pose = track.pose;
@@ -287,7 +377,73 @@ Status TagTracker::Track(ImageView<const uint8_t> image, TagTrackerFrameReport* 
     out.smoothed_cam_from_tag = track.smoothed;
     report->tags.push_back(out);
   }
-  report->total_ms = MillisecondsSince(start);
+}
+
+Status TagTracker::SearchPredicted(ImageView<const uint8_t> image, const PredictedTag* tags, int count,
+                                   TagTrackerFrameReport* report) {
+  const Clock::time_point start = Clock::now();
+  if (count < 0 || (count > 0 && tags == nullptr)) {
+    return InvalidArgument("TagTracker::SearchPredicted: count must be >= 0 with the tags given");
+  }
+  if (count == 0) return Status::Ok();
+  if (image.empty() || image.width != width_ || image.height != height_) {
+    return InvalidArgument("TagTracker::SearchPredicted: the frame is not the one of the last Track (" +
+                           std::to_string(image.width) + "x" + std::to_string(image.height) + ")");
+  }
+  const auto measured = [this](int id) {
+    const FollowedTag* track = FindTrack(id);
+    return track != nullptr && track->measured;
+  };
+  const auto predicted = [&](int id) {
+    for (int i = 0; i < count; ++i) {
+      if (tags[i].id == id) return true;
+    }
+    return false;
+  };
+  const bool full_frame_searched = report->search != TagTrackerFrameReport::Search::kRegions;
+  bool any_found = false;
+  for (int i = 0; i < count; ++i) {
+    const PredictedTag& tag = tags[i];
+    if (tag.id < 0 || measured(tag.id) || !PredictedInView(tag.cam_from_tag, image.width, image.height)) continue;
+    int region[4];
+    double shortest_edge_px = 0.0;
+    if (!SquareRegion(tag.cam_from_tag, nullptr, image.width, image.height, region, &shortest_edge_px) ||
+        !(shortest_edge_px >= options_.predicted_min_edge_px)) {
+      continue;
+    }
+    // A full-frame search of this frame already looked there at the region's resolution or finer.
+    const float decimate = RegionDecimate(shortest_edge_px, 1.0f);
+    if (full_frame_searched && options_.detector.quad_decimate <= decimate) continue;
+    RECONAR_RETURN_IF_ERROR(DetectRegion(image, region, decimate, report));
+    ++report->predicted_searched;
+    for (const TagDetection& detection : scratch_) {
+      if (!predicted(detection.id)) continue;
+      FollowedTag* track = FindTrack(detection.id);
+      if (track == nullptr) {
+        track = StartTrack(detection, true, report);
+      } else if (!track->measured) {
+        // Undo this frame's miss (Track counted it), measure, or count the miss again.
+        const TagTrackState state = track->state;
+        const int missed = track->missed_frames;
+        track->state = track->state_at_start;
+        track->missed_frames = track->missed_at_start;
+        Measure(*track, detection, true, &report->pose_ms);
+        if (!track->measured) {
+          track->state = state;
+          track->missed_frames = missed;
+        }
+      } else {
+        continue;
+      }
+      if (track != nullptr && track->measured) {
+        track->found_by_prediction = true;
+        ++report->predicted_found;
+        any_found = true;
+      }
+    }
+  }
+  if (any_found) FillReport(report);
+  report->total_ms += MillisecondsSince(start);
   return Status::Ok();
 }
 

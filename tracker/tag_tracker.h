@@ -7,9 +7,15 @@
 //     and every full_frame_interval frames (new tags, lost tags);
 //  4. estimate each found tag's pose (tag_pose.h: IPPE + LM) and filter it: translation by an
 //     alpha-beta (constant-velocity) filter, rotation by slerp toward the measurement.
+//  5. optionally (SearchPredicted, after Track, same frame): search tags the caller predicts from
+//     outside the tracker (a layout's tags placed by the frame's camera pose) where their predicted
+//     square appears, so that a tag entering the view is found in that frame.
 // Per-tag states: kTracking (measured this frame), kSearching (missed for fewer than
 // lost_after_missed_frames consecutive frames: still predicted and region-searched), kLost (missed
-// that many frames: only a full-frame search finds it again, reported as `reacquired`).
+// that many frames: only a full-frame or a predicted search finds it again, reported as
+// `reacquired`). When max_tags tracks exist and a new id is found, the track lost the longest gives
+// its place to the new id (a lost track keeps no state a re-acquisition uses); the id is dropped
+// only when every track is still tracking or searching.
 //
 // Frames and pixels: see tag_pose.h and tag_detector.h (corners in the program's convention, the
 // centre of the top-left pixel at (0, 0); cam_from_tag with the tag's z axis toward the viewer).
@@ -58,6 +64,9 @@ struct TagTrackerOptions {
   // tag's size per frame.
   double region_margin = 0.25;
   int region_margin_px = 8;
+  // SearchPredicted: tags whose predicted square has an edge shorter than this (pixels) are not
+  // searched (too small to decode: tag36h11 has 10 modules across, white border included).
+  double predicted_min_edge_px = 10.0;
   int lost_after_missed_frames = 5;
   // A full-frame search every this many frames even when every region search succeeds (0 = never),
   // so that new tags and lost ones are found (30: within a second at 30 fps).
@@ -79,7 +88,8 @@ struct TrackedTag {
   TagTrackState state = TagTrackState::kSearching;
   bool measured = false;    // detected (and its pose estimated) in this frame
   bool reacquired = false;  // measured in this frame after having been kLost
-  bool found_in_region = false;
+  bool found_in_region = false;      // in a region search (its own or, found_by_prediction, a predicted one)
+  bool found_by_prediction = false;  // found by SearchPredicted in this frame
   int missed_frames = 0;    // consecutive frames without a measurement
   TagDetection detection;   // this frame's detection (valid when measured)
   TagPose pose;             // this frame's raw pose estimate (valid when measured)
@@ -98,6 +108,8 @@ struct TagTrackerFrameReport {
   int regions_searched = 0;
   int detections = 0;      // raw detections over all searches
   int tags_dropped = 0;    // ids not followed because max_tags were already followed
+  int predicted_searched = 0;  // SearchPredicted: predicted tags searched in their region
+  int predicted_found = 0;     // SearchPredicted: tags measured by those searches
   double detect_ms = 0.0;  // inside libapriltag
   double pose_ms = 0.0;
   double total_ms = 0.0;
@@ -105,6 +117,13 @@ struct TagTrackerFrameReport {
 };
 
 const char* SearchName(TagTrackerFrameReport::Search search);
+
+// A tag the caller expects in the current frame at cam_from_tag (e.g. a layout's tag placed by the
+// camera pose of the frame: cam_from_world * world_from_tag), for TagTracker::SearchPredicted.
+struct PredictedTag {
+  int id = -1;
+  Rigid3 cam_from_tag;
+};
 
 class TagTracker {
  public:
@@ -116,15 +135,46 @@ class TagTracker {
   // *report is overwritten; keep one report object across frames so its storage is reused.
   Status Track(ImageView<const uint8_t> image, TagTrackerFrameReport* report);
 
+  // After Track() on the same frame (same image, same report): searches every predicted tag not
+  // measured in this frame where its square appears. A tag is skipped when a corner is behind the
+  // camera, its printed side faces away, its predicted edge is shorter than predicted_min_edge_px
+  // or its region misses the frame. The region is the one of a followed tag (the predicted
+  // square's box plus the margin, PredictRegion) and its quad_decimate the region rule of Options,
+  // from 1 up (no full-frame search has shown that the tag is found at the full-frame decimation).
+  // Detections of predicted ids found there are measured and followed like any other (a new id
+  // starts a track; a lost one counts as reacquired). Updates *report: its tags, detections,
+  // timings and predicted_searched / predicted_found. Nothing is searched when count is 0.
+  // InvalidArgument when the image is not the one of the last Track (size) or count < 0.
+  Status SearchPredicted(ImageView<const uint8_t> image, const PredictedTag* tags, int count,
+                         TagTrackerFrameReport* report);
+
   const TagTrackerOptions& options() const { return options_; }
 
  private:
   struct FollowedTag;
   explicit TagTracker(const TagTrackerOptions& options);
   FollowedTag* FindTrack(int id);
-  // The search box and the predicted square's shortest edge in pixels.
+  // The search box of a followed tag and its predicted square's shortest edge in pixels.
   bool PredictRegion(FollowedTag& track, int width, int height, int region[4], double* shortest_edge_px) const;
+  // The search box of a tag at cam_from_tag: the box of its projected square (and of `last_corners`,
+  // its last detected square, when not null) plus the margin, clipped to the frame. False when a
+  // corner is not in front of the camera or the clipped box is too small to hold a tag.
+  bool SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d* last_corners, int width, int height,
+                    int region[4], double* shortest_edge_px) const;
+  double RegionMargin(double box_side_px) const;
+  // SearchPredicted's test: the tag faces the camera and its square, projected without folding by
+  // the distortion, lies in the frame up to the region margin.
+  bool PredictedInView(const Rigid3& cam_from_tag, int width, int height) const;
+  // quad_decimate of a region search for a tag of that shortest edge, never below min_decimate.
+  float RegionDecimate(double shortest_edge_px, float min_decimate) const;
+  // Detects inside region with region_detector_ into scratch_ (time and count into *report).
+  Status DetectRegion(ImageView<const uint8_t> image, const int region[4], float decimate,
+                      TagTrackerFrameReport* report);
   void Measure(FollowedTag& track, const TagDetection& detection, bool in_region, double* pose_ms);
+  // Follows a detection of an id without a track: a new track, or the place of the track lost the
+  // longest when max_tags tracks exist (else counted in tags_dropped). Nothing when its pose fails.
+  FollowedTag* StartTrack(const TagDetection& detection, bool in_region, TagTrackerFrameReport* report);
+  void FillReport(TagTrackerFrameReport* report) const;
 
   TagTrackerOptions options_;
   std::unique_ptr<TagDetector> full_detector_;

@@ -45,4 +45,19 @@ double SymmetricEpipolarDistance(const Eigen::Matrix3d& F, const Eigen::Vector2d
 
 std::string SharedDataPath(const std::string& relative) { return std::string(RECONAR_SHARED_DATA_DIR) + "/" + relative; }
 
+Result<std::map<std::string, std::set<int>>> ReadListedTagIds(const std::string& path) {
+  RECONAR_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  std::map<std::string, std::set<int>> listed;
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    std::istringstream fields(line);
+    std::string image;
+    if (!(fields >> image)) continue;
+    std::set<int>& ids = listed[image];
+    for (int id; fields >> id;) ids.insert(id);
+  }
+  return listed;
+}
+
 }  // namespace reconar::testing

@@ -1,9 +1,10 @@
 #pragma once
 // Readers for the ground truth that ships with public datasets in ../shared/data (see each
 // SOURCE.txt), and the geometry derived from it. Test support only.
-#include <string>
-
 #include <Eigen/Core>
+#include <map>
+#include <set>
+#include <string>
 
 #include "core/base/status.h"
 
@@ -29,5 +30,9 @@ Eigen::Matrix3d FundamentalFromCameras(const GroundTruthCamera& a, const GroundT
 double SymmetricEpipolarDistance(const Eigen::Matrix3d& F, const Eigen::Vector2d& x_a, const Eigen::Vector2d& x_b);
 
 std::string SharedDataPath(const std::string& relative);
+
+// The tag ids listed per photo in a groundtruth.txt of tag photos (apriltag_swatbotics_mapping):
+// "<image file> <id> <id> ..." per line.
+Result<std::map<std::string, std::set<int>>> ReadListedTagIds(const std::string& path);
 
 }  // namespace reconar::testing

@@ -17,8 +17,18 @@ TEST(TagTrackerAllocationTest, SteadyStateTrackingDoesNotAllocate) {
   const CameraIntrinsics camera = testing::TestCamera();
   std::vector<Image<uint8_t>> frames;
   std::vector<testing::SyntheticTag> truth;
+  // Tag 9 enters the view at frame 14 (not a periodic full-frame frame); every frame the caller predicts it
+  // (SearchPredicted).
+  testing::SyntheticTag entering;
+  entering.id = 9;
+  entering.size = 0.07;
+  entering.cam_from_tag.rotation = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  entering.cam_from_tag.translation = Eigen::Vector3d(0.0, -0.12, 0.6);
+  PredictedTag predicted;
+  predicted.id = entering.id;
+  predicted.cam_from_tag = entering.cam_from_tag;
   for (int frame = 0; frame < 24; ++frame) {
-    testing::SyntheticTag tags[2];
+    testing::SyntheticTag tags[3];
     for (int i = 0; i < 2; ++i) {
       tags[i].id = 4 + i;
       tags[i].size = 0.07;
@@ -27,7 +37,8 @@ TEST(TagTrackerAllocationTest, SteadyStateTrackingDoesNotAllocate) {
           Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
       tags[i].cam_from_tag.translation = Eigen::Vector3d(-0.1 + 0.2 * i + 0.003 * frame, 0.01 * i, 0.55);
     }
-    frames.push_back(testing::RenderTags(tags, 2, camera, testing::SyntheticRenderOptions()));
+    tags[2] = entering;
+    frames.push_back(testing::RenderTags(tags, frame >= 14 ? 3 : 2, camera, testing::SyntheticRenderOptions()));
   }
   TagTrackerOptions options;
   options.intrinsics = camera;
@@ -38,12 +49,15 @@ TEST(TagTrackerAllocationTest, SteadyStateTrackingDoesNotAllocate) {
   TagTrackerFrameReport report;
   for (int frame = 0; frame < 4; ++frame) ASSERT_TRUE((*tracker)->Track(frames[frame].view(), &report).ok());
   long allocations = -1;
-  int measured = 0, region_frames = 0, full_frames = 0;
+  int measured = 0, region_frames = 0, full_frames = 0, predicted_searched = 0, predicted_found = 0;
   {
     testing::NoAllocationScope scope;
     for (size_t frame = 4; frame < frames.size(); ++frame) {
       const Status status = (*tracker)->Track(frames[frame].view(), &report);
       if (!status.ok()) break;
+      if (!(*tracker)->SearchPredicted(frames[frame].view(), &predicted, 1, &report).ok()) break;
+      predicted_searched += report.predicted_searched;
+      predicted_found += report.predicted_found;
       for (const TrackedTag& t : report.tags) measured += t.measured;
       region_frames += report.search == TagTrackerFrameReport::Search::kRegions;
       full_frames += report.search != TagTrackerFrameReport::Search::kRegions;
@@ -51,7 +65,9 @@ TEST(TagTrackerAllocationTest, SteadyStateTrackingDoesNotAllocate) {
     allocations = scope.allocations();
   }
   EXPECT_EQ(allocations, 0);
-  EXPECT_EQ(measured, 2 * 20);
+  EXPECT_EQ(measured, 2 * 20 + 10);  // tag 9 from frame 14 on
+  EXPECT_GT(predicted_searched, 5);
+  EXPECT_EQ(predicted_found, 1);  // found by prediction when it enters, then followed
   EXPECT_GT(region_frames, 10);
   EXPECT_GT(full_frames, 0);
 }
