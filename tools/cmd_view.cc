@@ -12,6 +12,7 @@
 #include "render/ar/ar_project.h"
 #include "render/ar/ar_view.h"
 #include "tools/ar_args.h"
+#include "tools/ar_output.h"
 #include "tools/commands.h"
 
 namespace reconar::tools {
@@ -29,8 +30,13 @@ constexpr char kHelp[] =
     "  --model FILE          mesh or point cloud to show (.ply, .obj, .glb)\n"
     "  --project DIR         a project of `reconar reconstruct --tag-size`: its mesh (or dense, or\n"
     "                        sparse points) at true size, posed from all of its tags in view at once\n"
-    "                        (tags.layout), with its tag size, family and camera (scaled to the frame\n"
-    "                        size; --intrinsics overrides); the --model-* options do not apply\n"
+    "                        (tags.layout) and from its localisation map (map/map.rmap), so the model\n"
+    "                        stays in place with no tag in view; with its tag size, family and camera\n"
+    "                        (scaled to the frame size; --intrinsics overrides); the --model-* options\n"
+    "                        do not apply\n"
+    "  --no-map              with --project: pose from the tags only\n"
+    "  --json                one JSON line per frame on stdout, as `reconar track --json` prints\n"
+    "                        (with --project: the pose's source and the map tracker's state)\n"
     "  --camera DEVICE       /dev/videoN, libcamera or libcamera:N\n"
     "  --frames PATH         a folder of JPEG/PNG frames or a .frames recording\n"
     "  --out DIR             write DIR/<frame>.png instead of showing a window\n"
@@ -111,7 +117,7 @@ int RunView(int argc, char** argv, int first) {
   std::set<std::string> valued = kTrackerValuedOptions;
   valued.insert({"model", "project", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
                  "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces"});
-  Args args(valued, {"no-axes", "smooth"});
+  Args args(valued, {"no-axes", "smooth", "no-map", "json"});
   if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args.Has("help")) {
     std::fputs(kHelp, stdout);
@@ -127,7 +133,9 @@ int RunView(int argc, char** argv, int first) {
   std::optional<ArProject> project;
   TrackerDefaults defaults;
   if (args.Has("project")) {
-    auto loaded = LoadArProject(args.Get("project"));
+    ArProjectOptions project_options;
+    project_options.load_map = !args.Has("no-map");
+    auto loaded = LoadArProject(args.Get("project"), project_options);
     if (!loaded.ok()) return Fail(loaded.status());
     project = std::move(*loaded);
     defaults = {project->photo_intrinsics, project->tag_size, project->family};
@@ -137,7 +145,10 @@ int RunView(int argc, char** argv, int first) {
   auto tracker_options = TrackerOptionsFromArgs(args, defaults);
   if (!tracker_options.ok()) return Fail(tracker_options.status());
   session.pose.tracker = *tracker_options;
-  if (project) session.pose.layout = project->layout;
+  if (project) {
+    session.pose.layout = project->layout;
+    session.map = project->map;
+  }
   session.scale_intrinsics_to_video = project && !args.Has("intrinsics");
   session.pose.smoothed = args.Has("smooth");
   session.source = args.Has("camera") ? args.Get("camera") : args.Get("frames");
@@ -168,7 +179,8 @@ int RunView(int argc, char** argv, int first) {
   auto model = LoadArModel(model_path, static_cast<size_t>(*max_faces));
   if (!model.ok()) return Fail(model.status());
   if (const auto& simplified = model->simplified) {
-    std::printf("%s: simplified from %zu to %zu faces for drawing (%.1fs; --max-faces)\n", model_path.c_str(),
+    // On stderr with --json: stdout holds only the frames' JSON lines.
+    std::fprintf(args.Has("json") ? stderr : stdout, "%s: simplified from %zu to %zu faces for drawing (%.1fs; --max-faces)\n", model_path.c_str(),
                 simplified->faces_before, simplified->faces_after, simplified->seconds);
   }
   if (!project) {
@@ -180,8 +192,15 @@ int RunView(int argc, char** argv, int first) {
   if (!view.ok()) return Fail(view.status());
   std::fprintf(stderr, "reconar view: %s\n", (*view)->Describe(model_path).c_str());
   const bool stderr_is_terminal = ::isatty(STDERR_FILENO) != 0;
-  auto report = (*view)->Run([&](long frames) {
-    if (stderr_is_terminal && frames % 10 == 0) std::fprintf(stderr, "\rreconar view: %ld frames", frames);
+  const bool json = args.Has("json");
+  auto report = (*view)->Run([&](const ArSession& frame) {
+    if (json) {
+      std::printf("%s\n", ArFrameJson(frame).c_str());
+      std::fflush(stdout);
+    }
+    if (stderr_is_terminal && frame.frames() % 10 == 0) {
+      std::fprintf(stderr, "\rreconar view: %ld frames", frame.frames());
+    }
   });
   if (!report.ok()) return Fail(report.status());
   std::fprintf(stderr,
@@ -189,6 +208,9 @@ int RunView(int argc, char** argv, int first) {
                "track + render %.2f%s\n",
                stderr_is_terminal ? "\r" : "", report->frames, report->frames_with_model, report->median_track_ms,
                report->median_render_ms, report->median_frame_ms, to_files ? " (render includes the readback)" : "");
+  if (session.map) {
+    std::fprintf(stderr, "reconar view: %s\n", PoseSourceCounts(report->frames_by_source).c_str());
+  }
   if (to_files) std::fprintf(stderr, "reconar view: wrote %ld PNGs to %s\n", report->frames, options.out_dir.c_str());
   return 0;
 }

@@ -77,6 +77,7 @@ void TagPoseSource::PoseFromLayout(WorldPose* pose) {
   for (const TrackedTag& tag : report_.tags) {
     if (tag.measured) measured_.Add(tag.detection);
   }
+  if (measured_.empty()) return;  // no pose, and no error message built (it would allocate)
   auto board = EstimateBoardPose(options_.layout, measured_, options_.tracker.intrinsics, options_.board);
   if (!board.ok()) return;
   board_ = *board;

@@ -6,6 +6,7 @@
 
 #include "core/base/elapsed.h"
 #include "core/base/json_writer.h"
+#include "core/math/rigid3_json.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/io/focal_prior.h"
@@ -87,13 +88,7 @@ std::string PhotoLocalizationJson(const PhotoLocalization& photo) {
   JsonWriter json;
   json.BeginObject().Key("image").String(photo.image).Key("registered").Bool(r.registered);
   if (r.registered) {
-    json.Key("cam_from_world").BeginObject().Key("R").BeginArray();
-    for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 3; ++col) json.Double(r.cam_from_world.rotation(row, col));
-    }
-    json.EndArray().Key("t").BeginArray();
-    for (int k = 0; k < 3; ++k) json.Double(r.cam_from_world.translation(k));
-    json.EndArray().EndObject();
+    WriteRigid3Json(json.Key("cam_from_world"), r.cam_from_world);
     json.Key("camera").BeginObject().Key("width").Int(photo.width).Key("height").Int(photo.height);
     json.Key("fx").Double(r.camera.focal).Key("fy").Double(r.camera.fy()).Key("cx").Double(r.camera.cx);
     json.Key("cy").Double(r.camera.cy).Key("k1").Double(r.camera.k1).Key("k2").Double(r.camera.k2);

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/base/json_writer.h"
+#include "core/math/rigid3_json.h"
 #include "core/geometry/triangulation.h"
 #include "core/sfm/tag_layout.h"
 
@@ -324,13 +325,7 @@ std::string TagRegistrationJson(const TagRegistrationReport& report, const std::
     for (double e : tag.edges_m) json.Double(e);
     json.EndArray();
     json.Key("rms_reprojection_px").Double(tag.rms_reprojection_px);
-    json.Key("world_from_tag").BeginObject().Key("R").BeginArray();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) json.Double(tag.world_from_tag.rotation(r, c));
-    }
-    json.EndArray().Key("t").BeginArray();
-    for (int r = 0; r < 3; ++r) json.Double(tag.world_from_tag.translation[r]);
-    json.EndArray().EndObject();
+    WriteRigid3Json(json.Key("world_from_tag"), tag.world_from_tag);
     json.EndObject();
   }
   json.EndArray();

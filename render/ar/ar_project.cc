@@ -11,7 +11,7 @@
 
 namespace reconar {
 
-Result<ArProject> LoadArProject(const std::string& dir) {
+Result<ArProject> LoadArProject(const std::string& dir, const ArProjectOptions& options) {
   const Project project(dir);
   ArProject scene;
   for (const std::string& path :
@@ -38,6 +38,15 @@ Result<ArProject> LoadArProject(const std::string& dir) {
   RECONAR_ASSIGN_OR_RETURN(scene.layout, ReadTagLayout(project.TagLayoutPath()));
   if (auto model = ReadColmapTextModel(project.SparseDir()); model.ok() && !model->cameras.empty()) {
     scene.photo_intrinsics = model->cameras.front().Intrinsics();
+  }
+  std::error_code error;
+  if (options.load_map && std::filesystem::exists(project.MapPath(), error)) {
+    RECONAR_ASSIGN_OR_RETURN(LocalizationMap map, ReadLocalizationMap(project.MapPath()));
+    if (!map.metric) {
+      return FailedPrecondition(project.MapPath() + ": the map is not in the tags' metric frame (it is '" + map.frame +
+                                "'); rebuild it with `reconar map " + dir + "`");
+    }
+    scene.map = std::make_shared<const LocalizationMap>(std::move(map));
   }
   return scene;
 }

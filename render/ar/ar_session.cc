@@ -17,13 +17,17 @@ Result<std::unique_ptr<ArSession>> ArSession::Open(const ArSessionOptions& optio
   session->first_frame_pending_ = true;
   session->width_ = session->frame_->width;
   session->height_ = session->frame_->height;
-  TagPoseSourceOptions pose_options = options.pose;
+  FusedPoseSourceOptions pose_options;
+  pose_options.tags = options.pose;
   if (options.scale_intrinsics_to_video) {
     RECONAR_ASSIGN_OR_RETURN(
-        pose_options.tracker.intrinsics,
-        ScaleIntrinsicsToFrame(pose_options.tracker.intrinsics, session->width_, session->height_));
+        pose_options.tags.tracker.intrinsics,
+        ScaleIntrinsicsToFrame(pose_options.tags.tracker.intrinsics, session->width_, session->height_));
   }
-  RECONAR_ASSIGN_OR_RETURN(session->pose_source_, TagPoseSource::Create(pose_options));
+  session->map_ = options.map;
+  pose_options.map = session->map_.get();
+  pose_options.map_tracking = options.map_tracking;
+  RECONAR_ASSIGN_OR_RETURN(session->pose_source_, FusedPoseSource::Create(pose_options));
   return session;
 }
 

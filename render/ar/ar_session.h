@@ -1,6 +1,6 @@
 #pragma once
-// ArSession: the AR runtime's loop over a video, joining a FrameSource (platform/camera) and a
-// pose source (tracker/tag_pose_source.h). Open() opens the source, reads the first frame (its size
+// ArSession: the AR runtime's loop over a video, joining a FrameSource (platform/camera) and the
+// pose source (tracker/fused_pose_source.h: the tags, and a project's map when one is given). Open() opens the source, reads the first frame (its size
 // fixes the camera's), scales the project camera to it when asked, and creates the pose source.
 // Each Step() gives the previous frame back, takes the next one and finds its pose:
 //
@@ -21,6 +21,8 @@
 #include "core/base/status.h"
 #include "core/math/camera_intrinsics.h"
 #include "platform/camera/frame_source.h"
+#include "core/sfm/localization_map.h"
+#include "tracker/fused_pose_source.h"
 #include "tracker/pose_source.h"
 #include "tracker/tag_pose_source.h"
 
@@ -33,13 +35,17 @@ struct ArSessionOptions {
   // pose.tracker.intrinsics are the photos' camera: scale them to the video's frame size
   // (ScaleIntrinsicsToFrame, core/math/camera_intrinsics.h).
   bool scale_intrinsics_to_video = false;
+  // A project's localisation map (in the world frame of pose.layout): frames are also posed from
+  // it, and without tags in view by it alone. nullptr: tags only.
+  std::shared_ptr<const LocalizationMap> map;
+  MapTrackerOptions map_tracking;  // its intrinsics are the tags' (scaled with them)
   int max_frames = 0;  // Step() ends after this many frames (0: at the end of the stream)
 };
 
 class ArSession {
  public:
   // Errors of the source, "SOURCE: no frames" (FailedPrecondition) for an empty stream, errors of
-  // scaling the intrinsics and of TagPoseSource::Create.
+  // scaling the intrinsics and of FusedPoseSource::Create.
   static Result<std::unique_ptr<ArSession>> Open(const ArSessionOptions& options);
   ~ArSession();
 
@@ -49,8 +55,10 @@ class ArSession {
 
   const Frame& frame() const { return *frame_; }
   const WorldPose& pose() const { return pose_; }
-  const TagPoseSource& tags() const { return *pose_source_; }
-  const CameraIntrinsics& intrinsics() const { return pose_source_->options().tracker.intrinsics; }
+  const TagPoseSource& tags() const { return pose_source_->tags(); }
+  // Which sources posed the frame, and the map tracker's report.
+  const FusedPoseSource& sources() const { return *pose_source_; }
+  const CameraIntrinsics& intrinsics() const { return pose_source_->options().tags.tracker.intrinsics; }
   int width() const { return width_; }  // of the first frame
   int height() const { return height_; }
   long frames() const { return frames_; }  // frames stepped through so far
@@ -65,7 +73,8 @@ class ArSession {
   std::unique_ptr<FrameSource> source_;  // outlives frame_ (members are destroyed in reverse order)
   FrameHandle frame_;
   bool first_frame_pending_ = false;
-  std::unique_ptr<TagPoseSource> pose_source_;
+  std::shared_ptr<const LocalizationMap> map_;  // outlives pose_source_
+  std::unique_ptr<FusedPoseSource> pose_source_;
   WorldPose pose_;
   int width_ = 0;
   int height_ = 0;

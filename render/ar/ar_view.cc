@@ -100,7 +100,7 @@ Status ArView::Draw(bool* drawn_model) {
   return Status::Ok();
 }
 
-Result<ArViewReport> ArView::Run(const std::function<void(long frames)>& progress) {
+Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& session)>& each_frame) {
   const bool to_files = !options_.out_dir.empty();
   std::vector<double> track_ms, render_ms, frame_ms;
   ArViewReport report;
@@ -112,6 +112,7 @@ Result<ArViewReport> ArView::Run(const std::function<void(long frames)>& progres
     bool drawn_model = false;
     Status drawn = Draw(&drawn_model);
     if (drawn_model) ++report.frames_with_model;
+    ++report.frames_by_source[static_cast<int>(session_->sources().source())];
     if (drawn.ok()) {
       if (to_files) {
         drawn = renderer_->ReadRgb(&rgb_);
@@ -126,7 +127,7 @@ Result<ArViewReport> ArView::Run(const std::function<void(long frames)>& progres
     if (!drawn.ok()) return drawn.WithContext(name);
     if (to_files) RECONAR_RETURN_IF_ERROR(WritePng(options_.out_dir + "/" + name, rgb_.view(), 3));
     ++report.frames;
-    if (progress) progress(report.frames);
+    if (each_frame) each_frame(*session_);
     if (!to_files && context_->PollEvents().should_quit()) break;
   }
   report.median_track_ms = Median(track_ms);

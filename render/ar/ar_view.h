@@ -35,6 +35,8 @@ struct ArViewOptions {
 struct ArViewReport {
   long frames = 0;
   long frames_with_model = 0;
+  // Frames by the source of their pose (FusedPoseSource): indexed by PoseSourceKind.
+  long frames_by_source[4] = {0, 0, 0, 0};
   // Medians over the frames, milliseconds: pose (tracking), drawing (with the readback when
   // writing PNGs), and both.
   double median_track_ms = 0.0;
@@ -52,8 +54,9 @@ class ArView {
   // "SOURCE; EGL-ROUTE RENDERER; model MODEL_NAME (N vertices, M triangles)".
   std::string Describe(const std::string& model_name) const;
   // Every frame until the stream ends, max_frames, or the window is closed ('q', Escape).
-  // `progress` (if set) is called with the frame count after each frame.
-  Result<ArViewReport> Run(const std::function<void(long frames)>& progress = nullptr);
+  // `each_frame` (if set) is called after each frame is drawn, with the session (the frame, its
+  // pose and its sources).
+  Result<ArViewReport> Run(const std::function<void(const ArSession& session)>& each_frame = nullptr);
 
  private:
   ArView(const ArViewOptions& options, std::unique_ptr<ArSession> session, std::unique_ptr<EglContext> context,

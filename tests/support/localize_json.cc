@@ -63,7 +63,67 @@ Result<LocalizedPhoto> ParseLine(const JsonValue& json) {
   return photo;
 }
 
+Result<TrackedFrame> ParseFrame(const JsonValue& json) {
+  TrackedFrame frame;
+  const JsonValue* name = json.Find("frame");
+  const JsonValue* tags = json.Find("tags");
+  const JsonValue* ms = NumberAt(json, "ms");
+  if (name == nullptr || !name->is_string() || tags == nullptr || !tags->is_array() || ms == nullptr)
+    return CorruptData("\"frame\", \"tags\" or \"ms\" missing");
+  frame.frame = name->string();
+  frame.ms = ms->number();
+  for (size_t i = 0; i < tags->size(); ++i) {
+    const JsonValue& tag = (*tags)[i];
+    const JsonValue* id = NumberAt(tag, "id");
+    const JsonValue* corners = tag.is_object() ? tag.Find("corners") : nullptr;
+    if (id == nullptr || corners == nullptr || !corners->is_array() || corners->size() != 4)
+      return CorruptData("a tag without \"id\" or four \"corners\"");
+    TrackedFrameTag out;
+    out.id = static_cast<int>(id->number());
+    for (size_t k = 0; k < 4; ++k) {
+      const JsonValue& corner = (*corners)[k];
+      if (!corner.is_array() || corner.size() != 2 || !corner[0].is_number() || !corner[1].is_number())
+        return CorruptData("a tag corner that is not [x, y]");
+      out.corners[k] = Eigen::Vector2d(corner[0].number(), corner[1].number());
+    }
+    frame.tags.push_back(out);
+  }
+  const JsonValue* source = json.Find("source");
+  if (source == nullptr) return frame;
+  const JsonValue* state = json.Find("state");
+  const JsonValue* inliers = NumberAt(json, "map_inliers");
+  if (!source->is_string() || state == nullptr || !state->is_string() || inliers == nullptr)
+    return CorruptData("\"source\" without \"state\" or \"map_inliers\"");
+  frame.source = source->string();
+  frame.state = state->string();
+  frame.map_inliers = static_cast<int>(inliers->number());
+  if (const JsonValue* pose = json.Find("cam_from_world")) {
+    double rotation[9], translation[3];
+    if (!ReadNumbers(*pose, "R", 9, rotation) || !ReadNumbers(*pose, "t", 3, translation))
+      return CorruptData("\"cam_from_world\" without R [9] and t [3]");
+    for (int i = 0; i < 9; ++i) frame.R(i / 3, i % 3) = rotation[i];
+    for (int i = 0; i < 3; ++i) frame.t(i) = translation[i];
+    frame.has_pose = true;
+  }
+  return frame;
+}
+
 }  // namespace
+
+Result<std::vector<TrackedFrame>> ParseTrackJson(const std::string& output) {
+  std::vector<TrackedFrame> frames;
+  std::istringstream lines(output);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] != '{') continue;
+    RECONAR_ASSIGN_OR_RETURN(const JsonValue json, ParseJson(line, "track --json"));
+    if (!json.is_object()) return CorruptData("track --json: a line that is not an object: " + line);
+    auto frame = ParseFrame(json);
+    if (!frame.ok()) return CorruptData("track --json: " + frame.status().message() + ": " + line);
+    frames.push_back(std::move(*frame));
+  }
+  return frames;
+}
 
 Result<std::map<std::string, LocalizedPhoto>> ParseLocalizeJson(const std::string& output) {
   std::map<std::string, LocalizedPhoto> result;

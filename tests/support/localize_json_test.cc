@@ -46,5 +46,48 @@ TEST(LocalizeJson, RefusesBrokenLines) {
   }
 }
 
+constexpr char kTrackedWithMap[] =
+    R"({"frame": "f1.png", "tags": [{"id": 3, "corners": [[1, 2], [3, 4], [5, 6], [7, 8]], "cam_from_tag": )"
+    R"({"R": [1, 0, 0, 0, 1, 0, 0, 0, 1], "t": [0, 0, 1]}, "rms_px": 0.2, "reacquired": false}], "source": "map", )"
+    R"("state": "tracking", "cam_from_world": {"R": [1, 0, 0, 0, 1, 0, 0, 0, 1], "t": [4, 5, 6]}, )"
+    R"("map_inliers": 120, "relocalised": false, "fused_map_points": 0, "search": "regions", "ms": 7.5})";
+constexpr char kTrackedTagsOnly[] = R"({"frame": "f2.png", "tags": [], "search": "full_frame", "ms": 3})";
+
+TEST(TrackJson, ReadsFramesWithAndWithoutAMap) {
+  auto parsed = testing::ParseTrackJson(std::string("note\n") + kTrackedWithMap + "\n" + kTrackedTagsOnly + "\n");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
+  ASSERT_EQ(parsed->size(), 2u);
+  const testing::TrackedFrame& a = (*parsed)[0];
+  EXPECT_EQ(a.frame, "f1.png");
+  ASSERT_EQ(a.tags.size(), 1u);
+  EXPECT_EQ(a.tags[0].id, 3);
+  EXPECT_EQ(a.tags[0].corners[3], Eigen::Vector2d(7, 8));
+  EXPECT_EQ(a.source, "map");
+  EXPECT_EQ(a.state, "tracking");
+  EXPECT_TRUE(a.has_pose);
+  EXPECT_EQ(a.t, Eigen::Vector3d(4, 5, 6));
+  EXPECT_EQ(a.map_inliers, 120);
+  EXPECT_DOUBLE_EQ(a.ms, 7.5);
+  const testing::TrackedFrame& b = (*parsed)[1];
+  EXPECT_TRUE(b.tags.empty());
+  EXPECT_TRUE(b.source.empty());
+  EXPECT_FALSE(b.has_pose);
+}
+
+TEST(TrackJson, RefusesBrokenLines) {
+  const std::string with_map = kTrackedWithMap;
+  for (const std::string& line :
+       {std::string(R"({"frame": "f.png", "ms": 1})"), std::string(R"({"tags": [], "ms": 1})"),
+        with_map.substr(0, with_map.find("\"state\"")) + R"("map_inliers": 1, "ms": 1})",
+        std::string(with_map).replace(with_map.find("[4, 5, 6]"), 9, "[4, 5]"),
+        std::string(with_map).replace(with_map.find("[7, 8]"), 6, "[7]")}) {
+    const auto parsed = testing::ParseTrackJson(line);
+    EXPECT_FALSE(parsed.ok()) << line;
+    if (!parsed.ok()) {
+      EXPECT_EQ(parsed.status().code(), StatusCode::kCorruptData) << parsed.status().ToString();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace reconar

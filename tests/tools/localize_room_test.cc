@@ -8,7 +8,13 @@
 //     (printed, not yet asserted: see where it is measured);
 //   - AR: the map's tag corners, projected with the localised pose and camera, land within 5 px of
 //     the painted-out tag's corners detected in the original photo;
-//   - wrong scene: Strecha fountain-P11's photos against the room's map register none.
+//   - wrong scene: Strecha fountain-P11's photos against the room's map register none;
+//   - `reconar view --project` over the 36 painted photos as one sequence: every frame the map
+//     poses has the model's tag corners within 5 px of the painted-out tags, and it poses at least
+//     the photos `reconar localize` does; over the map's own photos (tags visible) the frames with
+//     tags are posed by the tags (with the map), and the sources are printed;
+//   - tags found while tracking: `reconar track --project` over the 72 photos as one sequence
+//     finds at least as many tag instances as full-frame detection at decimation 1.
 // How many localise is printed (the issue compares it with the 14 of 72 that structure from
 // motion registers from the painted photos alone); at least one must, so the test can fail.
 // Printed beside the bars, to tell localisation errors from disagreement between the two
@@ -27,6 +33,7 @@
 #include <vector>
 
 #include "core/base/json_reader.h"
+#include "core/math/radial_camera.h"
 #include "core/sfm/model_io.h"
 #include "tests/support/ground_truth.h"
 #include "tests/support/localize_json.h"
@@ -289,6 +296,96 @@ TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
               kMaxCornerErrorPx);
   for (const std::string& image : corners_beyond_bar) ADD_FAILURE() << image << ": a tag corner beyond 5 px";
   EXPECT_GE(localized, 1);
+
+  // AR: `reconar view --project` over the 36 painted photos as one sequence draws the model on
+  // every photo the map poses; its tag corners through the view's pose and camera (the project's
+  // camera: the painted photos have the photos' size) land within 5 px of the painted-out tags.
+  const fs::path overlays = root / "overlays";
+  const testing::CommandRun view =
+      TimedReconar("view --project " + map_project.string() + " --frames " + painted_dir.string() + " --out " +
+                       overlays.string() + " --json",
+                   "view --project over the 36 painted photos", testing::StderrMode::kSeparate);
+  ASSERT_EQ(view.exit_code, 0) << view.output << view.error;
+  std::printf("%s", view.error.c_str());
+  auto viewed = testing::ParseTrackJson(view.output);
+  ASSERT_TRUE(viewed.ok()) << viewed.status().ToString();
+  ASSERT_EQ(viewed->size(), query_names.size()) << view.output;
+  const RadialCamera view_camera = map_model->cameras.front().Intrinsics().Camera();
+  int posed_by_map = 0;
+  std::vector<double> view_corner_errors;
+  for (const testing::TrackedFrame& frame : *viewed) {
+    EXPECT_TRUE(frame.tags.empty()) << frame.frame << ": a painted-out tag was detected";
+    EXPECT_TRUE(fs::exists(overlays / (Stem(frame.frame) + ".png"))) << frame.frame;
+    if (!frame.has_pose) continue;
+    EXPECT_EQ(frame.source, "map") << frame.frame;
+    ++posed_by_map;
+    double worst = 0.0;
+    for (const TagDetection& tag : original_tags.at(Stem(frame.frame))) {
+      const auto world = map_tags->corners.find(tag.id);
+      if (world == map_tags->corners.end()) continue;
+      for (size_t k = 0; k < 4; ++k) {
+        const Eigen::Vector3d in_camera = frame.R * world->second[k] + frame.t;
+        if (!(in_camera.z() > 0.0)) continue;
+        const double error = (view_camera.Project(in_camera) - tag.corners[k]).norm();
+        view_corner_errors.push_back(error);
+        worst = std::max(worst, error);
+      }
+    }
+    std::printf("view %s: posed by the map (%s, %d inliers); tag corners max %.2f px\n", frame.frame.c_str(),
+                frame.state.c_str(), frame.map_inliers, worst);
+    EXPECT_LE(worst, kMaxCornerErrorPx) << frame.frame;
+  }
+  std::printf("view --project: %d of %zu painted photos posed by the map; %zu tag corners, median %.2f px, max %.2f px\n",
+              posed_by_map, viewed->size(), view_corner_errors.size(), testing::Median(view_corner_errors),
+              MaxOf(view_corner_errors));
+  EXPECT_GE(posed_by_map, localized) << "the view poses fewer photos than `reconar localize` does";
+
+  // The map's own photos with their tags: tags and map together, and the frames say which posed them.
+  const testing::CommandRun view_tags =
+      TimedReconar("view --project " + map_project.string() + " --frames " + map_photos.string() + " --out " +
+                       (root / "overlays_with_tags").string() + " --json",
+                   "view --project over the 36 map photos", testing::StderrMode::kSeparate);
+  ASSERT_EQ(view_tags.exit_code, 0) << view_tags.output << view_tags.error;
+  std::printf("%s", view_tags.error.c_str());
+  auto with_tags = testing::ParseTrackJson(view_tags.output);
+  ASSERT_TRUE(with_tags.ok()) << with_tags.status().ToString();
+  ASSERT_EQ(with_tags->size(), map_names.size());
+  std::map<std::string, int> by_source;
+  for (const testing::TrackedFrame& frame : *with_tags) {
+    ++by_source[frame.source];
+    if (!frame.tags.empty()) {
+      EXPECT_NE(frame.source.find("tags"), std::string::npos) << frame.frame << ": tags in view but posed by "
+                                                               << frame.source;
+    }
+  }
+  for (const auto& [source, count] : by_source) std::printf("map photos posed by %s: %d\n", source.c_str(), count);
+
+  // Tags found while tracking: `reconar track --project` over the 72 photos in name order as one
+  // sequence finds at least as many tag instances as full-frame detection of every photo at
+  // full resolution (decimation 1), ids seen twice in a photo left out as both drop them.
+  std::vector<std::string> all_paths;
+  for (const std::string& name : names) all_paths.push_back(data + "/" + name);
+  PhotoTagOptions full_frame;
+  full_frame.show_progress = false;
+  full_frame.num_threads = 2;
+  PhotoTagReport full_frame_report;
+  auto detected = DetectTagsInPhotos(all_paths, full_frame, &full_frame_report);
+  ASSERT_TRUE(detected.ok()) << detected.status().ToString();
+  const testing::CommandRun track =
+      TimedReconar("track " + data + " --project " + full_project.string() + " --json",
+                   "track --project over the 72 photos", testing::StderrMode::kSeparate);
+  ASSERT_EQ(track.exit_code, 0) << track.output << track.error;
+  std::printf("%s", track.error.c_str());
+  auto tracked = testing::ParseTrackJson(track.output);
+  ASSERT_TRUE(tracked.ok()) << tracked.status().ToString();
+  ASSERT_EQ(tracked->size(), names.size());
+  int tracked_instances = 0;
+  for (const testing::TrackedFrame& frame : *tracked) tracked_instances += static_cast<int>(frame.tags.size());
+  const int full_frame_instances = full_frame_report.detections;  // duplicates already dropped
+  std::printf("tags while tracking: %d tag instances in the 72 photos; full-frame detection at decimation 1: %d "
+              "(%d with the ids seen twice)\n",
+              tracked_instances, full_frame_instances, full_frame_instances + full_frame_report.duplicates_dropped);
+  EXPECT_GE(tracked_instances, full_frame_instances);
 
   // A wrong scene: none of fountain-P11's photos may register against the room's map.
   const testing::CommandRun fountain =
