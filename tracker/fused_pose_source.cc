@@ -61,7 +61,12 @@ Status FusedPoseSource::Track(ImageView<const uint8_t> gray, WorldPose* pose) {
     return Status::Ok();
   }
   RECONAR_RETURN_IF_ERROR(tags_->Track(gray, has_previous_ ? &previous_cam_from_world_ : nullptr, &tag_pose_));
-  RECONAR_RETURN_IF_ERROR(map_->Track(gray, tag_pose_.found ? &tag_pose_.cam_from_world : nullptr, &map_report_));
+  // The tags' pose restarts a map tracker that has lost the map without a relocalisation; a restart
+  // that did not take (the next frame has no map pose: photos far apart rather than a video) is
+  // followed by a relocalisation.
+  const bool restart_failed = map_report_.from_prior && !map_report_.found;
+  const Rigid3* map_prior = tag_pose_.found && !restart_failed ? &tag_pose_.cam_from_world : nullptr;
+  RECONAR_RETURN_IF_ERROR(map_->Track(gray, map_prior, &map_report_));
 
   pose->found = false;
   pose->anchors_used = 0;

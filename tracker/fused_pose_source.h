@@ -6,7 +6,8 @@
 //     pose, else the previous frame's pose, predicts them (TagPoseSource's prior);
 //  2. the map tracker tracks the camera against the map with the tags' pose of this frame as its
 //     prior when there is one (its prediction, and a restart without relocalisation when it had
-//     lost the map), else by itself, relocalising when it has lost the map;
+//     lost the map, unless such a restart failed on the previous frame), else by itself,
+//     relocalising when it has lost the map;
 //  3. the pose: with tags and map, one robust refinement (Huber, core/geometry/absolute_pose.h)
 //     from the tags' board pose over the tag corners and the map inliers that agree with that pose
 //     within fusion_max_error_px. The tags keep the metric anchor (a map that disagrees with them
