@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "core/base/elapsed.h"
 #include "core/base/prng.h"
 #include "core/geometry/absolute_pose.h"
 #include "core/math/rotation.h"
@@ -15,10 +16,6 @@ namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // The pixel of a world point, false when it is not in front of the camera.
 bool ProjectPoint(const RadialCamera& camera, const Rigid3& cam_from_world, const Eigen::Vector3d& world,
@@ -291,7 +288,7 @@ Status MapTracker::Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameRepo
   }
   RECONAR_ASSIGN_OR_RETURN(const SiftFeatures features, sift_->Extract(sift_image_.view()));
   RECONAR_ASSIGN_OR_RETURN(const LocalizationResult result, localizer_.Localize(features, query_camera_));
-  report->relocalise_ms = MillisecondsSince(start);
+  report->relocalise_ms = 1000.0 * SecondsSince(start);
   if (!result.registered) return Status::Ok();
   // Every inlier is followed from its keypoint (best first up to the capacity: the localizer's
   // order is by map point id, which is as good as any).
@@ -478,7 +475,7 @@ Status MapTracker::Track(ImageView<const uint8_t> gray, const Rigid3* prior_cam_
   }
   have_previous_frame_ = true;
   report->state = state_;
-  report->track_ms = MillisecondsSince(start);
+  report->track_ms = 1000.0 * SecondsSince(start);
   return Status::Ok();
 }
 
