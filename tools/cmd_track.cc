@@ -29,7 +29,8 @@ constexpr char kHelp[] =
     "  --layout FILE         multi-tag layout (tag_layout.h format): also prints the layout's pose\n"
     "                        (\"cam_from_layout\"), and searches the layout's tags not found yet where\n"
     "                        that pose puts them (\"predicted\": regions searched, tags found;\n"
-    "                        \"predicted\": true on a tag found so)\n"
+    "                        \"predicted\": true on a tag found so); --max-tags is raised to the\n"
+    "                        layout's tag count\n"
     "  --max-frames N        stop after N frames\n"
     "  --json                JSON lines on stdout\n";
 
