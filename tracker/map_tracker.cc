@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "core/base/elapsed.h"
 #include "core/base/prng.h"
 #include "core/geometry/absolute_pose.h"
 #include "core/math/rotation.h"
@@ -15,10 +16,6 @@ namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // The pixel of a world point, false when it is not in front of the camera.
 bool ProjectPoint(const RadialCamera& camera, const Rigid3& cam_from_world, const Eigen::Vector3d& world,
@@ -69,6 +66,8 @@ Status MapTrackerOptions::Check() const {
     return InvalidArgument("MapTrackerOptions.max_view_angle_deg must be in (0, 180]");
   }
   if (border_px < 0) return InvalidArgument("MapTrackerOptions.border_px must be >= 0");
+  if (!(max_anchor_shift_px > 0.0)) return InvalidArgument("MapTrackerOptions.max_anchor_shift_px must be > 0");
+  if (reanchor_interval < 0) return InvalidArgument("MapTrackerOptions.reanchor_interval must be >= 0");
   return Status::Ok();
 }
 
@@ -110,6 +109,13 @@ Result<std::unique_ptr<MapTracker>> MapTracker::Create(const LocalizationMap* ma
   const size_t capacity = static_cast<size_t>(options.max_tracked_points);
   tracker->track_point_.resize(capacity);
   tracker->track_pixel_.resize(capacity);
+  tracker->track_slot_.resize(capacity);
+  tracker->corr_slot_.resize(capacity);
+  tracker->free_slots_.resize(capacity);
+  tracker->slot_used_.resize(capacity);
+  tracker->template_floats_ = FlowTemplateFloats(options.flow.window_radius);
+  tracker->templates_.resize(capacity * static_cast<size_t>(tracker->template_floats_));
+  tracker->RebuildFreeSlots();
   tracker->guesses_.resize(capacity);
   tracker->flow_.resize(capacity);
   tracker->pixels_.resize(capacity);
@@ -184,6 +190,7 @@ int MapTracker::RefineAndGate(int count, Rigid3* pose, double* rms) {
     pixels_[d] = pixels_[s];
     world_[d] = world_[s];
     corr_point_[d] = corr_point_[s];
+    corr_slot_[d] = corr_slot_[s];
   }
   pose->rotation = R;
   pose->translation = t;
@@ -205,15 +212,33 @@ bool MapTracker::TrackFrame(const Rigid3& predicted, MapTrackerFrameReport* repo
   if (!TrackPoints(previous, next, options_.flow, track_pixel_.data(), guesses_.data(), n, flow_.data()).ok()) {
     return false;
   }
-  int count = 0;
+  // The flow's result is refined against the point's template from its first sighting (no drift),
+  // and kept only when both agree.
+  const double max_shift2 = options_.max_anchor_shift_px * options_.max_anchor_shift_px;
   for (int i = 0; i < n; ++i) {
     const size_t s = static_cast<size_t>(i);
-    if (flow_[s].status != FlowStatus::kTracked) continue;
-    const size_t d = static_cast<size_t>(count++);
-    pixels_[d] = flow_[s].point.cast<double>();
-    world_[d] = map_->points[static_cast<size_t>(track_point_[s])];
-    corr_point_[d] = track_point_[s];
+    if (flow_[s].status != FlowStatus::kTracked || !options_.anchor_to_first_sighting) continue;
+    const FlowResult anchored = AlignFlowTemplate(next, TemplateOf(track_slot_[s]), flow_[s].point, options_.flow);
+    if (anchored.status != FlowStatus::kTracked || (anchored.point - flow_[s].point).squaredNorm() > max_shift2) {
+      flow_[s].status = FlowStatus::kLargeError;
+    } else {
+      flow_[s].point = anchored.point;
+    }
   }
+  const auto collect = [&]() {
+    int count = 0;
+    for (int i = 0; i < n; ++i) {
+      const size_t s = static_cast<size_t>(i);
+      if (flow_[s].status != FlowStatus::kTracked) continue;
+      const size_t d = static_cast<size_t>(count++);
+      pixels_[d] = flow_[s].point.cast<double>();
+      world_[d] = map_->points[static_cast<size_t>(track_point_[s])];
+      corr_point_[d] = track_point_[s];
+      corr_slot_[d] = track_slot_[s];
+    }
+    return count;
+  };
+  int count = collect();
   report->tracked_points = count;
   const int needed = std::max(options_.min_inliers, 4);
   if (count < needed) return false;
@@ -232,15 +257,7 @@ bool MapTracker::TrackFrame(const Rigid3& predicted, MapTrackerFrameReport* repo
     const Result<AbsolutePoseResult> estimate = EstimateAbsolutePose(pixels, world, camera_, ransac);
     if (!estimate.ok() || !estimate->success()) return false;
     // The correspondences were compacted by RefineAndGate: restore them from the flow.
-    count = 0;
-    for (int i = 0; i < n; ++i) {
-      const size_t s = static_cast<size_t>(i);
-      if (flow_[s].status != FlowStatus::kTracked) continue;
-      const size_t d = static_cast<size_t>(count++);
-      pixels_[d] = flow_[s].point.cast<double>();
-      world_[d] = map_->points[static_cast<size_t>(track_point_[s])];
-      corr_point_[d] = track_point_[s];
-    }
+    count = collect();
     pose = estimate->cam_from_world;
     inliers = RefineAndGate(count, &pose, &rms);
     report->ransac_fallback = true;
@@ -251,8 +268,10 @@ bool MapTracker::TrackFrame(const Rigid3& predicted, MapTrackerFrameReport* repo
     const size_t s = static_cast<size_t>(i);
     track_point_[s] = corr_point_[s];
     track_pixel_[s] = pixels_[s].cast<float>();
+    track_slot_[s] = corr_slot_[s];
   }
   num_tracks_ = inliers;
+  RebuildFreeSlots();
   report->cam_from_world = pose;
   report->inliers = inliers;
   report->rms_reprojection_px = rms;
@@ -269,13 +288,15 @@ Status MapTracker::Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameRepo
   }
   RECONAR_ASSIGN_OR_RETURN(const SiftFeatures features, sift_->Extract(sift_image_.view()));
   RECONAR_ASSIGN_OR_RETURN(const LocalizationResult result, localizer_.Localize(features, query_camera_));
-  report->relocalise_ms = MillisecondsSince(start);
+  report->relocalise_ms = 1000.0 * SecondsSince(start);
   if (!result.registered) return Status::Ok();
   // Every inlier is followed from its keypoint (best first up to the capacity: the localizer's
   // order is by map point id, which is as good as any).
   const double max_squared = options_.max_error_px * options_.max_error_px;
   int count = 0;
   double sum = 0.0;
+  num_tracks_ = 0;  // the followed points are replaced by the relocalisation's
+  RebuildFreeSlots();
   for (size_t i = 0; i < result.inlier_points.size() && count < options_.max_tracked_points; ++i) {
     const SiftKeypoint& keypoint = features.keypoints[static_cast<size_t>(result.inlier_keypoints[i])];
     const int32_t point = result.inlier_points[i];
@@ -284,16 +305,13 @@ Status MapTracker::Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameRepo
     const Eigen::Vector3d& world = map_->points[static_cast<size_t>(point)];
     const double squared =
         SquaredPixelError(camera_, result.cam_from_world.rotation, result.cam_from_world.translation, world, pixel);
-    if (!(squared < max_squared)) continue;
+    if (!(squared < max_squared) || !AddTrack(point, pixel.cast<float>())) continue;
     sum += squared;
     const size_t d = static_cast<size_t>(count++);
     pixels_[d] = pixel;
     world_[d] = world;
-    track_point_[d] = point;
-    track_pixel_[d] = pixel.cast<float>();
     followed_in_frame_[static_cast<size_t>(point)] = frame_index_;
   }
-  num_tracks_ = count;
   report->found = true;
   report->relocalised = true;
   report->cam_from_world = result.cam_from_world;
@@ -302,7 +320,29 @@ Status MapTracker::Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameRepo
   return Status::Ok();
 }
 
+void MapTracker::RebuildFreeSlots() {
+  std::fill(slot_used_.begin(), slot_used_.end(), 0);
+  for (int i = 0; i < num_tracks_; ++i) slot_used_[static_cast<size_t>(track_slot_[static_cast<size_t>(i)])] = 1;
+  num_free_ = 0;
+  for (size_t slot = slot_used_.size(); slot-- > 0;) {
+    if (!slot_used_[slot]) free_slots_[static_cast<size_t>(num_free_++)] = static_cast<int32_t>(slot);
+  }
+}
+
+bool MapTracker::AddTrack(int32_t point, const Eigen::Vector2f& pixel) {
+  if (num_free_ == 0 || num_tracks_ >= options_.max_tracked_points) return false;
+  const int32_t slot = free_slots_[static_cast<size_t>(num_free_ - 1)];
+  if (!MakeFlowTemplate(pyramids_[current_], pixel, options_.flow, TemplateOf(slot))) return false;
+  --num_free_;
+  const size_t d = static_cast<size_t>(num_tracks_++);
+  track_point_[d] = point;
+  track_pixel_[d] = pixel;
+  track_slot_[d] = slot;
+  return true;
+}
+
 int MapTracker::Seed(const Rigid3& cam_from_world) {
+  RebuildFreeSlots();
   std::fill(grid_.begin(), grid_.end(), 0);
   const int cell = options_.grid_cell_px;
   const auto cell_of = [&](const Eigen::Vector2f& p) {
@@ -332,11 +372,8 @@ int MapTracker::Seed(const Rigid3& cam_from_world) {
     if (!(ray.dot(view_direction_[p]) >= min_cos)) continue;
     const Eigen::Vector2f at = pixel.cast<float>();
     const size_t c = cell_of(at);
-    if (grid_[c]) continue;
+    if (grid_[c] || !AddTrack(point, at)) continue;
     grid_[c] = 1;
-    const size_t d = static_cast<size_t>(num_tracks_++);
-    track_point_[d] = point;
-    track_pixel_[d] = at;
     followed_in_frame_[p] = frame_index_;
     ++seeded;
   }
@@ -379,7 +416,16 @@ Status MapTracker::Track(ImageView<const uint8_t> gray, const Rigid3* prior_cam_
   // motion model (or a prior that is not quite orthonormal) must not accumulate.
   if (predicted) predicted->rotation = NearestRotation(predicted->rotation);
   bool found = false;
-  if (num_tracks_ > 0 && have_previous_frame_ && predicted) found = TrackFrame(*predicted, report);
+  const bool can_track = num_tracks_ > 0 && have_previous_frame_ && predicted;
+  if (can_track && options_.reanchor_interval > 0 && prior_cam_from_world == nullptr &&
+      frames_since_relocalisation_ >= options_.reanchor_interval) {
+    // Re-anchoring: the followed points are replaced by the relocalisation's SIFT matches; tracking
+    // stays the fallback when it fails.
+    RECONAR_RETURN_IF_ERROR(Relocalise(gray, report));
+    found = report->found;
+    if (!found) frames_since_relocalisation_ = 0;  // next try after another interval
+  }
+  if (!found && can_track) found = TrackFrame(*predicted, report);
   if (found) {
     report->found = true;
   } else {
@@ -405,6 +451,7 @@ Status MapTracker::Track(ImageView<const uint8_t> gray, const Rigid3* prior_cam_
       report->inlier_pixels.push_back(pixels_[static_cast<size_t>(i)]);
       report->inlier_world_points.push_back(world_[static_cast<size_t>(i)]);
     }
+    frames_since_relocalisation_ = report->relocalised ? 0 : frames_since_relocalisation_ + 1;
     previous_pose_ = last_pose_;
     have_previous_pose_ = have_last_pose_;
     last_pose_ = report->cam_from_world;
@@ -428,7 +475,7 @@ Status MapTracker::Track(ImageView<const uint8_t> gray, const Rigid3* prior_cam_
   }
   have_previous_frame_ = true;
   report->state = state_;
-  report->track_ms = MillisecondsSince(start);
+  report->track_ms = 1000.0 * SecondsSince(start);
   return Status::Ok();
 }
 

@@ -116,11 +116,11 @@ bool TagTracker::PredictRegion(FollowedTag& track, int width, int height, int re
     for (int i = 0; i <= track.missed_frames; ++i) predicted = motion * predicted;
   }
   // The box holds the predicted square and the last detected one.
-  return SquareRegion(predicted, track.detection.corners, width, height, region, shortest_edge_px);
+  return SquareRegion(predicted, track.detection.corners, width, height, region, shortest_edge_px, nullptr);
 }
 
 bool TagTracker::SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d* last_corners, int width, int height,
-                              int region[4], double* shortest_edge_px) const {
+                              int region[4], double* shortest_edge_px, bool* in_view) const {
   const std::array<Eigen::Vector3d, 4> corners = TagCornersInTagFrame(options_.tag_size);
   Eigen::Vector2d projected[4];
   for (int k = 0; k < 4; ++k) {
@@ -128,6 +128,13 @@ bool TagTracker::SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d*
     if (!(X.z() > 0.0)) return false;
     projected[k] = options_.intrinsics.Project(X);
     if (!projected[k].allFinite()) return false;
+    if (in_view != nullptr) {
+      // Beyond the radius where the distortion polynomial turns back, a point far outside the
+      // field of view projects into the frame: the pixel must undistort to the point's direction.
+      const Eigen::Vector2d back = options_.intrinsics.Unproject(projected[k]);
+      *in_view = back.allFinite() && options_.intrinsics.fx * (back - X.head<2>() / X.z()).norm() < 0.5;
+      if (!*in_view) return false;
+    }
   }
   Eigen::Vector2d lo = projected[0];
   Eigen::Vector2d hi = lo;
@@ -142,7 +149,12 @@ bool TagTracker::SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d*
       *shortest_edge_px = std::min(*shortest_edge_px, (last_corners[(k + 1) % 4] - last_corners[k]).norm());
     }
   }
-  const double margin = RegionMargin((hi - lo).maxCoeff());
+  const double margin = options_.region_margin * (hi - lo).maxCoeff() + options_.region_margin_px;
+  if (in_view != nullptr) {
+    // The whole box in the frame, up to the margin (the error the prediction may have).
+    *in_view = lo.x() >= -0.5 - margin && lo.y() >= -0.5 - margin && hi.x() <= width - 0.5 + margin &&
+               hi.y() <= height - 0.5 + margin;
+  }
   // Pixel centres sit on integers, so pixel i covers [i - 0.5, i + 0.5]: the box's pixel edges are
   // lo + 0.5 and hi + 0.5 in pixel-index units.
   const double x0 = std::max(0.0, std::floor(lo.x() + 0.5 - margin));
@@ -157,37 +169,6 @@ bool TagTracker::SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d*
   region[2] = static_cast<int>(x1 - x0);
   region[3] = static_cast<int>(y1 - y0);
   return true;
-}
-
-double TagTracker::RegionMargin(double box_side_px) const {
-  return options_.region_margin * box_side_px + options_.region_margin_px;
-}
-
-bool TagTracker::PredictedInView(const Rigid3& cam_from_tag, int width, int height) const {
-  // The printed side faces the camera: its z axis points back toward the camera centre.
-  if (!(cam_from_tag.rotation.col(2).dot(cam_from_tag.translation) < 0.0)) return false;
-  const std::array<Eigen::Vector3d, 4> corners = TagCornersInTagFrame(options_.tag_size);
-  Eigen::Vector2d projected[4];
-  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector2d hi = -lo;
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d X = cam_from_tag * corners[k];
-    if (!(X.z() > 0.0)) return false;
-    projected[k] = options_.intrinsics.Project(X);
-    // Beyond the radius where the distortion polynomial turns back, a point far outside the field
-    // of view projects into the frame: the pixel must undistort to the point's own direction.
-    const Eigen::Vector2d back = options_.intrinsics.Unproject(projected[k]);
-    if (!back.allFinite() || !projected[k].allFinite() ||
-        !(options_.intrinsics.fx * (back - X.head<2>() / X.z()).norm() < 0.5)) {
-      return false;
-    }
-    lo = lo.cwiseMin(projected[k]);
-    hi = hi.cwiseMax(projected[k]);
-  }
-  // The whole square in the frame, up to the region's margin (the error the prediction may have).
-  const double margin = RegionMargin((hi - lo).maxCoeff());
-  return lo.x() >= -0.5 - margin && lo.y() >= -0.5 - margin && hi.x() <= width - 0.5 + margin &&
-         hi.y() <= height - 0.5 + margin;
 }
 
 float TagTracker::RegionDecimate(double shortest_edge_px, float min_decimate) const {
@@ -404,11 +385,14 @@ Status TagTracker::SearchPredicted(ImageView<const uint8_t> image, const Predict
   bool any_found = false;
   for (int i = 0; i < count; ++i) {
     const PredictedTag& tag = tags[i];
-    if (tag.id < 0 || measured(tag.id) || !PredictedInView(tag.cam_from_tag, image.width, image.height)) continue;
+    if (tag.id < 0 || measured(tag.id)) continue;
+    // The printed side faces the camera: its z axis points back toward the camera centre.
+    if (!(tag.cam_from_tag.rotation.col(2).dot(tag.cam_from_tag.translation) < 0.0)) continue;
     int region[4];
     double shortest_edge_px = 0.0;
-    if (!SquareRegion(tag.cam_from_tag, nullptr, image.width, image.height, region, &shortest_edge_px) ||
-        !(shortest_edge_px >= options_.predicted_min_edge_px)) {
+    bool in_view = false;
+    if (!SquareRegion(tag.cam_from_tag, nullptr, image.width, image.height, region, &shortest_edge_px, &in_view) ||
+        !in_view || !(shortest_edge_px >= options_.predicted_min_edge_px)) {
       continue;
     }
     // A full-frame search of this frame already looked there at the region's resolution or finer.

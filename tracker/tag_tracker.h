@@ -137,11 +137,13 @@ class TagTracker {
 
   // After Track() on the same frame (same image, same report): searches every predicted tag not
   // measured in this frame where its square appears. A tag is skipped when a corner is behind the
-  // camera, its printed side faces away, its predicted edge is shorter than predicted_min_edge_px
-  // or its region misses the frame. The region is the one of a followed tag (the predicted
-  // square's box plus the margin, PredictRegion) and its quad_decimate the region rule of Options,
-  // from 1 up (no full-frame search has shown that the tag is found at the full-frame decimation).
-  // Detections of predicted ids found there are measured and followed like any other (a new id
+  // camera or projects through the fold of the distortion, its printed side faces away, its
+  // predicted square does not lie in the frame (up to the region margin) or has an edge shorter
+  // than predicted_min_edge_px. The region is the one of a followed tag (the predicted square's
+  // box plus the margin, SquareRegion) and its quad_decimate the region rule of the options, from
+  // 1 up (no full-frame search has shown that the tag is found at the full-frame decimation); it is
+  // not searched when this frame's full-frame search used that decimation or a finer one (it
+  // already looked there). Detections of predicted ids found there are measured and followed like any other (a new id
   // starts a track; a lost one counts as reacquired). Updates *report: its tags, detections,
   // timings and predicted_searched / predicted_found. Nothing is searched when count is 0.
   // InvalidArgument when the image is not the one of the last Track (size) or count < 0.
@@ -158,13 +160,12 @@ class TagTracker {
   bool PredictRegion(FollowedTag& track, int width, int height, int region[4], double* shortest_edge_px) const;
   // The search box of a tag at cam_from_tag: the box of its projected square (and of `last_corners`,
   // its last detected square, when not null) plus the margin, clipped to the frame. False when a
-  // corner is not in front of the camera or the clipped box is too small to hold a tag.
+  // corner is not in front of the camera or the clipped box is too small to hold a tag. With
+  // in_view: also false when a corner's projection is folded back by the distortion (its pixel does
+  // not undistort to its direction), and *in_view tells whether the unclipped box lies in the
+  // frame grown by the margin.
   bool SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d* last_corners, int width, int height,
-                    int region[4], double* shortest_edge_px) const;
-  double RegionMargin(double box_side_px) const;
-  // SearchPredicted's test: the tag faces the camera and its square, projected without folding by
-  // the distortion, lies in the frame up to the region margin.
-  bool PredictedInView(const Rigid3& cam_from_tag, int width, int height) const;
+                    int region[4], double* shortest_edge_px, bool* in_view) const;
   // quad_decimate of a region search for a tag of that shortest edge, never below min_decimate.
   float RegionDecimate(double shortest_edge_px, float min_decimate) const;
   // Detects inside region with region_detector_ into scratch_ (time and count into *report).

@@ -319,8 +319,13 @@ Status TrackRotatingView(const LocalizationMap& map, const Query& query, const R
   intrinsics.fy = camera.fy();
   intrinsics.cx = camera.cx;
   intrinsics.cy = camera.cy;
-  // The rendering is a pinhole homography; the tracker is given the same pinhole camera.
-  scene.photo_camera = scene.frame_camera = intrinsics;
+  intrinsics.k1 = camera.k1;
+  intrinsics.k2 = camera.k2;
+  // The query frame through its own (distorted) camera; the video's frames are rendered
+  // undistorted, and the tracker is given that pinhole camera.
+  scene.photo_camera = intrinsics;
+  intrinsics.k1 = intrinsics.k2 = 0.0;
+  scene.frame_camera = intrinsics;
   scene.photo_cam_from_world = cam_from_world;
   MapTrackerOptions options;
   options.intrinsics = intrinsics;

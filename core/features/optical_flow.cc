@@ -129,6 +129,87 @@ const char* FlowStatusName(FlowStatus status) {
   return "unknown";
 }
 
+namespace {
+
+// The inverse-compositional template of the window of `image` at (x, y): its samples, gradients
+// (central differences of a window one pixel wider) and the summed structure tensor h = (h00, h01,
+// h11). Returns whether the window has texture in two directions (min_eigenvalue per pixel) and
+// an invertible tensor.
+bool PrepareTemplate(const ImageView<const float>& image, float x, float y, int radius, double min_eigenvalue,
+                     float* values, float* gx, float* gy, float h[3]) {
+  const int side = 2 * radius + 1, wide = side + 2, n = side * side;
+  float templ_wide[kMaxPatchSide * kMaxPatchSide];
+  SampleWindow(image, x, y, radius + 1, templ_wide);
+  float h00 = 0.0f, h01 = 0.0f, h11 = 0.0f;
+  for (int j = 0; j < side; ++j) {
+    const float* c = templ_wide + (j + 1) * wide + 1;
+    for (int i = 0; i < side; ++i) {
+      const int k = j * side + i;
+      values[k] = c[i];
+      gx[k] = 0.5f * (c[i + 1] - c[i - 1]);
+      gy[k] = 0.5f * (c[i + wide] - c[i - wide]);
+      h00 += gx[k] * gx[k];
+      h01 += gx[k] * gy[k];
+      h11 += gy[k] * gy[k];
+    }
+  }
+  h[0] = h00;
+  h[1] = h01;
+  h[2] = h11;
+  const float trace_half = 0.5f * (h00 + h11);
+  const float det = h00 * h11 - h01 * h01;
+  const float min_eigen = trace_half - std::sqrt(std::max(0.0f, trace_half * trace_half - det));
+  return min_eigen / static_cast<float>(n) >= static_cast<float>(min_eigenvalue) && det > 0.0f;
+}
+
+// Inverse-compositional Gauss-Newton on the translation (qx, qy) in `image` (Baker & Matthews
+// 2004, sec. 3.2). Returns false when a step is not finite.
+bool AlignWindow(const ImageView<const float>& image, const float* values, const float* gx, const float* gy,
+                 const float h[3], int radius, int max_iterations, float epsilon2, float* qx, float* qy) {
+  const int side = 2 * radius + 1, n = side * side;
+  float sample[kMaxPatchSide * kMaxPatchSide];
+  const float inv_det = 1.0f / (h[0] * h[2] - h[1] * h[1]);
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
+    SampleWindow(image, *qx, *qy, radius, sample);
+    float b0 = 0.0f, b1 = 0.0f;
+    for (int k = 0; k < n; ++k) {
+      const float e = sample[k] - values[k];
+      b0 += gx[k] * e;
+      b1 += gy[k] * e;
+    }
+    const float dx = inv_det * (h[2] * b0 - h[1] * b1);
+    const float dy = inv_det * (h[0] * b1 - h[1] * b0);
+    if (!std::isfinite(dx) || !std::isfinite(dy)) return false;
+    *qx = ClampCoordinate(*qx - dx, image.width);
+    *qy = ClampCoordinate(*qy - dy, image.height);
+    if (!(dx * dx + dy * dy >= epsilon2)) break;
+  }
+  return true;
+}
+
+// The result at (qx, qy) of level 0: bounds, then the mean absolute difference to the template.
+FlowResult Finish(const ImageView<const float>& image, const float* values, int radius, float qx, float qy,
+                  double max_mean_error) {
+  FlowResult result;
+  result.point = Eigen::Vector2f(qx, qy);
+  if (!result.point.allFinite() || qx < 0.0f || qy < 0.0f || qx > static_cast<float>(image.width - 1) ||
+      qy > static_cast<float>(image.height - 1)) {
+    result.status = FlowStatus::kOutOfBounds;
+    return result;
+  }
+  const int side = 2 * radius + 1, n = side * side;
+  float sample[kMaxPatchSide * kMaxPatchSide];
+  SampleWindow(image, qx, qy, radius, sample);
+  float error = 0.0f;
+  for (int k = 0; k < n; ++k) error += std::abs(sample[k] - values[k]);
+  result.mean_error = error / static_cast<float>(n);
+  result.status =
+      result.mean_error <= static_cast<float>(max_mean_error) ? FlowStatus::kTracked : FlowStatus::kLargeError;
+  return result;
+}
+
+}  // namespace
+
 Status TrackPoints(const ImagePyramid& previous, const ImagePyramid& next, const OpticalFlowOptions& options,
                    const Eigen::Vector2f* points, const Eigen::Vector2f* guesses, int count, FlowResult* results) {
   RECONAR_RETURN_IF_ERROR(options.Check());
@@ -138,13 +219,10 @@ Status TrackPoints(const ImagePyramid& previous, const ImagePyramid& next, const
   }
   const int levels = std::min(options.num_levels, previous.num_levels());
   const int radius = options.window_radius;
-  const int side = 2 * radius + 1, n = side * side;
-  const int wide = side + 2;  // the template with a one-pixel ring for central differences
   const float width = static_cast<float>(previous.width()), height = static_cast<float>(previous.height());
   const float epsilon2 = static_cast<float>(options.epsilon_px * options.epsilon_px);
-  float templ_wide[kMaxPatchSide * kMaxPatchSide];
-  float templ[kMaxPatchSide * kMaxPatchSide], gx[kMaxPatchSide * kMaxPatchSide], gy[kMaxPatchSide * kMaxPatchSide];
-  float sample[kMaxPatchSide * kMaxPatchSide];
+  float values[kMaxPatchSide * kMaxPatchSide], gx[kMaxPatchSide * kMaxPatchSide], gy[kMaxPatchSide * kMaxPatchSide];
+  float h[3];
   for (int p = 0; p < count; ++p) {
     FlowResult& result = results[p];
     result = FlowResult();
@@ -157,55 +235,17 @@ Status TrackPoints(const ImagePyramid& previous, const ImagePyramid& next, const
     float qx = ClampCoordinate(guess.x(), previous.width()) / static_cast<float>(1 << (levels - 1));
     float qy = ClampCoordinate(guess.y(), previous.height()) / static_cast<float>(1 << (levels - 1));
     bool flat = false, diverged = false;
-    for (int l = levels - 1; l >= 0; --l) {
+    for (int l = levels - 1; l >= 0 && !flat && !diverged; --l) {
       const float scale = 1.0f / static_cast<float>(1 << l);
-      const ImageView<const float> prev_level = previous.level(l), next_level = next.level(l);
-      SampleWindow(prev_level, start.x() * scale, start.y() * scale, radius + 1, templ_wide);
-      float h00 = 0.0f, h01 = 0.0f, h11 = 0.0f;
-      for (int j = 0; j < side; ++j) {
-        const float* c = templ_wide + (j + 1) * wide + 1;
-        for (int i = 0; i < side; ++i) {
-          const int k = j * side + i;
-          templ[k] = c[i];
-          gx[k] = 0.5f * (c[i + 1] - c[i - 1]);
-          gy[k] = 0.5f * (c[i + wide] - c[i - wide]);
-          h00 += gx[k] * gx[k];
-          h01 += gx[k] * gy[k];
-          h11 += gy[k] * gy[k];
-        }
-      }
-      const float trace_half = 0.5f * (h00 + h11);
-      const float det = h00 * h11 - h01 * h01;
-      const float min_eigen =
-          trace_half - std::sqrt(std::max(0.0f, trace_half * trace_half - det));  // of the summed tensor
       // A window flat at a coarse level only keeps the estimate of the level above; at level 0 the
       // point is refused.
-      const bool textured =
-          min_eigen / static_cast<float>(n) >= static_cast<float>(options.min_eigenvalue) && det > 0.0f;
-      if (!textured && l == 0) {
-        flat = true;
-        break;
+      const bool textured = PrepareTemplate(previous.level(l), start.x() * scale, start.y() * scale, radius,
+                                            options.min_eigenvalue, values, gx, gy, h);
+      if (!textured) {
+        flat = l == 0;
+      } else {
+        diverged = !AlignWindow(next.level(l), values, gx, gy, h, radius, options.max_iterations, epsilon2, &qx, &qy);
       }
-      const float inv_det = textured ? 1.0f / det : 0.0f;
-      for (int iteration = 0; textured && iteration < options.max_iterations; ++iteration) {
-        SampleWindow(next_level, qx, qy, radius, sample);
-        float b0 = 0.0f, b1 = 0.0f;
-        for (int k = 0; k < n; ++k) {
-          const float e = sample[k] - templ[k];
-          b0 += gx[k] * e;
-          b1 += gy[k] * e;
-        }
-        const float dx = inv_det * (h11 * b0 - h01 * b1);
-        const float dy = inv_det * (h00 * b1 - h01 * b0);
-        if (!std::isfinite(dx) || !std::isfinite(dy)) {
-          diverged = true;
-          break;
-        }
-        qx = ClampCoordinate(qx - dx, next_level.width);
-        qy = ClampCoordinate(qy - dy, next_level.height);
-        if (!(dx * dx + dy * dy >= epsilon2)) break;  // converged (or not finite: caught below)
-      }
-      if (diverged) break;
       if (l > 0) {
         qx *= 2.0f;
         qy *= 2.0f;
@@ -215,19 +255,42 @@ Status TrackPoints(const ImagePyramid& previous, const ImagePyramid& next, const
       result.status = FlowStatus::kFlatWindow;
       continue;
     }
-    result.point = Eigen::Vector2f(qx, qy);
-    if (diverged || !result.point.allFinite() || qx < 0.0f || qy < 0.0f || qx > width - 1.0f || qy > height - 1.0f) {
-      result.status = FlowStatus::kOutOfBounds;
-      continue;
-    }
-    SampleWindow(next.level(0), qx, qy, radius, sample);
-    float error = 0.0f;
-    for (int k = 0; k < n; ++k) error += std::abs(sample[k] - templ[k]);
-    result.mean_error = error / static_cast<float>(n);
-    result.status = result.mean_error <= static_cast<float>(options.max_mean_error) ? FlowStatus::kTracked
-                                                                                    : FlowStatus::kLargeError;
+    if (diverged) continue;  // kOutOfBounds
+    result = Finish(next.level(0), values, radius, qx, qy, options.max_mean_error);
   }
   return Status::Ok();
+}
+
+int FlowTemplateFloats(int window_radius) {
+  const int side = 2 * window_radius + 1;
+  return 3 + 3 * side * side;
+}
+
+bool MakeFlowTemplate(const ImagePyramid& pyramid, const Eigen::Vector2f& point, const OpticalFlowOptions& options,
+                      float* storage) {
+  if (pyramid.num_levels() == 0 || !options.Check().ok() || !point.allFinite() || point.x() < 0.0f ||
+      point.y() < 0.0f || point.x() > static_cast<float>(pyramid.width() - 1) ||
+      point.y() > static_cast<float>(pyramid.height() - 1)) {
+    return false;
+  }
+  const int radius = options.window_radius, n = (2 * radius + 1) * (2 * radius + 1);
+  return PrepareTemplate(pyramid.level(0), point.x(), point.y(), radius, options.min_eigenvalue, storage + 3,
+                         storage + 3 + n, storage + 3 + 2 * n, storage);
+}
+
+FlowResult AlignFlowTemplate(const ImagePyramid& next, const float* storage, const Eigen::Vector2f& guess,
+                             const OpticalFlowOptions& options) {
+  FlowResult result;
+  if (next.num_levels() == 0 || !guess.allFinite()) return result;
+  const int radius = options.window_radius, n = (2 * radius + 1) * (2 * radius + 1);
+  const ImageView<const float> image = next.level(0);
+  float qx = ClampCoordinate(guess.x(), image.width), qy = ClampCoordinate(guess.y(), image.height);
+  const float epsilon2 = static_cast<float>(options.epsilon_px * options.epsilon_px);
+  if (!AlignWindow(image, storage + 3, storage + 3 + n, storage + 3 + 2 * n, storage, radius, options.max_iterations,
+                   epsilon2, &qx, &qy)) {
+    return result;
+  }
+  return Finish(image, storage + 3, radius, qx, qy, options.max_mean_error);
 }
 
 }  // namespace reconar

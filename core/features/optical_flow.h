@@ -86,4 +86,18 @@ struct FlowResult {
 Status TrackPoints(const ImagePyramid& previous, const ImagePyramid& next, const OpticalFlowOptions& options,
                    const Eigen::Vector2f* points, const Eigen::Vector2f* guesses, int count, FlowResult* results);
 
+// Templates kept across frames: the level-0 window of a point in the frame where it was found,
+// matched against later frames without the drift of chaining frame-to-frame flow. A template
+// takes FlowTemplateFloats(window_radius) floats of storage the caller owns.
+int FlowTemplateFloats(int window_radius);
+// Fills `storage` with the window of `pyramid`'s level 0 around `point` (samples, gradients and
+// their 2x2 tensor); false (storage unspecified) when the point is outside the image, the window
+// is flat (options.min_eigenvalue) or the options fail Check().
+bool MakeFlowTemplate(const ImagePyramid& pyramid, const Eigen::Vector2f& point, const OpticalFlowOptions& options,
+                      float* storage);
+// The position in `next`'s level 0 of a template made with the same options, by inverse-compositional
+// iterations from `guess` (which must be within about window_radius pixels of the answer: no pyramid).
+FlowResult AlignFlowTemplate(const ImagePyramid& next, const float* storage, const Eigen::Vector2f& guess,
+                             const OpticalFlowOptions& options);
+
 }  // namespace reconar

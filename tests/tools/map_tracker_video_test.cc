@@ -92,25 +92,25 @@ TEST(MapTrackerVideo, TracksTheArVideoWithTheTagPaintedOutAgainstAMapOfEveryFour
     const Rigid3& truth = tag->cam_from_tag;
     centre_cm.push_back(100.0 * (CameraCenterInWorld(report.cam_from_world) - CameraCenterInWorld(truth)).norm());
     rotation_deg.push_back(
-        Eigen::AngleAxisd(Eigen::Matrix3d(report.cam_from_world.rotation * truth.rotation.transpose())).angle() * 180.0 /
-        M_PI);
-    if (getenv("MT_DEBUG"))
-      std::printf("%s inl %d rms %.2f centre %.2f cm rot %.2f amb %.2f tag rms %.2f\n", frame.name.c_str(), report.inliers,
-                  report.rms_reprojection_px, centre_cm.back(), rotation_deg.back(), tag->ambiguity_ratio,
-                  tag->rms_reprojection_px);
+        Eigen::AngleAxisd(Eigen::Matrix3d(report.cam_from_world.rotation * truth.rotation.transpose())).angle() *
+        180.0 / M_PI);
+    std::printf("%s inl %d rms %.2f centre %.2f cm rot %.2f amb %.2f tag rms %.2f\n", frame.name.c_str(),
+                report.inliers, report.rms_reprojection_px, centre_cm.back(), rotation_deg.back(), tag->ambiguity_ratio,
+                tag->rms_reprojection_px);
   }
-  std::printf("map: %zu keyframes, %d points; states: %s\n", map->keyframes.size(), map->num_points(),
-              states.c_str());
+  std::printf("map: %zu keyframes, %d points; states: %s\n", map->keyframes.size(), map->num_points(), states.c_str());
   std::printf(
       "posed %d of 93 frames (%d relocalised, %d tracked); vs the tag pose: centre median %.2f cm, p95 %.2f, max %.2f; "
       "rotation median %.3f deg, p95 %.3f, max %.3f; tracked frame median %.2f ms\n",
       found, relocalised, tracked, Quantile(centre_cm, 0.5), Quantile(centre_cm, 0.95), Quantile(centre_cm, 1.0),
       Quantile(rotation_deg, 0.5), Quantile(rotation_deg, 0.95), Quantile(rotation_deg, 1.0), Quantile(ms, 0.5));
-  EXPECT_GE(found, 85);
-  EXPECT_LT(Quantile(centre_cm, 0.5), 2.0);
-  EXPECT_LT(Quantile(rotation_deg, 0.5), 1.0);
-  EXPECT_LT(Quantile(centre_cm, 1.0), 10.0);  // no wrong pose
-  EXPECT_LT(Quantile(rotation_deg, 1.0), 5.0);
+  // Measured: 93 of 93; centre median 0.36 cm, p95 1.2, max 2.7; rotation median 0.27 deg, p95 1.0,
+  // max 2.2 (relocalising every frame instead: median 0.32 cm, max 1.2 cm, max 0.7 deg).
+  EXPECT_GE(found, 90);
+  EXPECT_LT(Quantile(centre_cm, 0.5), 1.0);
+  EXPECT_LT(Quantile(rotation_deg, 0.5), 0.6);
+  EXPECT_LT(Quantile(centre_cm, 1.0), 5.0);  // no wrong pose
+  EXPECT_LT(Quantile(rotation_deg, 1.0), 4.0);
 }
 
 }  // namespace

@@ -125,12 +125,14 @@ TEST_F(MapTrackerTest, FollowsARotatingCameraLosesItOnAnUnrelatedViewAndRelocali
   EXPECT_EQ(states.substr(40, 10), "rrrlllllll");
   EXPECT_TRUE(states.substr(50, 2) == "tt" || states.substr(50, 2) == "lt") << states.substr(50, 2);
   EXPECT_EQ(states.substr(52), std::string(18, 't'));
-  EXPECT_EQ(relocalisations, 2);
+  EXPECT_GE(relocalisations, 2);  // the first frame, the return (and re-anchoring every 10 frames)
   EXPECT_GE(static_cast<int>(rotation_errors.size()), 59);
 }
 
 TEST_F(MapTrackerTest, APriorRestartsTrackingWithoutRelocalisation) {
-  auto tracker = MapTracker::Create(map_, Options());
+  MapTrackerOptions options = Options();
+  options.reanchor_interval = 0;  // only the prior and the flow
+  auto tracker = MapTracker::Create(map_, options);
   ASSERT_TRUE(tracker.ok()) << tracker.status().ToString();
   MapTrackerFrameReport report;
   // First frame with a prior: tracking starts from the prior's projection of the map (no pose yet).

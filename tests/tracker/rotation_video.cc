@@ -51,21 +51,36 @@ Result<RotationScene> MakeRotationScene(const std::string& path, int downscale, 
 
 Image<uint8_t> RenderRotatedView(const RotationScene& scene, const Eigen::Matrix3d& rotation) {
   const CameraIntrinsics& f = scene.frame_camera;
-  const CameraIntrinsics& p = scene.photo_camera;
+  const RadialCamera photo_camera = scene.photo_camera.Camera();
+  const bool distorted = scene.photo_camera.k1 != 0.0 || scene.photo_camera.k2 != 0.0;
   Eigen::Matrix3d k_frame_inverse;
   k_frame_inverse << 1.0 / f.fx, 0, -f.cx / f.fx, 0, 1.0 / f.fy, -f.cy / f.fy, 0, 0, 1;
   Eigen::Matrix3d k_photo;
-  k_photo << p.fx, 0, p.cx, 0, p.fy, p.cy, 0, 0, 1;
-  const Eigen::Matrix3d h = k_photo * rotation.transpose() * k_frame_inverse;
+  k_photo << photo_camera.focal, 0, photo_camera.cx, 0, photo_camera.fy(), photo_camera.cy, 0, 0, 1;
+  // The ray of frame pixel x in the photo camera's frame: R^T K_frame^-1 x (the frame camera is
+  // taken as a pinhole); a pinhole photo maps it by K_photo (a homography), a distorted one through
+  // its radial model.
+  const Eigen::Matrix3d photo_ray = rotation.transpose() * k_frame_inverse;
+  const Eigen::Matrix3d h = k_photo * photo_ray;
   Image<uint8_t> frame(f.width, f.height);
   const int pw = scene.photo.width(), ph = scene.photo.height();
   for (int y = 0; y < f.height; ++y) {
     uint8_t* out = frame.row(y);
     for (int x = 0; x < f.width; ++x) {
-      const Eigen::Vector3d s = h * Eigen::Vector3d(x, y, 1.0);
       out[x] = 128;
-      if (!(s.z() > 0.0)) continue;
-      const double sx = s.x() / s.z(), sy = s.y() / s.z();
+      double sx = 0.0, sy = 0.0;
+      if (distorted) {
+        const Eigen::Vector3d ray = photo_ray * Eigen::Vector3d(x, y, 1.0);
+        if (!(ray.z() > 0.0)) continue;
+        const Eigen::Vector2d s = photo_camera.Project(ray);
+        sx = s.x();
+        sy = s.y();
+      } else {
+        const Eigen::Vector3d s = h * Eigen::Vector3d(x, y, 1.0);
+        if (!(s.z() > 0.0)) continue;
+        sx = s.x() / s.z();
+        sy = s.y() / s.z();
+      }
       if (!(sx >= 0.0 && sy >= 0.0 && sx <= pw - 1 && sy <= ph - 1)) continue;
       const int x0 = std::min(static_cast<int>(sx), pw - 2), y0 = std::min(static_cast<int>(sy), ph - 2);
       const double ax = sx - x0, ay = sy - y0;

@@ -32,8 +32,9 @@ struct RotationScene {
 Result<RotationScene> MakeRotationScene(const std::string& path, int downscale, int width, int height,
                                         double focal_factor = 0.9);
 
-// The frame seen by the camera at cam_from_photo_cam = R (rotation only): frame pixel x shows photo
-// pixel K_photo R^T K_frame^-1 x, bilinear; outside the photo a mid grey.
+// The frame seen by the camera at cam_from_photo_cam = R (rotation only): frame pixel x shows the
+// photo's pixel of the ray R^T K_frame^-1 x (K_photo times it for a pinhole photo), bilinear;
+// outside the photo a mid grey. A distorted photo thus gives undistorted frames.
 Image<uint8_t> RenderRotatedView(const RotationScene& scene, const Eigen::Matrix3d& rotation);
 
 // cam_from_world of that view: R * photo_cam_from_world.

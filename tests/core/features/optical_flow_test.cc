@@ -122,6 +122,31 @@ TEST(OpticalFlowTest, RecoversTheCentreOfASmallRotationAndZoomFromAGuess) {
   EXPECT_LT(worst, 0.25);
 }
 
+TEST(OpticalFlowTest, ATemplateFromOneFrameIsFoundInALaterOneWithoutChaining) {
+  const int width = 240, height = 180;
+  const Eigen::Vector2d shift(2.35, -1.6);
+  const Image<uint8_t> first = Render(width, height, [](double x, double y) { return Eigen::Vector2d(x, y); });
+  const Image<uint8_t> later =
+      Render(width, height, [&](double x, double y) { return Eigen::Vector2d(x - shift.x(), y - shift.y()); });
+  ImagePyramid a, b;
+  ASSERT_TRUE(a.Build(first.view(), 3).ok());
+  ASSERT_TRUE(b.Build(later.view(), 3).ok());
+  const OpticalFlowOptions options;
+  std::vector<float> storage(static_cast<size_t>(FlowTemplateFloats(options.window_radius)));
+  int found = 0;
+  for (const Eigen::Vector2f& p : Grid(width, height, 30, 30)) {
+    if (!MakeFlowTemplate(a, p, options, storage.data())) continue;  // a flat window
+    const Eigen::Vector2f truth = p + shift.cast<float>();
+    const FlowResult r = AlignFlowTemplate(b, storage.data(), truth + Eigen::Vector2f(1.2f, 0.9f), options);
+    ASSERT_EQ(r.status, FlowStatus::kTracked);
+    EXPECT_LT((r.point - truth).norm(), 0.05f);
+    ++found;
+  }
+  EXPECT_GE(found, 15);
+  EXPECT_FALSE(MakeFlowTemplate(a, Eigen::Vector2f(-1.0f, 5.0f), options, storage.data()));
+  EXPECT_FALSE(MakeFlowTemplate(a, Eigen::Vector2f(std::nanf(""), 5.0f), options, storage.data()));
+}
+
 TEST(OpticalFlowTest, PointsOutsideTheFrameFlatWindowsAndWildGuessesAreReportedNotRead) {
   const int width = 160, height = 120;
   const Image<uint8_t> first = Render(width, height, [](double x, double y) { return Eigen::Vector2d(x, y); });
