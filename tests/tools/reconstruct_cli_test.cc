@@ -83,15 +83,9 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
   EXPECT_TRUE(report->Find("metric")->bool_value());
 
   // Detections against the ids listed per photo (human-made, groundtruth.txt).
-  std::map<std::string, std::set<int>> listed;
-  std::ifstream truth(data + "/groundtruth.txt");
-  std::string line;
-  while (std::getline(truth, line)) {
-    std::istringstream fields(line);
-    std::string name;
-    fields >> name;
-    for (int id; fields >> id;) listed[name].insert(id);
-  }
+  auto listed_ids = testing::ReadListedTagIds(data + "/groundtruth.txt");
+  ASSERT_TRUE(listed_ids.ok()) << listed_ids.status().ToString();
+  std::map<std::string, std::set<int>>& listed = *listed_ids;
   auto detections = ReadTagDetections(project + "/tags/detections.txt");
   ASSERT_TRUE(detections.ok()) << detections.status().ToString();
   int found = 0, false_ids = 0, total = 0;
@@ -135,6 +129,7 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
                                       testing::StderrMode::kSeparate);
   ASSERT_EQ(track.exit_code, 0) << track.error;
   std::istringstream lines(track.output);
+  std::string line;
   int compared = 0;
   while (std::getline(lines, line)) {
     auto frame = ParseJson(line, "track output");

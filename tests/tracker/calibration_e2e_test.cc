@@ -26,6 +26,7 @@
 
 #include "core/io/gray.h"
 #include "core/io/image_io.h"
+#include "tests/support/ground_truth.h"
 #include "tracker/calibration.h"
 #include "tracker/tag_detector.h"
 
@@ -33,21 +34,6 @@ namespace reconar {
 namespace {
 
 const std::string kDataDir = std::string(RECONAR_SHARED_DATA_DIR) + "/apriltag_swatbotics_mapping";
-
-// groundtruth.txt: "<image file> <id> <id> ..." per line.
-std::map<std::string, std::set<int>> ReadVisibleIds() {
-  std::map<std::string, std::set<int>> visible;
-  std::ifstream in(kDataDir + "/groundtruth.txt");
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream words(line);
-    std::string name;
-    if (!(words >> name)) continue;
-    std::set<int>& ids = visible[name];
-    for (int id; words >> id;) ids.insert(id);
-  }
-  return visible;
-}
 
 struct Detected {
   CalibrationObservations observations;
@@ -58,7 +44,10 @@ struct Detected {
 Detected DetectAll() {
   Detected detected;
   detected.observations.tag_size = 0.127;
-  const std::map<std::string, std::set<int>> visible = ReadVisibleIds();
+  auto listed = testing::ReadListedTagIds(kDataDir + "/groundtruth.txt");
+  EXPECT_TRUE(listed.ok()) << listed.status().ToString();
+  if (!listed.ok()) return detected;
+  const std::map<std::string, std::set<int>>& visible = *listed;
   EXPECT_EQ(visible.size(), 72u);
   TagDetectorOptions options;
   options.family = TagFamily::kTag36h11;
