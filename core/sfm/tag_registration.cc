@@ -113,6 +113,7 @@ std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vect
     for (const TagObservation& tag : observations[i]) {
       if (count[tag.tag_id] != 1) continue;  // a printed id twice in one photo: which is which is unknown
       first_keypoint[i][tag.tag_id] = static_cast<int>(image.keypoints.size());
+      image.tags.push_back({tag.tag_id, static_cast<int>(image.keypoints.size())});
       for (int k = 0; k < 4; ++k) {
         corners.push_back({static_cast<int>(i), static_cast<int>(image.keypoints.size()), tag.tag_id, k});
         image.keypoints.push_back(tag.corners[static_cast<size_t>(k)]);

@@ -42,7 +42,8 @@ struct TagCornerKeypoint {
 inline constexpr double kTagCornerWeight = 2.0;
 
 // observations[i] are the tags seen in images[i]. Corners get `keypoint_scale` as detection scale
-// (when the images carry scales) and `corner_weight` as weight. A pair of images that share tags
+// (when the images carry scales) and `corner_weight` as weight, and each image lists its tags in
+// MapperImage::tags (so that the mapper may register it by them). A pair of images that share tags
 // but have no verified pair gets a new one, marked planar so that it never starts the reconstruction.
 std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vector<TagObservation>>& observations,
                                                      double keypoint_scale, double corner_weight,
