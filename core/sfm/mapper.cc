@@ -217,6 +217,9 @@ Status MapperOptions::Check() const {
   if (registration_min_inliers < 6) return InvalidArgument("MapperOptions: registration_min_inliers < 6");
   if (registration_min_tag_point_inliers < 0)
     return InvalidArgument("MapperOptions: registration_min_tag_point_inliers < 0");
+  if (!(registration_max_tag_rms_px > 0.0)) return InvalidArgument("MapperOptions: registration_max_tag_rms_px <= 0");
+  if (!(registration_min_tag_two_view_fraction >= 0.0 && registration_min_tag_two_view_fraction <= 1.0))
+    return InvalidArgument("MapperOptions: registration_min_tag_two_view_fraction must be in [0, 1]");
   if (!(max_reprojection_error_px > 0.0)) return InvalidArgument("MapperOptions: max_reprojection_error_px <= 0");
   if (!(min_triangulation_angle_deg >= 0.0)) return InvalidArgument("MapperOptions: min_triangulation_angle_deg < 0");
   if (local_ba_images < 0) return InvalidArgument("MapperOptions: local_ba_images < 0");

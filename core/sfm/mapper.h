@@ -64,6 +64,14 @@ struct MapperOptions {
   // registers with fewer inliers when that is at least two such tags, or one and this many other
   // inliers.
   int registration_min_tag_point_inliers = 8;
+  // ... and whose root mean square error over those corners is at most this: a tag's corners are
+  // found to a few tenths of a pixel, and two small tags facing the camera admit a wrong pose that
+  // fits them each within a few pixels.
+  double registration_max_tag_rms_px = 2.0;
+  // ... and, when the image has at least registration_min_tag_point_inliers matches to registered
+  // images on tracks without a point, at least this fraction of them within
+  // registration_max_error_px of their epipolar lines under the pose.
+  double registration_min_tag_two_view_fraction = 0.3;
   // Triangulation and filtering.
   double max_reprojection_error_px = 4.0;
   double min_triangulation_angle_deg = 1.5;

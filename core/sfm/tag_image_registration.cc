@@ -1,6 +1,8 @@
 #include "core/sfm/tag_image_registration.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <utility>
 
 #include "core/geometry/absolute_pose.h"
@@ -97,7 +99,17 @@ struct Correspondences {
   std::vector<int> keypoint;  // the image's keypoint
   std::vector<int> point;     // its model point, -1 for a derived corner
   int num_corners = 0;
+  // Matches of the image's other keypoints to registered images on tracks without a point yet:
+  // (normalised point here, normalised point there, that image), for the epipolar check.
+  struct TwoView {
+    Eigen::Vector2d here, there;
+    int image;
+  };
+  std::vector<TwoView> two_view;
 };
+
+// At most this many two-view matches are checked.
+constexpr size_t kMaxTwoViewMatches = 2000;
 
 Correspondences Gather(const MapperModel& model, const std::vector<MapperImage>& images, int image,
                        const std::vector<KnownTag>& known) {
@@ -124,6 +136,22 @@ Correspondences Gather(const MapperModel& model, const std::vector<MapperImage>&
     c.keypoint.push_back(static_cast<int>(kp));
     c.point.push_back(model.point_of_track[static_cast<size_t>(t)]);
   }
+  const SfmCamera& camera =
+      model.rec.cameras[static_cast<size_t>(model.rec.images[static_cast<size_t>(image)].camera_id)];
+  for (size_t kp = 0; kp < track_of.size() && kp < in.keypoints.size(); ++kp) {
+    const int t = track_of[kp];
+    if (corner[kp] || t < 0 || model.point_of_track[static_cast<size_t>(t)] >= 0) continue;
+    Eigen::Vector2d here;
+    if (!camera.Undistort(in.keypoints[kp], &here)) continue;
+    for (const TrackElement& e : model.tracks.tracks[static_cast<size_t>(t)]) {
+      const SfmImage& other = model.rec.images[static_cast<size_t>(e.image_id)];
+      if (e.image_id == image || !other.registered || c.two_view.size() >= kMaxTwoViewMatches) continue;
+      Eigen::Vector2d there;
+      if (model.rec.cameras[static_cast<size_t>(other.camera_id)].Undistort(
+              other.keypoints[static_cast<size_t>(e.keypoint_id)], &there))
+        c.two_view.push_back({here, there, e.image_id});
+    }
+  }
   return c;
 }
 
@@ -133,15 +161,36 @@ struct Verdict {
   int tags_fitting = 0;
   int tags_off = 0;  // known tags with a corner beyond the bound
   int other_inliers = 0;
+  double corner_rms_px = 0.0;   // over the known tags' corners
+  int two_view_consistent = 0;  // two-view matches within the bound of their epipolar line
 };
 
-Verdict Judge(const Correspondences& c, const RadialCamera& camera, const Rigid3& cam_from_world,
-              const MapperOptions& options) {
+Verdict Judge(const MapperModel& model, const Correspondences& c, const RadialCamera& camera,
+              const Rigid3& cam_from_world, const MapperOptions& options) {
   Verdict v;
   const double bound = options.registration_max_error_px * options.registration_max_error_px;
+  double corner_squares = 0.0;
   for (size_t i = 0; i < c.pixels.size(); ++i) {
-    if (SquaredPixelError(camera, cam_from_world.rotation, cam_from_world.translation, c.world[i], c.pixels[i]) < bound)
-      v.inliers.push_back(static_cast<int>(i));
+    const double squared =
+        SquaredPixelError(camera, cam_from_world.rotation, cam_from_world.translation, c.world[i], c.pixels[i]);
+    if (squared < bound) v.inliers.push_back(static_cast<int>(i));
+    if (static_cast<int>(i) < c.num_corners) corner_squares += squared;
+  }
+  if (c.num_corners > 0) v.corner_rms_px = std::sqrt(corner_squares / c.num_corners);
+  for (const Correspondences::TwoView& m : c.two_view) {
+    // Sampson distance (pixels at the focal) under E = [t]x R of here_from_there.
+    const Rigid3& there_pose = model.rec.images[static_cast<size_t>(m.image)].cam_from_world;
+    const Eigen::Matrix3d R = cam_from_world.rotation * there_pose.rotation.transpose();
+    const Eigen::Vector3d t = cam_from_world.translation - R * there_pose.translation;
+    Eigen::Matrix3d tx;
+    tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
+    const Eigen::Matrix3d E = tx * R;
+    const Eigen::Vector3d x1 = m.there.homogeneous(), x2 = m.here.homogeneous();
+    const Eigen::Vector3d Ex1 = E * x1, Etx2 = E.transpose() * x2;
+    const double denominator = Ex1.head<2>().squaredNorm() + Etx2.head<2>().squaredNorm();
+    const double numerator = x2.dot(Ex1);
+    if (!(denominator > 0.0) || numerator * numerator <= bound / (camera.focal * camera.focal) * denominator)
+      ++v.two_view_consistent;
   }
   std::vector<int> per_tag(static_cast<size_t>(c.num_corners / 4), 0);
   for (int i : v.inliers) {
@@ -155,8 +204,18 @@ Verdict Judge(const Correspondences& c, const RadialCamera& camera, const Rigid3
   return v;
 }
 
-bool Accepted(const Verdict& v, const MapperOptions& options) {
-  return v.tags_off == 0 && TagsCanRegister(v.tags_fitting, v.other_inliers, options);
+std::string FormatPixels(double px) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.2f px", px);
+  return text;
+}
+
+bool Accepted(const Verdict& v, const Correspondences& c, const MapperOptions& options) {
+  const int two_view = static_cast<int>(c.two_view.size());
+  const bool epipolar = two_view < options.registration_min_tag_point_inliers ||
+                        v.two_view_consistent >= options.registration_min_tag_two_view_fraction * two_view;
+  return v.tags_off == 0 && v.corner_rms_px <= options.registration_max_tag_rms_px && epipolar &&
+         TagsCanRegister(v.tags_fitting, v.other_inliers, options);
 }
 
 }  // namespace
@@ -232,7 +291,7 @@ bool RegisterImageByTags(MapperModel* model, const std::vector<MapperImage>& ima
     auto corners = EstimateAbsolutePose(corner_pixels, corner_world, camera, pose_options);
     if (corners.ok() && corners->success()) {
       Rigid3 pose = corners->cam_from_world;
-      const Verdict v = Judge(c, camera, pose, options);
+      const Verdict v = Judge(*model, c, camera, pose, options);
       if (static_cast<int>(v.inliers.size()) >= 4) {
         RadialCamera refined_camera = camera;
         auto refined = RefineAbsolutePose(c.pixels, c.world, v.inliers, pose_options.refinement, &refined_camera,
@@ -246,10 +305,12 @@ bool RegisterImageByTags(MapperModel* model, const std::vector<MapperImage>& ima
   Verdict best_verdict;
   std::string judged;
   for (size_t p = 0; p < poses.size(); ++p) {
-    Verdict v = Judge(c, camera, poses[p], options);
+    Verdict v = Judge(*model, c, camera, poses[p], options);
     judged += (judged.empty() ? "" : ", ") + std::to_string(v.tags_fitting) + " of " + std::to_string(num_tags) +
-              " tags and " + std::to_string(v.other_inliers) + " other points fit";
-    if (Accepted(v, options) && (best < 0 || v.inliers.size() > best_verdict.inliers.size())) {
+              " tags and " + std::to_string(v.other_inliers) + " other points fit, corners rms " +
+              FormatPixels(v.corner_rms_px) + ", " + std::to_string(v.two_view_consistent) + " of " +
+              std::to_string(c.two_view.size()) + " two-view matches on their epipolar lines";
+    if (Accepted(v, c, options) && (best < 0 || v.inliers.size() > best_verdict.inliers.size())) {
       best = static_cast<int>(p);
       best_verdict = std::move(v);
     }

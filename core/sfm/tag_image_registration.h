@@ -9,7 +9,8 @@
 // by the edge of the tags the model holds in full: all tags of a project share one size). A tag of
 // known size fixes a pose on its own, up to the planar flip of a small tag; so the image needs
 // every corner of every known tag it sees within MapperOptions::registration_max_error_px of the
-// pose, and at least two such tags, or one and registration_min_tag_point_inliers other inliers.
+// pose, their root mean square error at most registration_max_tag_rms_px, and at least two such
+// tags, or one and registration_min_tag_point_inliers other inliers.
 // A known tag that does not fit the pose refuses it (a wrongly placed tag or a wrong pose).
 #include <Eigen/Core>
 #include <array>
