@@ -44,23 +44,6 @@ std::array<Eigen::Vector3d, 4> TagCorners(const Eigen::Vector3d& centre, const E
   return corners;
 }
 
-// Removes `image` from the model as if it had not been registered: no pose, no observation.
-void Unregister(MapperModel* model, int image) {
-  SfmImage& img = model->rec.images[static_cast<size_t>(image)];
-  img.registered = false;
-  img.cam_from_world = Rigid3();
-  for (int& id : img.point3d_ids) {
-    if (id < 0) continue;
-    std::vector<TrackElement>& track = model->rec.points[static_cast<size_t>(id)].track;
-    std::vector<TrackElement> kept;
-    for (const TrackElement& e : track) {
-      if (e.image_id != image) kept.push_back(e);
-    }
-    track = kept;
-    id = -1;
-  }
-}
-
 TagScene MakeTagScene(int points_kept, bool two_view = false) {
   TagScene t;
   testing::SceneOptions o;
@@ -112,7 +95,7 @@ TagScene MakeTagScene(int points_kept, bool two_view = false) {
     for (const TrackElement& e : t.model.tracks.tracks[static_cast<size_t>(track)])
       t.model.AddObservation(id, e.image_id, e.keypoint_id);
   }
-  Unregister(&t.model, kImage);
+  testing::Unregister(&t.model, kImage);
   // Image kImage keeps `points_kept` SIFT keypoints with a track; its tag corners keep theirs.
   std::vector<int>& track_of = t.model.tracks.track_of[kImage];
   const size_t sift = t.scene.images[kImage].keypoints.size() - 4 * observations[kImage].size();
