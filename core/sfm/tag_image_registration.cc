@@ -12,10 +12,14 @@
 namespace reconar {
 namespace {
 
-// The tag's corner keypoints lie within the image's keypoints.
-bool ValidTag(const MapperModel& model, int image, const MapperTag& tag) {
-  const size_t keypoints = model.tracks.track_of[static_cast<size_t>(image)].size();
-  return tag.first_keypoint >= 0 && static_cast<size_t>(tag.first_keypoint) + 4 <= keypoints;
+// The tag's corner keypoints lie within the image's keypoints and its tracks.
+bool ValidTag(const MapperModel& model, const std::vector<MapperImage>& images, int image, const MapperTag& tag) {
+  if (image < 0 || static_cast<size_t>(image) >= images.size() ||
+      static_cast<size_t>(image) >= model.tracks.track_of.size() || tag.first_keypoint < 0)
+    return false;
+  const size_t end = static_cast<size_t>(tag.first_keypoint) + 4;
+  return end <= model.tracks.track_of[static_cast<size_t>(image)].size() &&
+         end <= images[static_cast<size_t>(image)].keypoints.size();
 }
 
 // The model point of corner k of `tag` in `image`, or -1.
@@ -32,7 +36,7 @@ double ModelTagEdge(const MapperModel& model, const std::vector<MapperImage>& im
   for (size_t i = 0; i < images.size() && i < model.rec.images.size(); ++i) {
     if (!model.rec.images[i].registered) continue;
     for (const MapperTag& tag : images[i].tags) {
-      if (!ValidTag(model, static_cast<int>(i), tag)) continue;
+      if (!ValidTag(model, images, static_cast<int>(i), tag)) continue;
       std::array<int, 4> points;
       for (int k = 0; k < 4; ++k) points[static_cast<size_t>(k)] = CornerPoint(model, static_cast<int>(i), tag, k);
       if (*std::min_element(points.begin(), points.end()) < 0) continue;
@@ -57,7 +61,7 @@ bool CornersFromOneView(const MapperModel& model, const std::vector<MapperImage>
   for (size_t i = 0; i < images.size() && i < model.rec.images.size(); ++i) {
     if (!model.rec.images[i].registered) continue;
     for (const MapperTag& tag : images[i].tags) {
-      if (tag.tag_id != tag_id || !ValidTag(model, static_cast<int>(i), tag)) continue;
+      if (tag.tag_id != tag_id || !ValidTag(model, images, static_cast<int>(i), tag)) continue;
       double perimeter = 0.0;
       const std::vector<Eigen::Vector2d>& keypoints = images[i].keypoints;
       for (int k = 0; k < 4; ++k) {
@@ -226,9 +230,7 @@ std::vector<KnownTag> KnownTags(const MapperModel& model, const std::vector<Mapp
   if (image < 0 || static_cast<size_t>(image) >= images.size()) return known;
   double edge = -1.0;  // computed when first needed
   for (const MapperTag& tag : images[static_cast<size_t>(image)].tags) {
-    if (!ValidTag(model, image, tag) ||
-        static_cast<size_t>(tag.first_keypoint) + 4 > images[static_cast<size_t>(image)].keypoints.size())
-      continue;
+    if (!ValidTag(model, images, image, tag)) continue;
     KnownTag k;
     k.tag_id = tag.tag_id;
     k.first_keypoint = tag.first_keypoint;

@@ -264,5 +264,17 @@ TEST(TagImageRegistrationTest, ThreeCornersGiveTheFourth) {
   EXPECT_LT((known[0].corners[2] - t.tags[0][2]).norm(), 1e-9);
 }
 
+TEST(TagImageRegistrationTest, TagsWhoseCornersAreNoKeypointsAreIgnored) {
+  TagScene t = MakeTagScene(0);
+  const int size = static_cast<int>(t.scene.images[kImage].keypoints.size());
+  for (const int first : {-3, size - 3, size, 2147483646}) t.scene.images[kImage].tags.push_back({7, first});
+  EXPECT_EQ(KnownTags(t.model, t.scene.images, kImage, Options()).size(), 3u);
+  EXPECT_TRUE(KnownTags(t.model, t.scene.images, -1, Options()).empty());
+  EXPECT_TRUE(KnownTags(t.model, t.scene.images, static_cast<int>(t.scene.images.size()), Options()).empty());
+  bool focal_changed = false;
+  ASSERT_TRUE(RegisterImage(&t.model, t.scene.images, kImage, Options(), &focal_changed)) << t.model.failure[kImage];
+  ExpectTruePose(t);
+}
+
 }  // namespace
 }  // namespace reconar
