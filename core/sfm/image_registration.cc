@@ -3,6 +3,7 @@
 #include <string>
 
 #include "core/geometry/absolute_pose.h"
+#include "core/sfm/tag_image_registration.h"
 
 namespace reconar {
 
@@ -29,6 +30,16 @@ SfmCamera GuessCamera(const MapperModel& model, int image) {
     camera.k2 = k2_sum / n;
   }
   return camera;
+}
+
+void AcceptRegistration(MapperModel* model, int image, const Rigid3& cam_from_world,
+                        const std::vector<std::pair<int, int>>& observations) {
+  SfmImage& img = model->rec.images[static_cast<size_t>(image)];
+  img.cam_from_world.rotation = cam_from_world.rotation;
+  img.cam_from_world.translation = cam_from_world.translation;
+  img.registered = true;
+  for (const auto& [kp, point] : observations) model->AddObservation(point, image, kp);
+  model->failure[static_cast<size_t>(image)].clear();
 }
 
 bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, int image, const MapperOptions& options,
@@ -64,9 +75,14 @@ bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, i
     result = EstimateAbsolutePoseUnknownFocal(pixels, world, pose_camera, pose_options);
   }
   if (!result.ok() || !result->success()) {
-    model->failure[static_cast<size_t>(image)] =
-        "pose from " + std::to_string(pixels.size()) +
-        " 2D-3D correspondences failed: " + (result.ok() ? result->reason : result.status().message());
+    std::string reason = "pose from " + std::to_string(pixels.size()) +
+                         " 2D-3D correspondences failed: " + (result.ok() ? result->reason : result.status().message());
+    if (!images[static_cast<size_t>(image)].tags.empty()) {
+      std::string tag_reason;
+      if (RegisterImageByTags(model, images, image, options, &tag_reason)) return true;
+      reason += "; " + tag_reason;
+    }
+    model->failure[static_cast<size_t>(image)] = std::move(reason);
     return false;
   }
   if (!focal_confirmed && result->focal > 0.0) {
@@ -80,15 +96,14 @@ bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, i
     rec.cameras[static_cast<size_t>(camera_id)] = camera;
     *focal_changed = true;
   }
-  img.cam_from_world.rotation = result->cam_from_world.rotation;
-  img.cam_from_world.translation = result->cam_from_world.translation;
-  img.registered = true;
+  std::vector<std::pair<int, int>> observations;
+  observations.reserve(result->inliers.size());
   for (int index : result->inliers) {
     const int kp = keypoint_of[static_cast<size_t>(index)];
     const int t = track_of[static_cast<size_t>(kp)];
-    model->AddObservation(model->point_of_track[static_cast<size_t>(t)], image, kp);
+    observations.emplace_back(kp, model->point_of_track[static_cast<size_t>(t)]);
   }
-  model->failure[static_cast<size_t>(image)].clear();
+  AcceptRegistration(model, image, result->cam_from_world, observations);
   return true;
 }
 

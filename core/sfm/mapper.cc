@@ -139,7 +139,7 @@ class Mapper {
   // Registers the next image (next_image.h) that succeeds, triangulates its tracks and adjusts
   // around it (globally when its registration set a focal); false when no image registers.
   Result<bool> RegisterNextImage() {
-    for (const NextImageCandidate& candidate : NextImageCandidates(&model_, opt_)) {
+    for (const NextImageCandidate& candidate : NextImageCandidates(&model_, images_, opt_)) {
       model_.tried_with[static_cast<size_t>(candidate.image)] = candidate.visible;
       bool focal_changed = false;
       if (!RegisterImage(&model_, images_, candidate.image, opt_, &focal_changed)) continue;
@@ -215,6 +215,11 @@ Status MapperOptions::Check() const {
   }
   if (!(registration_max_error_px > 0.0)) return InvalidArgument("MapperOptions: registration_max_error_px <= 0");
   if (registration_min_inliers < 6) return InvalidArgument("MapperOptions: registration_min_inliers < 6");
+  if (registration_min_tag_point_inliers < 0)
+    return InvalidArgument("MapperOptions: registration_min_tag_point_inliers < 0");
+  if (!(registration_max_tag_rms_px > 0.0)) return InvalidArgument("MapperOptions: registration_max_tag_rms_px <= 0");
+  if (!(registration_min_tag_two_view_fraction >= 0.0 && registration_min_tag_two_view_fraction <= 1.0))
+    return InvalidArgument("MapperOptions: registration_min_tag_two_view_fraction must be in [0, 1]");
   if (!(max_reprojection_error_px > 0.0)) return InvalidArgument("MapperOptions: max_reprojection_error_px <= 0");
   if (!(min_triangulation_angle_deg >= 0.0)) return InvalidArgument("MapperOptions: min_triangulation_angle_deg < 0");
   if (local_ba_images < 0) return InvalidArgument("MapperOptions: local_ba_images < 0");

@@ -18,6 +18,13 @@
 
 namespace reconar {
 
+// A tag seen in an image: its four corners are the keypoints first_keypoint + k, k in the order of
+// kTagCornerUnits (tag_observations.h). AddTagCorrespondences (tag_registration.h) sets them.
+struct MapperTag {
+  int tag_id = -1;
+  int first_keypoint = -1;
+};
+
 struct MapperImage {
   std::string name;
   int width = 0;
@@ -29,6 +36,9 @@ struct MapperImage {
   // Optional: a bundle-adjustment weight (1 / relative standard deviation) per keypoint; 0 or an
   // empty vector leaves the keypoint to the scale rule (MapperOptions::weight_by_scale).
   std::vector<float> keypoint_weights;
+  // Optional: the tags among the keypoints. An image with tags may register by them
+  // (tag_image_registration.h); without, the mapper never looks at tags.
+  std::vector<MapperTag> tags;
 };
 
 struct MapperPair {
@@ -49,6 +59,19 @@ struct MapperOptions {
   // Registration: P3P LO-RANSAC with this pixel threshold; a pose needs this many inliers.
   double registration_max_error_px = 4.0;
   int registration_min_inliers = 30;
+  // Registration by tags (images with MapperImage::tags only, tag_image_registration.h): a pose
+  // that puts every corner of every tag the model holds within registration_max_error_px
+  // registers with fewer inliers when that is at least two such tags, or one and this many other
+  // inliers.
+  int registration_min_tag_point_inliers = 8;
+  // ... and whose root mean square error over those corners is at most this: a tag's corners are
+  // found to a few tenths of a pixel, and two small tags facing the camera admit a wrong pose that
+  // fits them each within a few pixels.
+  double registration_max_tag_rms_px = 2.0;
+  // ... and, when the image has at least registration_min_tag_point_inliers matches to registered
+  // images on tracks without a point, at least this fraction of them within
+  // registration_max_error_px of their epipolar lines under the pose.
+  double registration_min_tag_two_view_fraction = 0.3;
   // Triangulation and filtering.
   double max_reprojection_error_px = 4.0;
   double min_triangulation_angle_deg = 1.5;

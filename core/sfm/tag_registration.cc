@@ -12,6 +12,7 @@
 #include "core/base/json_writer.h"
 #include "core/math/rigid3_json.h"
 #include "core/geometry/triangulation.h"
+#include "core/math/rotation.h"
 #include "core/sfm/tag_layout.h"
 
 namespace reconar {
@@ -94,9 +95,75 @@ void ApplyToModel(const Sim3& world_from_model, Reconstruction* rec) {
     // X_cam' = s X_cam = s R_c X_model + s t_c with X_model = R^T (X_world - t) / s.
     Rigid3& pose = image.cam_from_world;
     pose.rotation = pose.rotation * model_from_world_rotation;
-    pose.translation = world_from_model.scale * pose.translation -
-                                      pose.rotation * world_from_model.translation;
+    pose.translation = world_from_model.scale * pose.translation - pose.rotation * world_from_model.translation;
   }
+}
+
+// The world tag as a rigid square of edge `edge` (model units) that best reprojects into the
+// views that saw its corners (cameras fixed; Gauss-Newton on its pose from the square fitted to
+// `corners`): a tag of known shape seen from several views fixes its plane better than four
+// corners triangulated each on its own. Returns `corners` when the fit fails or its root mean
+// square reprojection error exceeds max_error_px (the tag is no square in the model).
+std::array<Eigen::Vector3d, 4> RigidTagCorners(const Reconstruction& rec,
+                                               const std::array<std::vector<Observation>, 4>& views,
+                                               const std::array<Eigen::Vector3d, 4>& corners, double edge,
+                                               double max_error_px) {
+  const std::array<Eigen::Vector3d, 4> ideal = IdealCorners(edge);
+  auto start = AlignSimilarity(AsVector(ideal), AsVector(corners), 1.0);
+  if (!start.ok()) return corners;
+  Eigen::Matrix3d R = start->rotation;
+  Eigen::Vector3d t = start->translation;
+  const auto residuals = [&](const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation, Eigen::VectorXd* r) {
+    int n = 0;
+    for (size_t k = 0; k < 4; ++k) n += static_cast<int>(views[k].size());
+    r->resize(2 * n);
+    int i = 0;
+    for (size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d world = rotation * ideal[k] + translation;
+      for (const Observation& obs : views[k]) {
+        const SfmImage& image = rec.images[static_cast<size_t>(obs.first)];
+        const Eigen::Vector3d cam = image.cam_from_world * world;
+        if (!(cam.z() > 0.0)) return false;
+        r->segment<2>(2 * i++) = rec.cameras[static_cast<size_t>(image.camera_id)].Project(cam) - obs.second;
+      }
+    }
+    return r->allFinite();
+  };
+  Eigen::VectorXd r;
+  if (!residuals(R, t, &r) || r.size() < 12) return corners;
+  double cost = r.squaredNorm();
+  const double step = 1e-7 * std::max(1.0, t.norm());
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    Eigen::MatrixXd J(r.size(), 6);
+    for (int d = 0; d < 6; ++d) {
+      Eigen::Matrix3d R_d = R;
+      Eigen::Vector3d t_d = t;
+      Eigen::Vector3d delta = Eigen::Vector3d::Zero();
+      delta[d % 3] = d < 3 ? 1e-7 : step;
+      if (d < 3) {
+        R_d = RotationFromAngleAxis(delta) * R;
+      } else {
+        t_d += delta;
+      }
+      Eigen::VectorXd r_d;
+      if (!residuals(R_d, t_d, &r_d)) return corners;
+      J.col(d) = (r_d - r) / delta[d % 3];
+    }
+    const Eigen::Matrix<double, 6, 1> dx = (J.transpose() * J).ldlt().solve(-J.transpose() * r);
+    if (!dx.allFinite()) break;
+    const Eigen::Matrix3d R_new = RotationFromAngleAxis(dx.head<3>()) * R;
+    const Eigen::Vector3d t_new = t + dx.tail<3>();
+    Eigen::VectorXd r_new;
+    if (!residuals(R_new, t_new, &r_new) || r_new.squaredNorm() >= cost) break;
+    R = R_new;
+    t = t_new;
+    r = r_new;
+    cost = r.squaredNorm();
+  }
+  if (!(cost <= max_error_px * max_error_px * static_cast<double>(r.size() / 2))) return corners;
+  std::array<Eigen::Vector3d, 4> rigid;
+  for (size_t k = 0; k < 4; ++k) rigid[k] = R * ideal[k] + t;
+  return rigid;
 }
 
 }  // namespace
@@ -114,6 +181,7 @@ std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vect
     for (const TagObservation& tag : observations[i]) {
       if (count[tag.tag_id] != 1) continue;  // a printed id twice in one photo: which is which is unknown
       first_keypoint[i][tag.tag_id] = static_cast<int>(image.keypoints.size());
+      image.tags.push_back({tag.tag_id, static_cast<int>(image.keypoints.size())});
       for (int k = 0; k < 4; ++k) {
         corners.push_back({static_cast<int>(i), static_cast<int>(image.keypoints.size()), tag.tag_id, k});
         image.keypoints.push_back(tag.corners[static_cast<size_t>(k)]);
@@ -248,8 +316,9 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
   }
   report.metres_per_model_unit = options.tag_size_m / mean_edge;
   RECONAR_ASSIGN_OR_RETURN(report.world_from_model,
-                           AlignSimilarity(AsVector(world->corners), AsVector(IdealCorners(options.tag_size_m)),
-                                           report.metres_per_model_unit));
+                           AlignSimilarity(AsVector(RigidTagCorners(*rec, seen.at(world->id), world->corners, mean_edge,
+                                                                    options.max_reprojection_error_px)),
+                                           AsVector(IdealCorners(options.tag_size_m)), report.metres_per_model_unit));
   ApplyToModel(report.world_from_model, rec);
   report.metric = true;
   report.world_tag = world->id;

@@ -12,7 +12,11 @@
 // mean edge of all complete tags, and moves the model into the frame of the world tag (tag frame:
 // origin at its centre, x right, y up, z out of the printed tag; metres): world_from_model is the
 // similarity with that scale whose rotation and translation fit the world tag's corners to their
-// ideal places (Umeyama with fixed scale).
+// ideal places (Umeyama with fixed scale). Those corners are the world tag as a rigid square of
+// that edge whose pose best reprojects into every registered view of it (its four corner points
+// only start the fit and stay when the square does not fit within max_reprojection_error_px rms):
+// four corners triangulated each on its own tilt the frame by their depth errors, which the
+// cameras metres away turn into centimetres.
 #include <array>
 #include <string>
 #include <vector>
@@ -42,7 +46,8 @@ struct TagCornerKeypoint {
 inline constexpr double kTagCornerWeight = 2.0;
 
 // observations[i] are the tags seen in images[i]. Corners get `keypoint_scale` as detection scale
-// (when the images carry scales) and `corner_weight` as weight. A pair of images that share tags
+// (when the images carry scales) and `corner_weight` as weight, and each image lists its tags in
+// MapperImage::tags (so that the mapper may register it by them). A pair of images that share tags
 // but have no verified pair gets a new one, marked planar so that it never starts the reconstruction.
 std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vector<TagObservation>>& observations,
                                                      double keypoint_scale, double corner_weight,

@@ -19,28 +19,11 @@ testing::Scene RingScene() {
   return testing::MakeScene(o);
 }
 
-// Removes `image` from the model as if it had not been registered: no pose, no observation.
-void Unregister(MapperModel* model, int image) {
-  SfmImage& img = model->rec.images[static_cast<size_t>(image)];
-  img.registered = false;
-  img.cam_from_world = Rigid3();
-  for (int& id : img.point3d_ids) {
-    if (id < 0) continue;
-    std::vector<TrackElement>& track = model->rec.points[static_cast<size_t>(id)].track;
-    std::vector<TrackElement> kept;
-    for (const TrackElement& e : track) {
-      if (e.image_id != image) kept.push_back(e);
-    }
-    track = kept;
-    id = -1;
-  }
-}
-
 TEST(ImageRegistrationTest, RecoversTheTruePoseAndAddsTheInlierObservations) {
   const testing::Scene scene = RingScene();
   MapperModel model = testing::TrueModel(scene);
   const int image = 3;
-  Unregister(&model, image);
+  testing::Unregister(&model, image);
   MapperOptions options;
   options.num_threads = 1;
   bool focal_changed = true;
@@ -71,7 +54,7 @@ TEST(ImageRegistrationTest, RecoversTheTruePoseAndAddsTheInlierObservations) {
 TEST(ImageRegistrationTest, FailureGivesTheReasonAndLeavesTheImageUnregistered) {
   const testing::Scene scene = RingScene();
   MapperModel model = testing::TrueModel(scene);
-  Unregister(&model, 5);
+  testing::Unregister(&model, 5);
   MapperOptions options;
   options.registration_min_inliers = 100000;
   bool focal_changed = true;
@@ -97,7 +80,7 @@ double FocalAfterRegistration(double factor) {
   model.camera_prior.push_back(exif.focal);
   model.camera_from_exif.push_back(true);
   model.rec.images[2].camera_id = 1;
-  Unregister(&model, 2);
+  testing::Unregister(&model, 2);
   bool focal_changed = false;
   EXPECT_TRUE(RegisterImage(&model, images, 2, MapperOptions(), &focal_changed)) << model.failure[2];
   EXPECT_TRUE(focal_changed);
@@ -119,7 +102,7 @@ TEST(ImageRegistrationTest, GuessCameraAveragesRegisteredCamerasOfTheSameSize) {
   model.camera_prior.push_back(fresh.focal);
   model.camera_from_exif.push_back(false);
   model.rec.images[4].camera_id = 1;
-  Unregister(&model, 4);
+  testing::Unregister(&model, 4);
   // Camera 1 is unused and has no EXIF: the guess is camera 0's focal and distortion.
   const SfmCamera guess = GuessCamera(model, 4);
   EXPECT_EQ(guess.focal, scene.camera.focal);

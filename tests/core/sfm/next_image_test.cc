@@ -36,7 +36,7 @@ MapperModel HandMadeModel() {
 std::vector<NextImageCandidate> CandidatesOf(MapperModel* model) {
   MapperOptions options;
   options.registration_min_inliers = 2;
-  return NextImageCandidates(model, options);
+  return NextImageCandidates(model, {}, options);
 }
 
 TEST(NextImageTest, MostVisiblePointsFirstTiesByIndex) {
@@ -66,7 +66,7 @@ TEST(NextImageTest, NewPointsMakeAFailedImageACandidateAgain) {
 TEST(NextImageTest, RegisteredImagesAreNeverCandidates) {
   MapperModel model = HandMadeModel();
   for (SfmImage& image : model.rec.images) image.registered = true;
-  EXPECT_TRUE(NextImageCandidates(&model, MapperOptions()).empty());
+  EXPECT_TRUE(NextImageCandidates(&model, {}, MapperOptions()).empty());
 }
 
 }  // namespace

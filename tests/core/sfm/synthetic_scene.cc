@@ -162,6 +162,22 @@ MapperOptions SingleThreaded() {
   return options;
 }
 
+void Unregister(MapperModel* model, int image) {
+  SfmImage& img = model->rec.images[static_cast<size_t>(image)];
+  img.registered = false;
+  img.cam_from_world = Rigid3();
+  for (int& id : img.point3d_ids) {
+    if (id < 0) continue;
+    std::vector<TrackElement>& track = model->rec.points[static_cast<size_t>(id)].track;
+    std::vector<TrackElement> kept;
+    for (const TrackElement& e : track) {
+      if (e.image_id != image) kept.push_back(e);
+    }
+    track = kept;
+    id = -1;
+  }
+}
+
 MapperModel TrueModel(const Scene& scene) {
   MapperModel model;
   model.rec.cameras.push_back(scene.camera);

@@ -73,6 +73,9 @@ MapperOptions SingleThreaded();
 // whose keypoints all observe one true point (with all of them as observations).
 MapperModel TrueModel(const Scene& scene);
 
+// Removes `image` from the model as if it had not been registered: no pose, no observation.
+void Unregister(MapperModel* model, int image);
+
 // Expects (gtest) the two models equal to the bit: cameras, poses, observations, points.
 void ExpectIdenticalModels(const Reconstruction& a, const Reconstruction& b);
 
