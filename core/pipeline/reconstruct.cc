@@ -319,14 +319,17 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       json.EndObject();
       return WriteFileAtomically(project.SparseDir() + "/report.json", json.str() + "\n");
     };
-    RECONAR_RETURN_IF_ERROR(runner.Run("mapping",
-                                       Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
-                                                 {"max_error", mapper.max_reprojection_error_px},
-                                                 {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
-                                                 {"tag_size", options.tag_size_m},
-                                                 {"world_tag", sfm.tags.registration.world_tag},
-                                                 {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}}),
-                                       Exists(project.SparseDir() + "/report.json"), runner.redone(), run_mapping));
+    std::string mapping_settings = Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
+                                             {"max_error", mapper.max_reprojection_error_px},
+                                             {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
+                                             {"tag_size", options.tag_size_m},
+                                             {"world_tag", sfm.tags.registration.world_tag},
+                                             {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}});
+    // Tag projects map differently since images register by their known tags and the world tag is
+    // fitted as a square (version 2): their recorded mapping is not reused. Others are unchanged.
+    if (with_tags) mapping_settings += " " + Settings({{"tag_mapping", 2.0}});
+    RECONAR_RETURN_IF_ERROR(runner.Run("mapping", mapping_settings, Exists(project.SparseDir() + "/report.json"),
+                                       runner.redone(), run_mapping));
 
     MapStageOptions map = options.map;
     map.build.num_threads = threads;
