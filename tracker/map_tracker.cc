@@ -290,8 +290,8 @@ Status MapTracker::Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameRepo
   RECONAR_ASSIGN_OR_RETURN(const LocalizationResult result, localizer_.Localize(features, query_camera_));
   report->relocalise_ms = 1000.0 * SecondsSince(start);
   if (!result.registered) return Status::Ok();
-  // Every inlier is followed from its keypoint (best first up to the capacity: the localizer's
-  // order is by map point id, which is as good as any).
+  // The inliers (within max_error_px, up to the capacity, in the localizer's order: by map point
+  // id) are the frame's; each is followed from its keypoint unless its window is flat.
   const double max_squared = options_.max_error_px * options_.max_error_px;
   int count = 0;
   double sum = 0.0;
@@ -305,7 +305,8 @@ Status MapTracker::Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameRepo
     const Eigen::Vector3d& world = map_->points[static_cast<size_t>(point)];
     const double squared =
         SquaredPixelError(camera_, result.cam_from_world.rotation, result.cam_from_world.translation, world, pixel);
-    if (!(squared < max_squared) || !AddTrack(point, pixel.cast<float>())) continue;
+    if (!(squared < max_squared)) continue;
+    AddTrack(point, pixel.cast<float>());  // not followed when its window is flat; still an inlier
     sum += squared;
     const size_t d = static_cast<size_t>(count++);
     pixels_[d] = pixel;

@@ -170,6 +170,19 @@ TEST_F(MapTrackerTest, RejectsBadOptionsAndInputs) {
   Image<uint8_t> square(300, 300);
   EXPECT_FALSE((*tracker)->Track(square.view(), nullptr, &report).ok());
   EXPECT_STREQ(MapTrackingStateName(MapTrackingState::kRelocalising), "relocalising");
+  // Intrinsics without a size take any frame; tiny frames are refused or lost, never read beyond.
+  options = Options();
+  options.intrinsics.width = options.intrinsics.height = 0;
+  auto any_size = MapTracker::Create(map_, options);
+  ASSERT_TRUE(any_size.ok());
+  for (const int side : {1, 3, 9, 17}) {
+    Image<uint8_t> tiny(side, side + 1);
+    std::fill(tiny.data(), tiny.data() + side * (side + 1), static_cast<uint8_t>(40 * side));
+    const Status status = (*any_size)->Track(tiny.view(), nullptr, &report);
+    if (status.ok()) {
+      EXPECT_FALSE(report.found) << side;
+    }
+  }
 }
 
 }  // namespace
