@@ -28,7 +28,11 @@
 // pitch sweeps of a few degrees: every frame is a homography of the query frame,
 // tests/tracker/rotation_video.h); the tracker relocalises on its first frame and tracks the rest
 // against the same map. Median and 95th percentile of the tracked frames' time (wall and thread
-// CPU, 1 thread), and their rotation / centre error against the rendered truth.
+// CPU, 1 thread), and their rotation / centre error against the rendered truth. Beside it, the
+// textbook OpenCV tracker on the same frames: the map inliers of our first (relocalised) frame
+// followed by cv::calcOpticalFlowPyrLK (21x21 window, 3 levels, the defaults) from the previous
+// frame, and cv::solvePnP (iterative LM from the previous pose, the same pinhole camera) on the
+// points it keeps; no new points are added (a user would add a detector and matching for that).
 #include <time.h>
 
 #include <Eigen/Geometry>
@@ -39,6 +43,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -58,6 +63,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/flann.hpp>
+#include <opencv2/video/tracking.hpp>
 #endif
 
 namespace reconar {
@@ -303,7 +309,77 @@ struct TrackingSummary {
   int lost_frames = 0;  // frames after the first without a pose
   int max_tracked_points = 0;
   std::vector<double> ms, cpu_ms, inliers, rotation_error_deg, centre_error;
+  // The OpenCV tracker on the same frames (when built with OpenCV).
+  int opencv_lost_frames = 0;
+  std::vector<double> opencv_ms, opencv_cpu_ms, opencv_points, opencv_rotation_error_deg, opencv_centre_error;
 };
+
+#ifdef RECONAR_BENCH_WITH_OPENCV
+// The textbook tracker: points followed by pyramidal LK from the previous frame, pose by
+// iterative PnP from the previous one. Started from our first frame's map inliers and pose.
+class OpenCvFlowTracker {
+ public:
+  OpenCvFlowTracker(const CameraIntrinsics& camera, const MapTrackerFrameReport& first, const cv::Mat& first_frame)
+      : k_(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1), previous_(first_frame.clone()) {
+    for (size_t i = 0; i < first.inlier_pixels.size(); ++i) {
+      pixels_.emplace_back(static_cast<float>(first.inlier_pixels[i].x()), static_cast<float>(first.inlier_pixels[i].y()));
+      const Eigen::Vector3d& X = first.inlier_world_points[i];
+      points_.emplace_back(static_cast<float>(X.x()), static_cast<float>(X.y()), static_cast<float>(X.z()));
+    }
+    cv::Matx33d r;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) r(i, j) = first.cam_from_world.rotation(i, j);
+    }
+    cv::Rodrigues(r, rvec_);
+    tvec_ = (cv::Mat_<double>(3, 1) << first.cam_from_world.translation.x(), first.cam_from_world.translation.y(),
+             first.cam_from_world.translation.z());
+  }
+
+  // The next frame's pose; false when fewer than 6 points are left.
+  bool Track(const cv::Mat& frame, Rigid3* cam_from_world) {
+    if (pixels_.size() < 6) return false;
+    std::vector<cv::Point2f> next;
+    std::vector<uint8_t> status;
+    std::vector<float> error;
+    cv::calcOpticalFlowPyrLK(previous_, frame, pixels_, next, status, error);
+    size_t kept = 0;
+    for (size_t i = 0; i < next.size(); ++i) {
+      if (!status[i]) continue;
+      pixels_[kept] = next[i];
+      points_[kept] = points_[i];
+      ++kept;
+    }
+    pixels_.resize(kept);
+    points_.resize(kept);
+    frame.copyTo(previous_);
+    if (kept < 6 || !cv::solvePnP(points_, pixels_, k_, cv::noArray(), rvec_, tvec_, true, cv::SOLVEPNP_ITERATIVE)) {
+      return false;
+    }
+    cv::Matx33d r;
+    cv::Rodrigues(rvec_, r);
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) cam_from_world->rotation(i, j) = r(i, j);
+      cam_from_world->translation(i) = tvec_.at<double>(i);
+    }
+    return true;
+  }
+  size_t points() const { return pixels_.size(); }
+
+ private:
+  cv::Matx33d k_;
+  cv::Mat previous_;
+  cv::Mat rvec_, tvec_;
+  std::vector<cv::Point2f> pixels_;
+  std::vector<cv::Point3f> points_;
+};
+#endif
+
+void AccumulatePoseError(const Rigid3& estimate, const Rigid3& truth, std::vector<double>* rotation_error_deg,
+                         std::vector<double>* centre_error) {
+  const Eigen::AngleAxisd delta(Eigen::Matrix3d(estimate.rotation * truth.rotation.transpose()));
+  rotation_error_deg->push_back(std::abs(delta.angle()) * 180.0 / M_PI);
+  centre_error->push_back((CameraCenterInWorld(estimate) - CameraCenterInWorld(truth)).norm());
+}
 
 // A rotating-camera video of kTrackedVideoFrames frames around the query's localised pose, tracked
 // against the map; the frames after the first (relocalised) are timed.
@@ -335,6 +411,9 @@ Status TrackRotatingView(const LocalizationMap& map, const Query& query, const R
   RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<MapTracker> tracker, MapTracker::Create(&map, options));
   MapTrackerFrameReport report;
   ++summary->videos;
+#ifdef RECONAR_BENCH_WITH_OPENCV
+  std::unique_ptr<OpenCvFlowTracker> opencv;
+#endif
   for (int i = 0; i < kTrackedVideoFrames; ++i) {
     // Yaw 0 -> 4 deg -> 0, pitch 0 -> 2 deg: up to ~0.4 deg (~4 px at 640 px) per frame.
     const double phase = static_cast<double>(i) / (kTrackedVideoFrames - 1);
@@ -344,6 +423,26 @@ Status TrackRotatingView(const LocalizationMap& map, const Query& query, const R
     RECONAR_RETURN_IF_ERROR(tracker->Track(frame.view(), nullptr, &report));
     double wall_ms = 0.0, cpu_ms = 0.0;
     clock.Stop(&wall_ms, &cpu_ms);
+    const Rigid3 truth = testing::RotatedViewPose(scene, rotation);
+#ifdef RECONAR_BENCH_WITH_OPENCV
+    const cv::Mat cv_frame(frame.height(), frame.width(), CV_8U, const_cast<uint8_t*>(frame.data()));
+    if (i == 0 && report.found) opencv = std::make_unique<OpenCvFlowTracker>(intrinsics, report, cv_frame);
+    if (i > 0 && opencv) {
+      Rigid3 opencv_pose;
+      const Stopwatch opencv_clock;
+      const bool opencv_found = opencv->Track(cv_frame, &opencv_pose);
+      double opencv_wall_ms = 0.0, opencv_cpu_ms = 0.0;
+      opencv_clock.Stop(&opencv_wall_ms, &opencv_cpu_ms);
+      if (opencv_found) {
+        summary->opencv_ms.push_back(opencv_wall_ms);
+        summary->opencv_cpu_ms.push_back(opencv_cpu_ms);
+        summary->opencv_points.push_back(static_cast<double>(opencv->points()));
+        AccumulatePoseError(opencv_pose, truth, &summary->opencv_rotation_error_deg, &summary->opencv_centre_error);
+      } else {
+        ++summary->opencv_lost_frames;
+      }
+    }
+#endif
     if (i == 0) continue;
     if (!report.found) {
       ++summary->lost_frames;
@@ -353,10 +452,7 @@ Status TrackRotatingView(const LocalizationMap& map, const Query& query, const R
     summary->ms.push_back(wall_ms);
     summary->cpu_ms.push_back(cpu_ms);
     summary->inliers.push_back(report.inliers);
-    const Rigid3 truth = testing::RotatedViewPose(scene, rotation);
-    const Eigen::AngleAxisd delta(Eigen::Matrix3d(report.cam_from_world.rotation * truth.rotation.transpose()));
-    summary->rotation_error_deg.push_back(std::abs(delta.angle()) * 180.0 / M_PI);
-    summary->centre_error.push_back((CameraCenterInWorld(report.cam_from_world) - CameraCenterInWorld(truth)).norm());
+    AccumulatePoseError(report.cam_from_world, truth, &summary->rotation_error_deg, &summary->centre_error);
   }
   return Status::Ok();
 }
@@ -543,6 +639,13 @@ int Run(int argc, char** argv) {
     json.Key("median_rotation_error_deg").Double(Median(tracking.rotation_error_deg));
     json.Key("p95_rotation_error_deg").Double(Quantile(tracking.rotation_error_deg, 0.95));
     json.Key("median_centre_error").Double(Median(tracking.centre_error));
+    if (with_opencv) {
+      JsonTimes(&json, "opencv_frame_ms", tracking.opencv_ms);
+      JsonTimes(&json, "opencv_frame_cpu_ms", tracking.opencv_cpu_ms);
+      json.Key("opencv_lost_frames").Int(tracking.opencv_lost_frames);
+      json.Key("opencv_median_rotation_error_deg").Double(Median(tracking.opencv_rotation_error_deg));
+      json.Key("opencv_median_centre_error").Double(Median(tracking.opencv_centre_error));
+    }
     json.EndObject();
     if (with_opencv) {
       JsonSummary(&json, "opencv", baseline, false);
@@ -605,6 +708,18 @@ int Run(int argc, char** argv) {
     std::printf("OpenCV baseline: not built (OpenCV not found)\n");
     return 0;
   }
+  std::printf("OpenCV tracked frames (calcOpticalFlowPyrLK 21x21, 3 levels + solvePnP iterative from the previous pose, "
+              "started from our first frame's map inliers, no new points):\n");
+  PrintRow("tracked frame", tracking.opencv_ms, tracking.opencv_cpu_ms);
+  std::printf(
+      "    %zu tracked frames, %d without a pose; median points %.0f; vs the rendered truth: rotation median %.4f / "
+      "p95 %.4f deg, centre median %.5f (map units)\n",
+      tracking.opencv_ms.size(), tracking.opencv_lost_frames, Median(tracking.opencv_points),
+      Median(tracking.opencv_rotation_error_deg), Quantile(tracking.opencv_rotation_error_deg, 0.95),
+      Median(tracking.opencv_centre_error));
+  std::printf("    ratios ours/OpenCV: tracked frame median %.3f (thread CPU %.3f); rotation error median %.3f\n",
+              Median(tracking.ms) / Median(tracking.opencv_ms), Median(tracking.cpu_ms) / Median(tracking.opencv_cpu_ms),
+              Median(tracking.rotation_error_deg) / Median(tracking.opencv_rotation_error_deg));
 #ifdef RECONAR_BENCH_WITH_OPENCV
   std::printf(
       "OpenCV %s (SIFT defaults; FLANN KD-tree 4 trees, 32 checks, over all %d map points, trained once in "
