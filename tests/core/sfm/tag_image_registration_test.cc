@@ -124,11 +124,13 @@ void HideTag(TagScene* t, int id) {
   }
 }
 
-void ExpectTruePose(const TagScene& t) {
+// The pose within max_rotation_deg and max_centre_error (scene units) of the truth.
+void ExpectTruePose(const TagScene& t, double max_rotation_deg = 0.2, double max_centre_error = 0.05) {
   const SfmImage& img = t.model.rec.images[kImage];
   ASSERT_TRUE(img.registered);
-  EXPECT_LT(RotationAngle(img.cam_from_world.rotation, t.scene.poses[kImage].rotation) * 180.0 / M_PI, 0.2);
-  EXPECT_LT((img.Center() - CameraCenterInWorld(t.scene.poses[kImage])).norm(), 0.05);
+  EXPECT_LT(RotationAngle(img.cam_from_world.rotation, t.scene.poses[kImage].rotation) * 180.0 / M_PI,
+            max_rotation_deg);
+  EXPECT_LT((img.Center() - CameraCenterInWorld(t.scene.poses[kImage])).norm(), max_centre_error);
 }
 
 MapperOptions Options() {
@@ -244,13 +246,19 @@ TEST(TagImageRegistrationTest, ATagWithoutPointsIsPlacedByItsPoseInOneRegistered
   const std::vector<KnownTag> known = KnownTags(t.model, t.scene.images, kImage, Options());
   ASSERT_EQ(known.size(), 2u);
   EXPECT_EQ(known[1].tag_id, 1);
+  constexpr double kPlacedCornerError = 0.05;  // scene units
   for (size_t k = 0; k < 4; ++k) {
     EXPECT_EQ(known[1].points[k], -1);
-    EXPECT_LT((known[1].corners[k] - t.tags[1][k]).norm(), 0.05);
+    EXPECT_LT((known[1].corners[k] - t.tags[1][k]).norm(), kPlacedCornerError);
   }
   bool focal_changed = false;
   ASSERT_TRUE(RegisterImage(&t.model, t.scene.images, kImage, Options(), &focal_changed)) << t.model.failure[kImage];
-  ExpectTruePose(t);
+  // Half of the pose's 8 corners are placed only within kPlacedCornerError, seen from about 10
+  // units (the ring's radius): the pose can turn by up to twice that error's angle, about 0.57
+  // degrees, and its centre move by that angle times the distance, about 0.1 units. (The exact
+  // errors differ between x86-64 and aarch64, whose floating-point contraction differs.)
+  const double angle = std::atan(kPlacedCornerError / 10.0);
+  ExpectTruePose(t, 2.0 * angle * 180.0 / M_PI, 2.0 * angle * 10.0);
 }
 
 TEST(TagImageRegistrationTest, ThreeCornersGiveTheFourth) {
