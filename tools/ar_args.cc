@@ -40,6 +40,15 @@ Result<CameraIntrinsics> IntrinsicsFromArg(const std::string& value) {
   return intrinsics;
 }
 
+Result<std::optional<ArProject>> ProjectFromArgs(const Args& args, TrackerDefaults* defaults) {
+  if (!args.Has("project")) return std::optional<ArProject>();
+  ArProjectOptions options;
+  options.load_map = !args.Has("no-map");
+  RECONAR_ASSIGN_OR_RETURN(ArProject project, LoadArProject(args.Get("project"), options));
+  *defaults = {project.photo_intrinsics, project.tag_size, project.family};
+  return std::optional<ArProject>(std::move(project));
+}
+
 Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args, const TrackerDefaults& defaults) {
   TagTrackerOptions options;
   if (args.Has("intrinsics")) {

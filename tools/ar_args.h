@@ -6,6 +6,7 @@
 
 #include "core/base/status.h"
 #include "core/math/camera_intrinsics.h"
+#include "render/ar/ar_project.h"
 #include "tools/args.h"
 #include "tracker/tag_tracker.h"
 
@@ -22,6 +23,10 @@ struct TrackerDefaults {
   std::optional<double> tag_size;
   std::optional<std::string> family;
 };
+
+// --project DIR (with --no-map, without its map): the project, and in *defaults the camera, tag
+// size and family it gives; nullopt without --project. Errors of LoadArProject.
+Result<std::optional<ArProject>> ProjectFromArgs(const Args& args, TrackerDefaults* defaults);
 
 // --intrinsics, --tag-size, --family, --decimate, --threads, --full-frame-interval, --max-tags.
 Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args, const TrackerDefaults& defaults = {});

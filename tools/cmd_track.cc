@@ -64,14 +64,11 @@ int RunTrack(int argc, char** argv, int first) {
   options.source = args.positionals()[0];
   options.frames.want_rgb = false;
   TrackerDefaults defaults;
-  if (args.Has("project")) {
-    ArProjectOptions project_options;
-    project_options.load_map = !args.Has("no-map");
-    auto project = LoadArProject(args.Get("project"), project_options);
-    if (!project.ok()) return Fail(project.status());
-    defaults = {project->photo_intrinsics, project->tag_size, project->family};
-    options.pose.layout = std::move(project->layout);
-    options.map = std::move(project->map);
+  auto project = ProjectFromArgs(args, &defaults);
+  if (!project.ok()) return Fail(project.status());
+  if (*project) {
+    options.pose.layout = std::move((*project)->layout);
+    options.map = std::move((*project)->map);
     options.scale_intrinsics_to_video = !args.Has("intrinsics");
   }
   auto tracker_options = TrackerOptionsFromArgs(args, defaults);

@@ -130,16 +130,10 @@ int RunView(int argc, char** argv, int first) {
     std::fputs(kTrackerOptionsHelp, stderr);
     return 2;
   }
-  std::optional<ArProject> project;
   TrackerDefaults defaults;
-  if (args.Has("project")) {
-    ArProjectOptions project_options;
-    project_options.load_map = !args.Has("no-map");
-    auto loaded = LoadArProject(args.Get("project"), project_options);
-    if (!loaded.ok()) return Fail(loaded.status());
-    project = std::move(*loaded);
-    defaults = {project->photo_intrinsics, project->tag_size, project->family};
-  }
+  auto loaded = ProjectFromArgs(args, &defaults);
+  if (!loaded.ok()) return Fail(loaded.status());
+  const std::optional<ArProject>& project = *loaded;
   ArViewOptions options;
   ArSessionOptions& session = options.session;
   auto tracker_options = TrackerOptionsFromArgs(args, defaults);

@@ -10,6 +10,7 @@
 #include "core/base/elapsed.h"
 #include "core/base/prng.h"
 #include "core/geometry/absolute_pose.h"
+#include "core/io/gray.h"
 #include "core/math/rotation.h"
 
 namespace reconar {
@@ -281,11 +282,7 @@ bool MapTracker::TrackFrame(const Rigid3& predicted, MapTrackerFrameReport* repo
 Status MapTracker::Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameReport* report) {
   const auto start = Clock::now();
   report->relocalisation_tried = true;
-  for (int y = 0; y < gray.height; ++y) {
-    const uint8_t* in = gray.row(y);
-    float* out = sift_image_.row(y);
-    for (int x = 0; x < gray.width; ++x) out[x] = in[x] * (1.0f / 255.0f);
-  }
+  Gray8ToFloat(gray, sift_image_.view());
   RECONAR_ASSIGN_OR_RETURN(const SiftFeatures features, sift_->Extract(sift_image_.view()));
   RECONAR_ASSIGN_OR_RETURN(const LocalizationResult result, localizer_.Localize(features, query_camera_));
   report->relocalise_ms = 1000.0 * SecondsSince(start);

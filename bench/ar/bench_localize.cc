@@ -178,6 +178,13 @@ struct Summary {
   int registered_with_reference = 0;
 };
 
+void AccumulatePoseError(const Rigid3& estimate, const Rigid3& truth, std::vector<double>* rotation_error_deg,
+                         std::vector<double>* centre_error) {
+  const Eigen::AngleAxisd delta(Eigen::Matrix3d(estimate.rotation * truth.rotation.transpose()));
+  rotation_error_deg->push_back(std::abs(delta.angle()) * 180.0 / M_PI);
+  centre_error->push_back((CameraCenterInWorld(estimate) - CameraCenterInWorld(truth)).norm());
+}
+
 void Accumulate(const Outcome& o, const Query& query, bool last_run, Summary* s) {
   s->sift_ms.push_back(o.sift_ms);
   s->sift_cpu_ms.push_back(o.sift_cpu_ms);
@@ -194,10 +201,7 @@ void Accumulate(const Outcome& o, const Query& query, bool last_run, Summary* s)
   ++s->registered;
   if (!query.reference) return;
   ++s->registered_with_reference;
-  const Rigid3& ref = *query.reference;
-  s->centre_error.push_back((CameraCenterInWorld(o.cam_from_world) - CameraCenterInWorld(ref)).norm());
-  const Eigen::AngleAxisd delta(Eigen::Matrix3d(o.cam_from_world.rotation * ref.rotation.transpose()));
-  s->rotation_error_deg.push_back(std::abs(delta.angle()) * 180.0 / M_PI);
+  AccumulatePoseError(o.cam_from_world, *query.reference, &s->rotation_error_deg, &s->centre_error);
 }
 
 Result<Outcome> RunOurs(const Query& query, SiftExtractor* extractor, const Localizer& localizer,
@@ -205,9 +209,7 @@ Result<Outcome> RunOurs(const Query& query, SiftExtractor* extractor, const Loca
   Outcome o;
   const Stopwatch sift_clock;
   Image<float> gray(query.gray.width(), query.gray.height());
-  for (int y = 0; y < gray.height(); ++y) {
-    for (int x = 0; x < gray.width(); ++x) gray.row(y)[x] = query.gray.row(y)[x] * (1.0f / 255.0f);
-  }
+  Gray8ToFloat(query.gray.view(), gray.view());
   RECONAR_ASSIGN_OR_RETURN(const SiftFeatures features, extractor->Extract(gray.view()));
   sift_clock.Stop(&o.sift_ms, &o.sift_cpu_ms);
   const Stopwatch pose_clock;
@@ -373,13 +375,6 @@ class OpenCvFlowTracker {
   std::vector<cv::Point3f> points_;
 };
 #endif
-
-void AccumulatePoseError(const Rigid3& estimate, const Rigid3& truth, std::vector<double>* rotation_error_deg,
-                         std::vector<double>* centre_error) {
-  const Eigen::AngleAxisd delta(Eigen::Matrix3d(estimate.rotation * truth.rotation.transpose()));
-  rotation_error_deg->push_back(std::abs(delta.angle()) * 180.0 / M_PI);
-  centre_error->push_back((CameraCenterInWorld(estimate) - CameraCenterInWorld(truth)).norm());
-}
 
 // A rotating-camera video of kTrackedVideoFrames frames around the query's localised pose, tracked
 // against the map; the frames after the first (relocalised) are timed.

@@ -20,6 +20,16 @@ void CheckChannels(const Image<uint8_t>& image) {
 
 }  // namespace
 
+void Gray8ToFloat(ImageView<const uint8_t> gray, ImageView<float> out) {
+  RECONAR_CHECK(out.width == gray.width && out.height == gray.height)
+      << "Gray8ToFloat: " << gray.width << "x" << gray.height << " into " << out.width << "x" << out.height;
+  for (int y = 0; y < gray.height; ++y) {
+    const uint8_t* in = gray.row(y);
+    float* row = out.row(y);
+    for (int x = 0; x < gray.width; ++x) row[x] = in[x] * (1.0f / 255.0f);
+  }
+}
+
 Image<float> ToGrayFloat(const Image<uint8_t>& rgb) {
   CheckChannels(rgb);
   Image<float> gray(rgb.width(), rgb.height(), 1);
@@ -28,7 +38,7 @@ Image<float> ToGrayFloat(const Image<uint8_t>& rgb) {
   const uint8_t* src = rgb.data();
   float* dst = gray.data();
   if (c == 1) {
-    for (size_t i = 0; i < n; ++i) dst[i] = src[i] * (1.0f / 255.0f);
+    Gray8ToFloat(rgb.view(), gray.view());
     return gray;
   }
   constexpr float kR = 0.299f / 255.0f;
