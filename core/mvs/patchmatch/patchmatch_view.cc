@@ -1,0 +1,419 @@
+#include "core/mvs/patchmatch/patchmatch_view.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "core/base/thread_pool.h"
+
+namespace reconar {
+namespace {
+
+// A window whose weighted grey variance is below this (one grey level squared, in [0, 1] units)
+// carries no texture: its NCC is noise.
+constexpr float kMinTextureVariance = 1.0f / (255.0f * 255.0f);
+constexpr int kFarSteps = 5;                   // far neighbours 3, 5, ..., 2 kFarSteps + 1 pixels away
+constexpr float kDepthPerturbation = 0.1f;     // relative depth range of a perturbation in sweep 0, ...
+constexpr float kNormalPerturbation = 0.5f;    // ... and of a normal's (added vector); both halve each sweep
+constexpr int kInitialisationSweep = 1 << 20;  // the random stream of the initial planes
+
+uint64_t Mix(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// SplitMix64: a per-pixel stream, so the result does not depend on the thread count.
+class PixelRandom {
+ public:
+  PixelRandom(uint64_t seed, size_t pixel, int sweep)
+      : state_(Mix(seed ^ Mix(static_cast<uint64_t>(pixel) * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(sweep)))) {}
+  float Uniform() {  // [0, 1)
+    state_ += 0x9E3779B97F4A7C15ull;
+    return static_cast<float>(Mix(state_) >> 40) * 0x1.0p-24f;
+  }
+
+ private:
+  uint64_t state_;
+};
+
+struct SourceGeometry {
+  const Image<float>* grey = nullptr;
+  const DepthMap* depth = nullptr;  // may be null or empty
+  // Plane-induced homography H = A + b m^T / (n . X) (see PatchMatchViewSolver::Cost).
+  Eigen::Matrix3d a;
+  Eigen::Vector3d b;
+  Eigen::Matrix3d source_from_reference_rotation;
+  Eigen::Vector3d source_from_reference_translation;
+  Eigen::Matrix3d reference_from_source_rotation;
+  Eigen::Vector3d reference_from_source_translation;
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+};
+
+// Per-worker scratch, sized once: the reference window of the current pixel and the per-source costs.
+struct Scratch {
+  std::vector<float> reference;  // centred grey values of the active window samples
+  std::vector<float> weights;    // their bilateral weights
+  std::vector<int> active;       // their offset indices (samples inside the reference image)
+  std::vector<float> costs;      // one per source
+  int count = 0;
+  float weight_sum = 0.0f;
+  float variance = 0.0f;
+};
+
+class PatchMatchViewSolver {
+ public:
+  PatchMatchViewSolver(const PatchMatchViewInput& input, const PatchMatchOptions& options, ThreadPool* pool,
+                       DepthMap* map)
+      : input_(input), options_(options), pool_(pool), map_(*map), view_(*input.reference) {
+    inv_fx_ = 1.0 / view_.fx;
+    inv_fy_ = 1.0 / view_.fy;
+    const int r = options.window_radius, step = options.window_step;
+    for (int oy = -r; oy <= r; oy += step) {
+      for (int ox = -r; ox <= r; ox += step) {
+        offset_x_.push_back(ox);
+        offset_y_.push_back(oy);
+        spatial_.push_back(
+            static_cast<float>(std::exp(-(ox * ox + oy * oy) / (2.0 * options.sigma_spatial * options.sigma_spatial))));
+      }
+    }
+    for (int d = 0; d < 256; ++d) {
+      color_[d] = static_cast<float>(std::exp(-(d * d) / (2.0 * options.sigma_color * options.sigma_color)));
+    }
+    const Eigen::Matrix3d& rr = view_.cam_from_world.rotation;
+    const Eigen::Vector3d& tr = view_.cam_from_world.translation;
+    Eigen::Matrix3d k_inv_r;
+    k_inv_r << inv_fx_, 0.0, -view_.cx * inv_fx_, 0.0, inv_fy_, -view_.cy * inv_fy_, 0.0, 0.0, 1.0;
+    for (size_t k = 0; k < input.sources.size(); ++k) {
+      const DenseView& s = *input.sources[k];
+      SourceGeometry g;
+      g.grey = input.source_greys[k];
+      g.depth = k < input.source_depths.size() ? input.source_depths[k] : nullptr;
+      g.source_from_reference_rotation = s.cam_from_world.rotation * rr.transpose();
+      g.source_from_reference_translation = s.cam_from_world.translation - g.source_from_reference_rotation * tr;
+      g.reference_from_source_rotation = g.source_from_reference_rotation.transpose();
+      g.reference_from_source_translation = -(g.reference_from_source_rotation * g.source_from_reference_translation);
+      Eigen::Matrix3d k_s;
+      k_s << s.fx, 0.0, s.cx, 0.0, s.fy, s.cy, 0.0, 0.0, 1.0;
+      g.a = k_s * g.source_from_reference_rotation * k_inv_r;
+      g.b = k_s * g.source_from_reference_translation;
+      g.fx = s.fx;
+      g.fy = s.fy;
+      g.cx = s.cx;
+      g.cy = s.cy;
+      sources_.push_back(g);
+    }
+    top_k_ = std::min<int>(options.cost_top_k, static_cast<int>(sources_.size()));
+    scratch_.resize(static_cast<size_t>(pool->num_threads()));
+    for (Scratch& s : scratch_) {
+      s.reference.resize(offset_x_.size());
+      s.weights.resize(offset_x_.size());
+      s.active.resize(offset_x_.size());
+      s.costs.resize(sources_.size());
+    }
+  }
+
+  void Initialise() {
+    map_.Reset(view_.width(), view_.height());
+    ForRows([&](int y, Scratch* s) {
+      for (int x = 0; x < map_.width; ++x) {
+        const size_t i = map_.Index(x, y);
+        PixelRandom random(input_.seed, i, kInitialisationSweep);
+        const float depth = RandomDepth(&random);
+        const Eigen::Vector3f normal = RandomNormal(&random, Ray(x, y));
+        Store(i, depth, normal, ReferenceWindow(x, y, s) ? Cost(x, y, depth, normal, false, s) : kNoDepthCost);
+      }
+    });
+  }
+
+  // Recomputes every pixel's cost for its current plane.
+  void Rescore(bool geometric) {
+    ForRows([&](int y, Scratch* s) {
+      for (int x = 0; x < map_.width; ++x) {
+        const size_t i = map_.Index(x, y);
+        map_.cost[i] = ReferenceWindow(x, y, s) ? Cost(x, y, map_.depth[i], Normal(i), geometric, s) : kNoDepthCost;
+      }
+    });
+  }
+
+  // Red pixels ((x + y) even), then black ones: a pixel reads only pixels of the other colour.
+  void Sweep(int sweep, bool geometric) {
+    for (int colour = 0; colour < 2; ++colour) {
+      ForRows([&](int y, Scratch* s) {
+        for (int x = (y + colour) & 1; x < map_.width; x += 2) UpdatePixel(x, y, sweep, geometric, s);
+      });
+    }
+  }
+
+ private:
+  template <typename Fn>
+  void ForRows(const Fn& fn) {
+    pool_->ParallelFor(0, static_cast<size_t>(map_.height),
+                       [&](size_t y, int worker) { fn(static_cast<int>(y), &scratch_[static_cast<size_t>(worker)]); });
+  }
+
+  Eigen::Vector3f Ray(int x, int y) const {
+    return Eigen::Vector3f(static_cast<float>((x - view_.cx) * inv_fx_), static_cast<float>((y - view_.cy) * inv_fy_),
+                           1.0f);
+  }
+  Eigen::Vector3f Normal(size_t i) const {
+    return Eigen::Vector3f(map_.normal[3 * i], map_.normal[3 * i + 1], map_.normal[3 * i + 2]);
+  }
+  void Store(size_t i, float depth, const Eigen::Vector3f& normal, float cost) {
+    map_.depth[i] = depth;
+    map_.normal[3 * i] = normal.x();
+    map_.normal[3 * i + 1] = normal.y();
+    map_.normal[3 * i + 2] = normal.z();
+    map_.cost[i] = cost;
+  }
+
+  // Inverse depth uniform in [1 / depth_max, 1 / depth_min]: equal steps in disparity.
+  float RandomDepth(PixelRandom* random) const {
+    const double inv_min = 1.0 / input_.depth_max, inv_max = 1.0 / input_.depth_min;
+    return static_cast<float>(1.0 / (inv_min + (inv_max - inv_min) * random->Uniform()));
+  }
+  // Uniform on the half sphere facing the camera (n . ray < 0).
+  static Eigen::Vector3f RandomNormal(PixelRandom* random, const Eigen::Vector3f& ray) {
+    const float z = 2.0f * random->Uniform() - 1.0f;
+    const float phi = 2.0f * static_cast<float>(M_PI) * random->Uniform();
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    const Eigen::Vector3f n(r * std::cos(phi), r * std::sin(phi), z);
+    return n.dot(ray) > 0.0f ? Eigen::Vector3f(-n) : n;
+  }
+  static float PerturbDepth(PixelRandom* random, float depth, float scale) {
+    return depth * (1.0f + kDepthPerturbation * scale * (2.0f * random->Uniform() - 1.0f));
+  }
+  // The normal plus a random vector of the cube [-s, s]^3, s = kNormalPerturbation scale; the
+  // normal itself when the result would not face the camera.
+  static Eigen::Vector3f PerturbNormal(PixelRandom* random, const Eigen::Vector3f& normal, float scale,
+                                       const Eigen::Vector3f& ray) {
+    const float s = kNormalPerturbation * scale;
+    Eigen::Vector3f n = normal;
+    for (int c = 0; c < 3; ++c) n[c] += s * (2.0f * random->Uniform() - 1.0f);
+    const float length = n.norm();
+    if (!(length > 1e-6f)) return normal;
+    n /= length;
+    return n.dot(ray) < 0.0f ? n : normal;
+  }
+
+  // The window of (x, y): bilateral weights against the centre's grey level, samples outside the
+  // image left out. False when it is textureless.
+  bool ReferenceWindow(int x, int y, Scratch* s) const {
+    const Image<float>& grey = *input_.reference_grey;
+    const int centre = view_.gray.row(y)[x];
+    const int w = grey.width(), h = grey.height();
+    s->count = 0;
+    float weight_sum = 0.0f, sum = 0.0f, sum_squares = 0.0f;
+    for (size_t o = 0; o < offset_x_.size(); ++o) {
+      const int px = x + offset_x_[o], py = y + offset_y_[o];
+      if (px < 0 || py < 0 || px >= w || py >= h) continue;
+      const float value = grey.row(py)[px];
+      const float weight = spatial_[o] * color_[std::abs(view_.gray.row(py)[px] - centre)];
+      s->active[static_cast<size_t>(s->count)] = static_cast<int>(o);
+      s->reference[static_cast<size_t>(s->count)] = value;
+      s->weights[static_cast<size_t>(s->count)] = weight;
+      ++s->count;
+      weight_sum += weight;
+      sum += weight * value;
+      sum_squares += weight * value * value;
+    }
+    if (s->count < 4 || !(weight_sum > 0.0f)) return false;
+    const float mean = sum / weight_sum;
+    s->variance = sum_squares / weight_sum - mean * mean;
+    s->weight_sum = weight_sum;
+    if (!(s->variance >= kMinTextureVariance)) return false;
+    for (int j = 0; j < s->count; ++j) s->reference[static_cast<size_t>(j)] -= mean;
+    return true;
+  }
+
+  // 1 - weighted NCC of the reference window (in `s`) and its warp by `h` into the source;
+  // kNoDepthCost when a sample falls outside the source image or behind its camera, or the warped
+  // window is textureless.
+  float WindowCost(const SourceGeometry& g, const Eigen::Matrix3d& hd, int x, int y, const Scratch& s) const {
+    const Eigen::Matrix3f h = hd.cast<float>();
+    const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+    const float h0x = h(0, 0) * fx + h(0, 1) * fy + h(0, 2);
+    const float h0y = h(1, 0) * fx + h(1, 1) * fy + h(1, 2);
+    const float h0z = h(2, 0) * fx + h(2, 1) * fy + h(2, 2);
+    const Image<float>& grey = *g.grey;
+    const int width = grey.width();
+    const float max_u = static_cast<float>(width - 1), max_v = static_cast<float>(grey.height() - 1);
+    const float* pixels = grey.data();
+    float sum = 0.0f, sum_squares = 0.0f, sum_products = 0.0f;
+    for (int j = 0; j < s.count; ++j) {
+      const int o = s.active[static_cast<size_t>(j)];
+      const float ox = static_cast<float>(offset_x_[static_cast<size_t>(o)]);
+      const float oy = static_cast<float>(offset_y_[static_cast<size_t>(o)]);
+      const float hz = h0z + h(2, 0) * ox + h(2, 1) * oy;
+      if (!(hz > 0.0f)) return kNoDepthCost;
+      const float u = (h0x + h(0, 0) * ox + h(0, 1) * oy) / hz;
+      const float v = (h0y + h(1, 0) * ox + h(1, 1) * oy) / hz;
+      if (!(u >= 0.0f && v >= 0.0f && u < max_u && v < max_v)) return kNoDepthCost;
+      const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+      const float au = u - static_cast<float>(u0), av = v - static_cast<float>(v0);
+      const float* p = pixels + static_cast<size_t>(v0) * static_cast<size_t>(width) + u0;
+      const float top = p[0] + au * (p[1] - p[0]);
+      const float bottom = p[width] + au * (p[width + 1] - p[width]);
+      const float value = top + av * (bottom - top);
+      const float w = s.weights[static_cast<size_t>(j)];
+      sum += w * value;
+      sum_squares += w * value * value;
+      sum_products += w * s.reference[static_cast<size_t>(j)] * value;
+    }
+    const float mean = sum / s.weight_sum;
+    const float variance = sum_squares / s.weight_sum - mean * mean;
+    if (!(variance >= kMinTextureVariance)) return kNoDepthCost;
+    // The reference is centred, so sum_products / weight_sum is the weighted covariance.
+    const float ncc = sum_products / s.weight_sum / std::sqrt(s.variance * variance);
+    return 1.0f - std::clamp(ncc, -1.0f, 1.0f);
+  }
+
+  // Forward-backward reprojection error (pixels, capped) of the reference point through the
+  // source's depth map: project into the source, take its depth there, back into the reference.
+  float GeometricError(const SourceGeometry& g, const Eigen::Vector3d& point, int x, int y) const {
+    const double max_error = options_.geometric_max_error_px;
+    if (g.depth == nullptr || g.depth->empty()) return static_cast<float>(max_error);
+    const Eigen::Vector3d in_source = g.source_from_reference_rotation * point + g.source_from_reference_translation;
+    if (!(in_source.z() > 0.0)) return static_cast<float>(max_error);
+    const double u = g.fx * in_source.x() / in_source.z() + g.cx, v = g.fy * in_source.y() / in_source.z() + g.cy;
+    if (!(u >= -0.5 && v >= -0.5 && u < g.depth->width - 0.5 && v < g.depth->height - 0.5)) {
+      return static_cast<float>(max_error);
+    }
+    const int qx = static_cast<int>(std::lround(u)), qy = static_cast<int>(std::lround(v));
+    const size_t q = g.depth->Index(qx, qy);
+    const double depth = g.depth->depth[q];
+    if (!(depth > 0.0) || !(g.depth->cost[q] < kNoDepthCost)) return static_cast<float>(max_error);
+    const Eigen::Vector3d back = g.reference_from_source_rotation *
+                                     Eigen::Vector3d(depth * (qx - g.cx) / g.fx, depth * (qy - g.cy) / g.fy, depth) +
+                                 g.reference_from_source_translation;
+    if (!(back.z() > 0.0)) return static_cast<float>(max_error);
+    const double du = view_.fx * back.x() / back.z() + view_.cx - x, dv = view_.fy * back.y() / back.z() + view_.cy - y;
+    return static_cast<float>(std::min(std::sqrt(du * du + dv * dv), max_error));
+  }
+
+  // The cost of plane (depth, normal) at (x, y): the mean of the best top_k_ source costs. For
+  // points X on the plane n . X = n . X0 (X0 = depth K^-1 (x, y, 1)), X_s = R X + t = (R + t n^T /
+  // (n . X0)) X, so the homography is K_s (R + t n^T / (n . X0)) K_r^-1 = A + b m^T / (n . X0)
+  // with A = K_s R K_r^-1, b = K_s t, m = K_r^-T n.
+  float Cost(int x, int y, float depth, const Eigen::Vector3f& normal, bool geometric, Scratch* s) const {
+    const Eigen::Vector3d ray((x - view_.cx) * inv_fx_, (y - view_.cy) * inv_fy_, 1.0);
+    const Eigen::Vector3d n = normal.cast<double>();
+    const double plane = depth * n.dot(ray);
+    if (!(plane < 0.0)) return kNoDepthCost;
+    const Eigen::Vector3d m(n.x() * inv_fx_, n.y() * inv_fy_,
+                            n.z() - n.x() * view_.cx * inv_fx_ - n.y() * view_.cy * inv_fy_);
+    const Eigen::Vector3d m_scaled = m / plane;
+    const Eigen::Vector3d point = depth * ray;
+    for (size_t k = 0; k < sources_.size(); ++k) {
+      const SourceGeometry& g = sources_[k];
+      const Eigen::Matrix3d h = g.a + g.b * m_scaled.transpose();
+      float cost = WindowCost(g, h, x, y, *s);
+      if (geometric) cost += static_cast<float>(options_.geometric_weight) * GeometricError(g, point, x, y);
+      s->costs[k] = cost;
+    }
+    std::partial_sort(s->costs.begin(), s->costs.begin() + top_k_, s->costs.end());
+    float sum = 0.0f;
+    for (int k = 0; k < top_k_; ++k) sum += s->costs[static_cast<size_t>(k)];
+    return sum / static_cast<float>(top_k_);
+  }
+
+  // The depth at the ray `ray` of the plane stored at pixel q; <= 0 when the ray misses its front.
+  float PropagatedDepth(int qx, int qy, const Eigen::Vector3f& ray) const {
+    const size_t q = map_.Index(qx, qy);
+    const Eigen::Vector3f n = Normal(q);
+    const float denominator = n.dot(ray);
+    if (!(denominator < 0.0f)) return -1.0f;
+    return map_.depth[q] * n.dot(Ray(qx, qy)) / denominator;
+  }
+
+  void UpdatePixel(int x, int y, int sweep, bool geometric, Scratch* s) {
+    const size_t i = map_.Index(x, y);
+    if (!ReferenceWindow(x, y, s)) {
+      map_.cost[i] = kNoDepthCost;
+      return;
+    }
+    const Eigen::Vector3f ray = Ray(x, y);
+    float best_depth = map_.depth[i], best_cost = map_.cost[i];
+    Eigen::Vector3f best_normal = Normal(i);
+    const float depth_min = static_cast<float>(input_.depth_min), depth_max = static_cast<float>(input_.depth_max);
+    auto consider = [&](float depth, const Eigen::Vector3f& normal) {
+      if (!(depth >= depth_min && depth <= depth_max)) return;
+      const float cost = Cost(x, y, depth, normal, geometric, s);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_depth = depth;
+        best_normal = normal;
+      }
+    };
+    static constexpr int kDirections[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+    for (const auto& d : kDirections) {
+      const int nx = x + d[0], ny = y + d[1];
+      if (nx < 0 || ny < 0 || nx >= map_.width || ny >= map_.height) continue;
+      if (map_.cost[map_.Index(nx, ny)] < kNoDepthCost)
+        consider(PropagatedDepth(nx, ny, ray), Normal(map_.Index(nx, ny)));
+      int far_x = -1, far_y = -1;
+      float far_cost = kNoDepthCost;
+      for (int k = 3; k <= 2 * kFarSteps + 1; k += 2) {
+        const int fx = x + k * d[0], fy = y + k * d[1];
+        if (fx < 0 || fy < 0 || fx >= map_.width || fy >= map_.height) break;
+        const float c = map_.cost[map_.Index(fx, fy)];
+        if (c < far_cost) {
+          far_cost = c;
+          far_x = fx;
+          far_y = fy;
+        }
+      }
+      if (far_x >= 0) consider(PropagatedDepth(far_x, far_y, ray), Normal(map_.Index(far_x, far_y)));
+    }
+    // Refinement around the best plane so far: random and perturbed depth and normal.
+    PixelRandom random(input_.seed, i, sweep);
+    const float scale = std::ldexp(1.0f, -std::min(sweep, 20));
+    const float depth = best_depth;
+    const Eigen::Vector3f normal = best_normal;
+    const float random_depth = RandomDepth(&random);
+    const Eigen::Vector3f random_normal = RandomNormal(&random, ray);
+    const float perturbed_depth = PerturbDepth(&random, depth, scale);
+    const Eigen::Vector3f perturbed_normal = PerturbNormal(&random, normal, scale, ray);
+    consider(random_depth, normal);
+    consider(depth, random_normal);
+    consider(perturbed_depth, perturbed_normal);
+    consider(perturbed_depth, normal);
+    consider(depth, perturbed_normal);
+    Store(i, best_depth, best_normal, best_cost);
+  }
+
+  const PatchMatchViewInput& input_;
+  const PatchMatchOptions& options_;
+  ThreadPool* pool_;
+  DepthMap& map_;
+  const DenseView& view_;
+  double inv_fx_ = 0.0, inv_fy_ = 0.0;
+  std::vector<int> offset_x_, offset_y_;
+  std::vector<float> spatial_;
+  float color_[256];
+  std::vector<SourceGeometry> sources_;
+  int top_k_ = 1;
+  std::vector<Scratch> scratch_;
+};
+
+}  // namespace
+
+void RunPhotometricPatchMatch(const PatchMatchViewInput& input, const PatchMatchOptions& options, ThreadPool* pool,
+                              DepthMap* map) {
+  PatchMatchViewSolver solver(input, options, pool, map);
+  solver.Initialise();
+  for (int sweep = 0; sweep < options.iterations; ++sweep) solver.Sweep(sweep, false);
+}
+
+void RunGeometricPatchMatch(const PatchMatchViewInput& input, const PatchMatchOptions& options, ThreadPool* pool,
+                            DepthMap* map) {
+  PatchMatchViewSolver solver(input, options, pool, map);
+  solver.Rescore(true);
+  for (int k = 0; k < options.geometric_iterations; ++k) solver.Sweep(options.iterations + k, true);
+  solver.Rescore(false);
+}
+
+}  // namespace reconar
