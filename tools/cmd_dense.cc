@@ -1,6 +1,7 @@
 #include <sys/stat.h>
 
 #include <cstdio>
+#include <set>
 #include <string>
 
 #include "core/pipeline/dense_stage.h"
@@ -15,11 +16,13 @@ constexpr char kHelp[] =
     "\n"
     "Dense multi-view stereo on a project made by `reconar sfm`: the registered images are grouped\n"
     "into overlapping view clusters (CMVS; redundant images dropped), each cluster's photos are\n"
-    "undistorted at the chosen resolution level and PMVS grows oriented patches from them; the\n"
-    "clusters' points are merged. Reads PROJECT_DIR/sparse and PROJECT_DIR/features/images.txt,\n"
+    "undistorted at the chosen resolution level and PMVS grows oriented patches from them (or\n"
+    "PatchMatch makes a depth map per view and fuses them: --method); the clusters' points are merged. Reads PROJECT_DIR/sparse and PROJECT_DIR/features/images.txt,\n"
     "writes:\n"
     "  dense/points.ply      binary PLY: position, normal, RGBA colour per point\n"
     "  dense/report.json     level, clusters, counts, seconds and peak memory per phase\n"
+    "  --method pmvs|patchmatch  PMVS's patches (default; the paper's method) or a PatchMatch depth\n"
+    "                         map per view, fused across views\n"
     "  --level 0|1|2|auto     image resolution: full, half, quarter; auto (default) takes the finest\n"
     "                         whose memory estimate fits --memory-budget\n"
     "  --max-cluster-size N   images per PMVS run (default 20; smaller needs less memory)\n"
@@ -40,8 +43,16 @@ void PrintSummary(const DenseStageReport& r) {
               r.level, r.level_auto ? "auto" : "given", r.kept_images, r.images, r.removed_images, r.clusters,
               r.max_cluster_size, r.cluster_size_reduced ? " (reduced for the memory budget)" : "");
   if (r.clusters_from_cameras) std::printf("dense: no sparse points; clusters from camera positions\n");
-  std::printf("dense: %zu points (%zu before merging clusters), %zu PMVS features, %zu initial + %zu expanded patches\n",
-              r.points, r.points_before_merge, r.pmvs.features, r.pmvs.initial_patches, r.pmvs.expanded_patches);
+  if (r.method == DenseMethod::kPatchMatch) {
+    const PatchMatchReport& m = r.patchmatch;
+    std::printf("dense: %zu points (%zu before merging clusters) by PatchMatch: %zu depth maps, %zu depth pixels, "
+                "%zu fused; %.1fs selection, %.1fs propagation, %.1fs consistency, %.1fs fusion\n",
+                r.points, r.points_before_merge, m.views, m.depth_pixels, m.fused_points, m.seconds_selection,
+                m.seconds_propagation, m.seconds_consistency, m.seconds_fusion);
+  } else {
+    std::printf("dense: %zu points (%zu before merging clusters), %zu PMVS features, %zu initial + %zu expanded patches\n",
+                r.points, r.points_before_merge, r.pmvs.features, r.pmvs.initial_patches, r.pmvs.expanded_patches);
+  }
   if (r.outliers.input_points > 0) {
     std::printf("dense: outliers removed: %zu isolated, %zu in %d small pieces (median spacing %.4g)\n",
                 r.outliers.isolated_removed, r.outliers.small_piece_removed, r.outliers.pieces - r.outliers.pieces_kept,
@@ -65,21 +76,16 @@ void PrintSummary(const DenseStageReport& r) {
 }  // namespace
 
 int RunDense(int argc, char** argv, int first) {
-  Args args({"level", "max-cluster-size", "threads", "memory-budget"}, {"json", "keep-outliers"});
+  std::set<std::string> valued = {"max-cluster-size", "threads", "memory-budget"};
+  valued.insert(kDenseValuedOptions.begin(), kDenseValuedOptions.end());
+  Args args(valued, {"json", "keep-outliers"});
   if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 1, 1)) return *exit_code;
   const Project project(args.positionals()[0]);
   if (!IsDirectory(project.root())) {
     return Fail(NotFound(project.root() + ": no such project directory (make one with `reconar sfm`)"));
   }
   DenseStageOptions options;
-  const std::string level = args.Get("level", "auto");
-  if (level == "auto") {
-    options.level = -1;
-  } else if (level == "0" || level == "1" || level == "2") {
-    options.level = level[0] - '0';
-  } else {
-    return Fail(InvalidArgument("--level must be 0, 1, 2 or auto, got '" + level + "'"));
-  }
+  if (const Status status = ReadDenseArgs(args, &options); !status.ok()) return Fail(status);
   auto cluster_size = args.GetInt("max-cluster-size", options.clustering.max_cluster_size, 3, 10000);
   if (!cluster_size.ok()) return Fail(cluster_size.status());
   options.clustering.max_cluster_size = *cluster_size;

@@ -25,6 +25,7 @@ int RunReconstructCommand(int argc, char** argv, int first, const char* help, bo
 #include "core/base/status.h"
 #include "core/features/sift/sift.h"
 #include "core/mesh/mesh.h"
+#include "core/pipeline/dense_stage.h"
 #include "core/pipeline/match_stage.h"
 #include "tools/args.h"
 
@@ -40,6 +41,11 @@ inline const std::set<std::string> kSiftValuedOptions = {"first-octave", "max-fe
 Status ReadMatchArgs(const Args& args, MatchStageOptions* options);
 inline const std::set<std::string> kMatchValuedOptions = {"ratio", "checks", "min-inliers", "f-threshold",
                                                             "threads"};
+
+// --level 0|1|2|auto and --method pmvs|patchmatch, shared by dense and reconstruct
+// (reconstruct_command.cc).
+Status ReadDenseArgs(const Args& args, DenseStageOptions* dense);
+inline const std::set<std::string> kDenseValuedOptions = {"level", "method"};
 
 // Shared by export and mesh (cmd_export.cc): creates the parent directory of an output file, and
 // prints "<verb> <path>: N vertices, M triangles[, normals][, colours]" on stdout.

@@ -20,7 +20,8 @@ const std::set<std::string> kFlags = {"no-tags-in-ba", "no-preview", "force", "j
 std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
   valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
-  valued.insert({"tag-size", "tag-family", "world-tag", "memory-budget", "stages", "level", "depth", "trim",
+  valued.insert(kDenseValuedOptions.begin(), kDenseValuedOptions.end());
+  valued.insert({"tag-size", "tag-family", "world-tag", "memory-budget", "stages", "depth", "trim",
                  "max-faces", "formats", "principal-point", "max-error"});
   return valued;
 }
@@ -59,15 +60,27 @@ Status ReadMapperArgs(const Args& args, MapperOptions* mapper) {
   return Status::Ok();
 }
 
-Status ReadDenseAndMeshArgs(const Args& args, ReconstructOptions* options) {
+}  // namespace
+
+Status ReadDenseArgs(const Args& args, DenseStageOptions* dense) {
   const std::string level = args.Get("level", "auto");
   if (level == "auto") {
-    options->dense.level = -1;
+    dense->level = -1;
   } else if (level == "0" || level == "1" || level == "2") {
-    options->dense.level = level[0] - '0';
+    dense->level = level[0] - '0';
   } else {
     return InvalidArgument("--level must be 0, 1, 2 or auto, got '" + level + "'");
   }
+  if (args.Has("method")) {
+    RECONAR_ASSIGN_OR_RETURN(dense->method, ParseDenseMethod(args.Get("method")));
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+Status ReadDenseAndMeshArgs(const Args& args, ReconstructOptions* options) {
+  RECONAR_RETURN_IF_ERROR(ReadDenseArgs(args, &options->dense));
   MeshStageOptions& mesh = options->mesh;
   RECONAR_ASSIGN_OR_RETURN(mesh.poisson.depth, args.GetInt("depth", mesh.poisson.depth, 5, 11));
   RECONAR_ASSIGN_OR_RETURN(mesh.poisson.trim, args.GetDouble("trim", mesh.poisson.trim, 0.0, 20.0));

@@ -3,15 +3,21 @@
 // with its ground-truth cameras (point count, share inside the README's bounding box).
 // run_dense_figures.sh wraps each scene in /usr/bin/time -v for the peak RSS.
 //
-// Usage: bench_dense_figures bunny|templering [--level L] [--threads N] [--depth D] [--trim T]
-//                            [--stride S] [--project DIR] [shared_data_dir]
+// Usage: bench_dense_figures bunny|templering [--method pmvs|patchmatch] [--level L] [--threads N]
+//                            [--depth D] [--trim T] [--stride S] [--project DIR] [--keep-outliers]
+//                            [shared_data_dir]
+// --keep-outliers runs the dense stage without its outlier filter, then applies the filter here and
+// says how many of the points each of its two tests removes, and keeps, are wrong by the scene's
+// truth: farther than two pixel footprints from bun_zipper's surface, or outside templeRing's box.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 #include <unistd.h>
 
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/poisson/point_outliers.h"
 #include "platform/egl/egl_context.h"
 #include "tests/dense/bunny_dense.h"
 #include "tests/dense/dense_runs.h"
@@ -21,6 +27,8 @@ namespace {
 
 struct Args {
   std::string scene;
+  DenseMethod method = DenseMethod::kPmvs;
+  bool keep_outliers = false;
   int level = -2;  // -2: the scene's default (bunny 0, templeRing 1)
   int threads = 0;
   int depth = 8;
@@ -33,8 +41,9 @@ struct Args {
 int Usage(const char* message) {
   std::fprintf(stderr,
                "bench_dense_figures: %s\n"
-               "usage: bench_dense_figures bunny|templering [--level L] [--threads N] [--depth D] [--trim T]\n"
-               "                           [--stride S] [--project DIR] [shared_data_dir]\n",
+               "usage: bench_dense_figures bunny|templering [--method pmvs|patchmatch] [--level L] [--threads N]\n"
+               "                           [--depth D] [--trim T] [--stride S] [--project DIR] [--keep-outliers]\n"
+               "                           [shared_data_dir]\n",
                message);
   return 2;
 }
@@ -42,11 +51,47 @@ int Usage(const char* message) {
 void PrintDense(const DenseStageReport& dense) {
   std::printf("dense: level %d, %d images (%d kept), %d clusters, %zu points (%zu before merge)\n", dense.level,
               dense.images, dense.kept_images, dense.clusters, dense.points, dense.points_before_merge);
-  std::printf("dense phases s: load %.1f clustering %.1f undistort %.1f mvs %.1f merge %.1f write %.1f; "
-              "pmvs: %zu features, %zu initial, %zu expanded, %zu final patches\n",
+  std::printf("dense phases s: load %.1f clustering %.1f undistort %.1f mvs %.1f merge %.1f outliers %.1f write %.1f\n",
               dense.load.seconds, dense.clustering.seconds, dense.undistort.seconds, dense.mvs.seconds,
-              dense.merge.seconds, dense.write.seconds, dense.pmvs.features, dense.pmvs.initial_patches,
-              dense.pmvs.expanded_patches, dense.pmvs.final_patches);
+              dense.merge.seconds, dense.outlier_filter.seconds, dense.write.seconds);
+  if (dense.method == DenseMethod::kPatchMatch) {
+    const PatchMatchReport& m = dense.patchmatch;
+    std::printf("patchmatch: %zu depth maps, %zu depth pixels, %zu fused; s: selection %.1f propagation %.1f "
+                "consistency %.1f fusion %.1f\n",
+                m.views, m.depth_pixels, m.fused_points, m.seconds_selection, m.seconds_propagation,
+                m.seconds_consistency, m.seconds_fusion);
+  } else {
+    std::printf("pmvs: %zu features, %zu initial, %zu expanded, %zu final patches\n", dense.pmvs.features,
+                dense.pmvs.initial_patches, dense.pmvs.expanded_patches, dense.pmvs.final_patches);
+  }
+  std::printf("outliers: %zu isolated, %zu in small pieces removed\n", dense.outliers.isolated_removed,
+              dense.outliers.small_piece_removed);
+}
+
+// The outlier filter's two tests (core/mesh/poisson/point_outliers.h) on the unfiltered points,
+// against `wrong` (the scene's truth): how many wrong and right points each removes and keeps.
+void PrintFilterAgainstTruth(const std::vector<Eigen::Vector3f>& points, const std::vector<uint8_t>& wrong) {
+  OutlierFilterOptions isolated_only;
+  isolated_only.min_component_fraction = 0.0;
+  auto first = FindInlierPoints(points, isolated_only);
+  auto both = FindInlierPoints(points, OutlierFilterOptions());
+  if (!first.ok() || !both.ok()) {
+    std::fprintf(stderr, "bench_dense_figures: outlier filter: %s\n",
+                 (first.ok() ? both.status() : first.status()).ToString().c_str());
+    return;
+  }
+  size_t counts[3][2] = {};  // [isolated removed, small piece removed, kept][right, wrong]
+  for (size_t i = 0; i < points.size(); ++i) {
+    const int verdict = !(*first)[i] ? 0 : !(*both)[i] ? 1 : 2;
+    ++counts[verdict][wrong[i] ? 1 : 0];
+  }
+  const char* names[3] = {"isolated, removed", "small pieces, removed", "kept"};
+  for (int v = 0; v < 3; ++v) {
+    std::printf("FILTER %-22s %8zu points: %8zu right, %8zu wrong (%.3f wrong)\n", names[v],
+                counts[v][0] + counts[v][1], counts[v][0], counts[v][1],
+                counts[v][0] + counts[v][1] == 0 ? 0.0
+                                                 : static_cast<double>(counts[v][1]) / (counts[v][0] + counts[v][1]));
+  }
 }
 
 int RunBunny(const Args& args, const std::string& project) {
@@ -59,6 +104,8 @@ int RunBunny(const Args& args, const std::string& project) {
   auto bunny = ReadPly(args.data_dir + "/stanford_bunny/reconstruction/bun_zipper.ply");
   if (!bunny.ok()) return Usage(bunny.status().ToString().c_str());
   testing::BunnyDenseOptions options;
+  options.method = args.method;
+  options.remove_outliers = !args.keep_outliers;
   options.level = args.level == -2 ? 0 : args.level;
   options.num_threads = args.threads;
   options.poisson.depth = args.depth;
@@ -88,11 +135,23 @@ int RunBunny(const Args& args, const std::string& project) {
               1e3 * c.max_mesh_to_reference, 1e3 * c.mean_reference_to_mesh, 1e3 * c.median_reference_to_mesh,
               1e3 * c.p90_reference_to_mesh, 1e3 * c.max_reference_to_mesh);
   std::printf("scoring %.1f s; project in %s\n", figures->seconds_scoring, project.c_str());
+  if (args.keep_outliers) {
+    auto points = testing::ReadDensePoints(project);
+    if (!points.ok()) return Usage(points.status().ToString().c_str());
+    const double wrong_beyond = 2.0 * scene.pixel_footprint_at_center_m * (1 << figures->dense.level);
+    const testing::MeshDistanceField surface(*bunny);
+    std::vector<uint8_t> wrong(points->size());
+    for (size_t i = 0; i < points->size(); ++i) wrong[i] = surface.Distance((*points)[i]) > wrong_beyond ? 1 : 0;
+    std::printf("wrong: farther than %.3f mm from bun_zipper\n", 1e3 * wrong_beyond);
+    PrintFilterAgainstTruth(*points, wrong);
+  }
   return 0;
 }
 
 int RunTempleRing(const Args& args, const std::string& project) {
   testing::TempleRingDenseOptions options;
+  options.method = args.method;
+  options.remove_outliers = !args.keep_outliers;
   options.level = args.level == -2 ? 1 : args.level;
   options.num_threads = args.threads;
   options.import.view_stride = args.stride;
@@ -108,6 +167,15 @@ int RunTempleRing(const Args& args, const std::string& project) {
   std::printf("POINTS %zu, in the README box (+%.1f mm) %zu = %.4f\n", figures->points, 1e3 * options.box_margin_m,
               figures->points_in_box, figures->in_box_fraction);
   std::printf("project in %s\n", project.c_str());
+  if (args.keep_outliers) {
+    auto points = testing::ReadDensePoints(project);
+    if (!points.ok()) return Usage(points.status().ToString().c_str());
+    const testing::Box3 box = testing::TempleRingBoundingBox();
+    std::vector<uint8_t> wrong(points->size());
+    for (size_t i = 0; i < points->size(); ++i) wrong[i] = box.Contains((*points)[i], options.box_margin_m) ? 0 : 1;
+    std::printf("wrong: outside the README's box (+%.1f mm)\n", 1e3 * options.box_margin_m);
+    PrintFilterAgainstTruth(*points, wrong);
+  }
   return 0;
 }
 
@@ -124,6 +192,12 @@ int main(int argc, char** argv) {
     if (arg == "--help" || arg == "-h") {
       reconar::Usage("dense-accuracy figures of one scene");
       return 0;
+    } else if (arg == "--keep-outliers") {
+      args.keep_outliers = true;
+    } else if (arg == "--method" && has_value) {
+      auto method = reconar::ParseDenseMethod(argv[++i]);
+      if (!method.ok()) return reconar::Usage(method.status().ToString().c_str());
+      args.method = *method;
     } else if (arg == "--level" && has_value) {
       args.level = std::atoi(argv[++i]);
     } else if (arg == "--threads" && has_value) {

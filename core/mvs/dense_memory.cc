@@ -16,8 +16,7 @@ size_t EstimateDenseBytes(const DenseMemoryInput& input, int level, int cluster_
     largest_full = std::max(largest_full, static_cast<double>(width) * static_cast<double>(height));
   }
   std::sort(pixels.begin(), pixels.end(), std::greater<double>());
-  const double cell = static_cast<double>(std::max(1, input.cell_size));
-  const double per_pixel = kViewBytesPerPixel + kPmvsBytesPerPixel + kPmvsBytesPerCell / (cell * cell);
+  const double per_pixel = kViewBytesPerPixel + input.work_bytes_per_pixel;
   double bytes = static_cast<double>(input.baseline_bytes);
   for (size_t i = 0; i < pixels.size() && static_cast<int>(i) < cluster_size; ++i) bytes += per_pixel * pixels[i];
   const double scale = 1.0 / static_cast<double>(1 << (2 * level));

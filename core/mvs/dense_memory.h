@@ -1,12 +1,17 @@
 #pragma once
 // Memory model of one dense run, used to pick the resolution level and the cluster size from a
-// budget. While PMVS works on a cluster the process holds, per view of P pixels at the level:
-//   kViewBytesPerPixel            the undistorted DenseView (RGB + grey)
-//   kPmvsBytesPerPixel            PMVS's per-pixel work images (feature responses, visibility)
-//   kPmvsBytesPerCell / cell^2    PMVS's cell lists and the patches that fill them: a list head
-//                                 per cell, and at most one patch per cell of each image, each
-//                                 patch (about 128 bytes with its image list and cell entries)
-//                                 lying in the cells of at least 3 images (PMVS's gamma)
+// budget. While the multi-view stereo works on a cluster the process holds, per view of P pixels
+// at the level, kViewBytesPerPixel (the undistorted DenseView: RGB + grey) and the method's work
+// bytes per pixel (DenseMemoryInput::work_bytes_per_pixel):
+//   PMVS (PmvsWorkBytesPerPixel)
+//     kPmvsBytesPerPixel            per-pixel work images (feature responses, visibility)
+//     kPmvsBytesPerCell / cell^2    cell lists and the patches that fill them: a list head per
+//                                   cell, and at most one patch per cell of each image, each
+//                                   patch (about 128 bytes with its image list and cell entries)
+//                                   lying in the cells of at least 3 images (PMVS's gamma)
+//   PatchMatch (kPatchMatchBytesPerPixel)
+//     the grey image as floats (4), the plane (depth 4, normal 12) and cost (4) of every pixel,
+//     and the fusion's per-pixel mark (1)
 // plus, during undistortion, one decoded full-resolution photo (3 bytes per pixel) and its level
 // copy per worker thread. The constants are a model, not a bound: the stage reports the measured
 // peak RSS next to the estimate.
@@ -20,11 +25,17 @@ namespace reconar {
 constexpr double kViewBytesPerPixel = 4.0;
 constexpr double kPmvsBytesPerPixel = 16.0;
 constexpr double kPmvsBytesPerCell = 4.0 + 128.0 / 3.0;
+constexpr double kPatchMatchBytesPerPixel = 4.0 + 16.0 + 4.0 + 1.0;
+
+inline double PmvsWorkBytesPerPixel(int cell_size) {
+  const double cell = static_cast<double>(cell_size < 1 ? 1 : cell_size);
+  return kPmvsBytesPerPixel + kPmvsBytesPerCell / (cell * cell);
+}
 
 struct DenseMemoryInput {
   std::vector<std::pair<int, int>> image_sizes;  // full-resolution width, height of every kept image
   int max_cluster_size = 20;
-  int cell_size = 2;
+  double work_bytes_per_pixel = PmvsWorkBytesPerPixel(2);  // the method's, see above
   int num_threads = 1;
   size_t baseline_bytes = 0;  // already held by the caller (model, merged points so far)
 };

@@ -42,6 +42,32 @@ class PhaseTimer {
   Clock::time_point start_;
 };
 
+void AddReports(const PatchMatchReport& part, PatchMatchReport* sum) {
+  sum->views += part.views;
+  sum->depth_pixels += part.depth_pixels;
+  sum->fused_points += part.fused_points;
+  sum->seconds_selection += part.seconds_selection;
+  sum->seconds_propagation += part.seconds_propagation;
+  sum->seconds_consistency += part.seconds_consistency;
+  sum->seconds_fusion += part.seconds_fusion;
+}
+
+// The model's points that some image of `cluster` (sorted ids) observed: what PatchMatch takes its
+// depth ranges and source views from.
+std::vector<Eigen::Vector3d> ClusterSparsePoints(const Reconstruction& model, const std::vector<int>& cluster) {
+  std::vector<Eigen::Vector3d> points;
+  for (const SfmPoint& point : model.points) {
+    if (point.deleted) continue;
+    for (const TrackElement& element : point.track) {
+      if (std::binary_search(cluster.begin(), cluster.end(), element.image_id)) {
+        points.push_back(point.position);
+        break;
+      }
+    }
+  }
+  return points;
+}
+
 void AddReports(const PatchMvsReport& part, PatchMvsReport* sum) {
   sum->features += part.features;
   sum->initial_patches += part.initial_patches;
@@ -110,6 +136,16 @@ void PhaseJson(const char* name, const DensePhase& phase, JsonWriter* json) {
 
 }  // namespace
 
+const char* DenseMethodName(DenseMethod method) {
+  return method == DenseMethod::kPatchMatch ? "patchmatch" : "pmvs";
+}
+
+Result<DenseMethod> ParseDenseMethod(const std::string& name) {
+  if (name == "pmvs") return DenseMethod::kPmvs;
+  if (name == "patchmatch") return DenseMethod::kPatchMatch;
+  return InvalidArgument("dense method must be pmvs or patchmatch, got '" + name + "'");
+}
+
 Status DenseStageOptions::Check() const {
   if (level < -1 || level > kMaxDenseLevel) {
     return InvalidArgument("dense: level must be -1 (auto), 0, 1 or 2, got " + std::to_string(level));
@@ -117,12 +153,14 @@ Status DenseStageOptions::Check() const {
   if (memory_budget_bytes == 0) return InvalidArgument("dense: the memory budget must be positive");
   RECONAR_RETURN_IF_ERROR(clustering.Check());
   RECONAR_RETURN_IF_ERROR(outliers.Check());
+  RECONAR_RETURN_IF_ERROR(patchmatch.Check());
   return mvs.Check();
 }
 
 Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   DenseStageReport report;
+  report.method = options.method;
   report.peak_rss_resettable = ResetPeakResidentBytes();
 
   // Load: the sparse model and the photo of every registered image.
@@ -158,10 +196,13 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
     memory.image_sizes.emplace_back(camera.width, camera.height);
   }
   memory.max_cluster_size = options.clustering.max_cluster_size;
-  memory.cell_size = options.mvs.cell_size;
+  const bool patchmatch = options.method == DenseMethod::kPatchMatch;
+  memory.work_bytes_per_pixel = patchmatch ? kPatchMatchBytesPerPixel : PmvsWorkBytesPerPixel(options.mvs.cell_size);
   memory.num_threads = num_threads;
   memory.baseline_bytes = CurrentMemoryUsage().resident_bytes;
-  const int min_cluster = std::max(options.clustering.min_views_per_point, options.mvs.min_visible_views);
+  // The fewest views a cluster needs for the method to make a point.
+  const int min_views = patchmatch ? options.patchmatch.fusion_min_views + 1 : options.mvs.min_visible_views;
+  const int min_cluster = std::max(options.clustering.min_views_per_point, min_views);
   RECONAR_ASSIGN_OR_RETURN(const DenseLevelChoice choice,
                            ChooseDenseLevel(memory, options.level, options.memory_budget_bytes, min_cluster));
   report.level = choice.level;
@@ -183,16 +224,20 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   report.clusters_from_cameras = clustering.from_camera_geometry;
   report.sparse_points_covered = clustering.covered_fraction;
 
-  // Per cluster: undistort its views (reusing the previous cluster's), run PMVS, keep the points.
+  // Per cluster: undistort its views (reusing the previous cluster's), run the multi-view stereo,
+  // keep the points.
   PatchMvsOptions mvs_options = options.mvs;
   if (mvs_options.num_threads == 0) mvs_options.num_threads = num_threads;
   mvs_options.show_progress = options.show_progress;
+  PatchMatchOptions patchmatch_options = options.patchmatch;
+  if (patchmatch_options.num_threads == 0) patchmatch_options.num_threads = num_threads;
+  patchmatch_options.show_progress = options.show_progress;
   ThreadPool pool(num_threads);
   std::map<int, std::unique_ptr<DenseView>> cache;
   std::vector<MergeInput> parts;
   for (size_t c = 0; c < clustering.clusters.size(); ++c) {
     const std::vector<int>& cluster = clustering.clusters[c];
-    if (static_cast<int>(cluster.size()) < mvs_options.min_visible_views) {
+    if (static_cast<int>(cluster.size()) < min_views) {
       ++report.clusters_without_points;
       continue;
     }
@@ -215,10 +260,17 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
     }
     std::vector<const DenseView*> views;
     for (int id : cluster) views.push_back(cache.at(id).get());
-    mvs_options.progress_label = cluster_label + "patch MVS";
     PhaseTimer timer(&report.mvs);
-    PatchMvsReport cluster_report;
-    auto points = RunPatchMvs(views, mvs_options, &cluster_report);
+    PatchMvsReport pmvs_report;
+    PatchMatchReport patchmatch_report;
+    Result<OrientedPoints> points = OrientedPoints();
+    if (patchmatch) {
+      patchmatch_options.progress_label = cluster_label + "PatchMatch";
+      points = RunPatchMatchMvs(views, ClusterSparsePoints(model, cluster), patchmatch_options, &patchmatch_report);
+    } else {
+      mvs_options.progress_label = cluster_label + "patch MVS";
+      points = RunPatchMvs(views, mvs_options, &pmvs_report);
+    }
     if (!points.ok()) {
       if (points.status().code() != StatusCode::kFailedPrecondition) {
         return points.status().WithContext("dense: cluster " + std::to_string(c + 1) + " of " +
@@ -227,7 +279,8 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
       ++report.clusters_without_points;
       continue;
     }
-    AddReports(cluster_report, &report.pmvs);
+    AddReports(pmvs_report, &report.pmvs);
+    AddReports(patchmatch_report, &report.patchmatch);
     MergeInput part;
     part.footprints.reserve(points->size());
     for (const Eigen::Vector3f& position : points->positions) part.footprints.push_back(PixelFootprint(views, position));
@@ -281,6 +334,7 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
 std::string DenseReportJson(const DenseStageReport& report) {
   JsonWriter json(2);
   json.BeginObject();
+  json.Key("method").String(DenseMethodName(report.method));
   json.Key("level").Int(report.level);
   json.Key("level_chosen_from_memory_budget").Bool(report.level_auto);
   json.Key("estimated_cluster_mib").Double(static_cast<double>(report.estimated_bytes) / (1 << 20));
@@ -311,6 +365,15 @@ std::string DenseReportJson(const DenseStageReport& report) {
   json.Key("seconds_matching").Double(report.pmvs.seconds_matching);
   json.Key("seconds_expansion").Double(report.pmvs.seconds_expansion);
   json.Key("seconds_filtering").Double(report.pmvs.seconds_filtering);
+  json.EndObject();
+  json.Key("patchmatch").BeginObject();
+  json.Key("views").Int(static_cast<long long>(report.patchmatch.views));
+  json.Key("depth_pixels").Int(static_cast<long long>(report.patchmatch.depth_pixels));
+  json.Key("fused_points").Int(static_cast<long long>(report.patchmatch.fused_points));
+  json.Key("seconds_selection").Double(report.patchmatch.seconds_selection);
+  json.Key("seconds_propagation").Double(report.patchmatch.seconds_propagation);
+  json.Key("seconds_consistency").Double(report.patchmatch.seconds_consistency);
+  json.Key("seconds_fusion").Double(report.patchmatch.seconds_fusion);
   json.EndObject();
   json.Key("peak_rss_resettable").Bool(report.peak_rss_resettable);
   json.Key("phases").BeginObject();

@@ -1,8 +1,9 @@
 #pragma once
 // Dense stage: reads a project's sparse model (<project>/sparse, COLMAP text) and image list
 // (features/images.txt), groups the registered images into view clusters (core/mvs/view_clustering.h),
-// undistorts the views of each cluster (core/mvs/undistort.h) and runs PMVS on it
-// (core/mvs/pmvs/patch_mvs.h), merges the clusters' points (core/mvs/merge_points.h), drops isolated
+// undistorts the views of each cluster (core/mvs/undistort.h) and runs the chosen multi-view stereo
+// on it (DenseMethod: PMVS, core/mvs/pmvs/patch_mvs.h, or PatchMatch depth maps,
+// core/mvs/patchmatch/patchmatch_mvs.h), merges the clusters' points (core/mvs/merge_points.h), drops isolated
 // points and small floating pieces (core/mesh/poisson/point_outliers.h) and writes
 //   <project>/dense/points.ply     binary PLY: x y z, nx ny nz (float), red green blue alpha (uchar)
 //   <project>/dense/report.json    DenseReportJson below
@@ -13,17 +14,29 @@
 
 #include "core/base/status.h"
 #include "core/mesh/poisson/point_outliers.h"
+#include "core/mvs/patchmatch/patchmatch_mvs.h"
 #include "core/mvs/pmvs/patch_mvs.h"
 #include "core/mvs/view_clustering.h"
 #include "core/pipeline/project.h"
 
 namespace reconar {
 
+enum class DenseMethod {
+  kPmvs,        // patches grown from matched features (Furukawa & Ponce 2010): the paper's method
+  kPatchMatch,  // a depth map per view by PatchMatch, fused across views
+};
+
+// "pmvs", "patchmatch"; ParseDenseMethod returns InvalidArgument naming the choices.
+const char* DenseMethodName(DenseMethod method);
+Result<DenseMethod> ParseDenseMethod(const std::string& name);
+
 struct DenseStageOptions {
+  DenseMethod method = DenseMethod::kPmvs;
   int level = -1;  // -1: the finest level 0..2 whose memory estimate fits the budget; else 0, 1 or 2
   size_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
   ViewClusteringOptions clustering;
   PatchMvsOptions mvs;  // its num_threads 0 takes the stage's
+  PatchMatchOptions patchmatch;  // likewise
   bool remove_outliers = true;
   OutlierFilterOptions outliers;  // its num_threads 0 takes the stage's
   int num_threads = 0;  // 0: one per core
@@ -38,6 +51,7 @@ struct DensePhase {
 };
 
 struct DenseStageReport {
+  DenseMethod method = DenseMethod::kPmvs;
   int level = 0;
   bool level_auto = false;
   size_t estimated_bytes = 0;     // the memory model's figure for one cluster at that level
@@ -46,7 +60,7 @@ struct DenseStageReport {
   int images = 0;                 // registered images in the model
   int kept_images = 0, removed_images = 0;
   int clusters = 0;
-  int clusters_without_points = 0;  // too small for PMVS, or no patch survived
+  int clusters_without_points = 0;  // too small for the method, or no point survived
   bool clusters_from_cameras = false;
   double sparse_points_covered = 0.0;  // fraction, see ViewClustering::covered_fraction
   size_t views_undistorted = 0;   // counting views reused by consecutive clusters once
@@ -55,7 +69,8 @@ struct DenseStageReport {
   size_t points = 0;
   DensePhase load, clustering, undistort, mvs, merge, outlier_filter, write;
   bool peak_rss_resettable = false;
-  PatchMvsReport pmvs;            // summed over clusters
+  PatchMvsReport pmvs;            // summed over clusters (PMVS)
+  PatchMatchReport patchmatch;    // summed over clusters (PatchMatch)
   std::string points_path, report_path;
 };
 

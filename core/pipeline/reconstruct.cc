@@ -361,12 +361,16 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       }
       return Status::Ok();
     };
-    RECONAR_RETURN_IF_ERROR(runner.Run("dense",
-                                       Settings({{"level", dense.level},
-                                                 {"max_cluster_size", dense.clustering.max_cluster_size},
-                                                 {"budget_mib", Mib(budget)},
-                                                 {"remove_outliers", dense.remove_outliers ? 1.0 : 0.0}}),
-                                       Exists(project.root() + "/dense/report.json"), runner.redone(), run_dense));
+    std::string dense_settings = Settings({{"level", dense.level},
+                                           {"max_cluster_size", dense.clustering.max_cluster_size},
+                                           {"budget_mib", Mib(budget)},
+                                           {"remove_outliers", dense.remove_outliers ? 1.0 : 0.0}});
+    // PMVS records no method, so that the projects made before the choice existed stay finished.
+    if (dense.method != DenseMethod::kPmvs) {
+      dense_settings += " " + Settings({{"method", static_cast<double>(dense.method)}});
+    }
+    RECONAR_RETURN_IF_ERROR(runner.Run("dense", dense_settings, Exists(project.root() + "/dense/report.json"),
+                                       runner.redone(), run_dense));
   }
 
   if (options.run_mesh) {

@@ -27,8 +27,9 @@ Result<BunnyDenseFigures> RunBunnyDense(const Mesh& bunny, const std::string& pr
   figures.seconds_render = SecondsSince(start);
 
   start = Clock::now();
-  RECONAR_ASSIGN_OR_RETURN(figures.dense,
-                           RunDenseStage(Project(project_dir), DenseRunOptions(options.level, options.num_threads)));
+  DenseStageOptions dense = DenseRunOptions(options.method, options.level, options.num_threads);
+  dense.remove_outliers = options.remove_outliers;
+  RECONAR_ASSIGN_OR_RETURN(figures.dense, RunDenseStage(Project(project_dir), dense));
   figures.seconds_dense = SecondsSince(start);
 
   // Positions and normals as the dense stage wrote them: Poisson needs the normals.

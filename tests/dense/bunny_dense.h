@@ -18,6 +18,8 @@ namespace testing {
 
 struct BunnyDenseOptions {
   BunnyProjectOptions project;
+  DenseMethod method = DenseMethod::kPmvs;
+  bool remove_outliers = true;  // DenseStageOptions::remove_outliers
   int level = 0;
   int num_threads = 0;
   PoissonOptions poisson;  // depth 8; trim set by the caller (0 keeps Poisson's closure of the unseen base)

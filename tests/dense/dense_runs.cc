@@ -15,8 +15,9 @@ Box3 TempleRingBoundingBox() {
   return box;
 }
 
-DenseStageOptions DenseRunOptions(int level, int num_threads) {
+DenseStageOptions DenseRunOptions(DenseMethod method, int level, int num_threads) {
   DenseStageOptions options;
+  options.method = method;
   options.level = level;
   options.num_threads = num_threads;
   options.show_progress = false;
@@ -33,8 +34,9 @@ Result<TempleRingDenseFigures> RunTempleRingDense(const std::string& par_path, c
   TempleRingDenseFigures figures;
   RECONAR_ASSIGN_OR_RETURN(figures.import, ImportMiddleburyProject(par_path, project_dir, options.import));
   const auto start = std::chrono::steady_clock::now();
-  RECONAR_ASSIGN_OR_RETURN(figures.dense,
-                           RunDenseStage(Project(project_dir), DenseRunOptions(options.level, options.num_threads)));
+  DenseStageOptions dense = DenseRunOptions(options.method, options.level, options.num_threads);
+  dense.remove_outliers = options.remove_outliers;
+  RECONAR_ASSIGN_OR_RETURN(figures.dense, RunDenseStage(Project(project_dir), dense));
   figures.seconds_dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   RECONAR_ASSIGN_OR_RETURN(const std::vector<Eigen::Vector3f> points, ReadDensePoints(project_dir));
   const Box3 box = TempleRingBoundingBox();

@@ -30,14 +30,17 @@ struct Box3 {
 // templeRing's tight bounding box as its README.txt gives it (metres, world frame of templeR_par.txt).
 Box3 TempleRingBoundingBox();
 
-// DenseStageOptions for these runs: no progress bar, the given level and threads, the rest default.
-DenseStageOptions DenseRunOptions(int level, int num_threads);
+// DenseStageOptions for these runs: no progress bar, the given method, level and threads, the rest
+// default.
+DenseStageOptions DenseRunOptions(DenseMethod method, int level, int num_threads);
 
 // The positions of <project>/dense/points.ply.
 Result<std::vector<Eigen::Vector3f>> ReadDensePoints(const std::string& project_dir);
 
 struct TempleRingDenseOptions {
   MiddleburyImportOptions import;  // view_stride 1 = all 47 views
+  DenseMethod method = DenseMethod::kPmvs;
+  bool remove_outliers = true;     // DenseStageOptions::remove_outliers
   int level = 1;                   // 0 full 640 x 480, 1 half
   int num_threads = 0;
   // Margin around the tight box: ~6 pixel footprints at level 0 (0.5 m / 1520 px = 0.33 mm), so

@@ -22,6 +22,9 @@ struct PatchMatchViewSetup {
 // One setup per view. A sparse point belongs to a view when it projects inside the image with
 // positive depth. The range comes from the depth quantiles of the view's points; a source view
 // shares points with it whose median triangulation angle lies in [min, max]_triangulation_angle_deg.
+// A view with too few points (a model imported with known cameras and no points) falls back on the
+// cameras' geometry: the range around the point the views' optical axes meet nearest, the sources
+// by their angle seen from there.
 std::vector<PatchMatchViewSetup> SetUpPatchMatchViews(const std::vector<const DenseView*>& views,
                                                       const std::vector<Eigen::Vector3d>& sparse_points,
                                                       const PatchMatchOptions& options, ThreadPool* pool);
