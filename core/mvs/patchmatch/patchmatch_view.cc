@@ -57,11 +57,13 @@ struct SourceGeometry {
 struct Scratch {
   std::vector<float> reference;  // centred grey values of the active window samples
   std::vector<float> weights;    // their bilateral weights
-  std::vector<int> active;       // their offset indices (samples inside the reference image)
-  std::vector<float> costs;      // one per source
+  std::vector<float> offset_x;   // their offsets (the samples inside the reference image)
+  std::vector<float> offset_y;
+  std::vector<float> costs;  // one per source
   int count = 0;
   float weight_sum = 0.0f;
   float variance = 0.0f;
+  float min_x = 0.0f, max_x = 0.0f, min_y = 0.0f, max_y = 0.0f;  // bounding box of the offsets
 };
 
 class PatchMatchViewSolver {
@@ -111,7 +113,8 @@ class PatchMatchViewSolver {
     for (Scratch& s : scratch_) {
       s.reference.resize(offset_x_.size());
       s.weights.resize(offset_x_.size());
-      s.active.resize(offset_x_.size());
+      s.offset_x.resize(offset_x_.size());
+      s.offset_y.resize(offset_x_.size());
       s.costs.resize(sources_.size());
     }
   }
@@ -207,14 +210,25 @@ class PatchMatchViewSolver {
     const int w = grey.width(), h = grey.height();
     s->count = 0;
     float weight_sum = 0.0f, sum = 0.0f, sum_squares = 0.0f;
+    int min_x = 0, max_x = 0, min_y = 0, max_y = 0;
     for (size_t o = 0; o < offset_x_.size(); ++o) {
       const int px = x + offset_x_[o], py = y + offset_y_[o];
       if (px < 0 || py < 0 || px >= w || py >= h) continue;
       const float value = grey.row(py)[px];
       const float weight = spatial_[o] * color_[std::abs(view_.gray.row(py)[px] - centre)];
-      s->active[static_cast<size_t>(s->count)] = static_cast<int>(o);
-      s->reference[static_cast<size_t>(s->count)] = value;
-      s->weights[static_cast<size_t>(s->count)] = weight;
+      const size_t j = static_cast<size_t>(s->count);
+      if (j == 0) {
+        min_x = max_x = offset_x_[o];
+        min_y = max_y = offset_y_[o];
+      }
+      min_x = std::min(min_x, offset_x_[o]);
+      max_x = std::max(max_x, offset_x_[o]);
+      min_y = std::min(min_y, offset_y_[o]);
+      max_y = std::max(max_y, offset_y_[o]);
+      s->offset_x[j] = static_cast<float>(offset_x_[o]);
+      s->offset_y[j] = static_cast<float>(offset_y_[o]);
+      s->reference[j] = value;
+      s->weights[j] = weight;
       ++s->count;
       weight_sum += weight;
       sum += weight * value;
@@ -224,15 +238,24 @@ class PatchMatchViewSolver {
     const float mean = sum / weight_sum;
     s->variance = sum_squares / weight_sum - mean * mean;
     s->weight_sum = weight_sum;
+    s->min_x = static_cast<float>(min_x);
+    s->max_x = static_cast<float>(max_x);
+    s->min_y = static_cast<float>(min_y);
+    s->max_y = static_cast<float>(max_y);
     if (!(s->variance >= kMinTextureVariance)) return false;
     for (int j = 0; j < s->count; ++j) s->reference[static_cast<size_t>(j)] -= mean;
     return true;
   }
 
   // 1 - weighted NCC of the reference window (in `s`) and its warp by `h` into the source;
-  // kNoDepthCost when a sample falls outside the source image or behind its camera, or the warped
-  // window is textureless.
+  // kNoDepthCost when the window reaches outside the source image or behind its camera, or the
+  // warped window is textureless. The check is made on the corners of the offsets' bounding box:
+  // h's third row is affine in the offset, so positive at the corners means positive inside, and
+  // then h maps the box to the convex quadrilateral of the corners' images, which holds every
+  // sample. The corners keep kBorderMargin pixels from the last column and row, more than the
+  // float rounding of any sample, so the bilinear reads stay inside the image.
   float WindowCost(const SourceGeometry& g, const Eigen::Matrix3d& hd, int x, int y, const Scratch& s) const {
+    constexpr float kBorderMargin = 0.01f;
     const Eigen::Matrix3f h = hd.cast<float>();
     const float fx = static_cast<float>(x), fy = static_cast<float>(y);
     const float h0x = h(0, 0) * fx + h(0, 1) * fy + h(0, 2);
@@ -240,28 +263,35 @@ class PatchMatchViewSolver {
     const float h0z = h(2, 0) * fx + h(2, 1) * fy + h(2, 2);
     const Image<float>& grey = *g.grey;
     const int width = grey.width();
-    const float max_u = static_cast<float>(width - 1), max_v = static_cast<float>(grey.height() - 1);
-    const float* pixels = grey.data();
-    float sum = 0.0f, sum_squares = 0.0f, sum_products = 0.0f;
-    for (int j = 0; j < s.count; ++j) {
-      const int o = s.active[static_cast<size_t>(j)];
-      const float ox = static_cast<float>(offset_x_[static_cast<size_t>(o)]);
-      const float oy = static_cast<float>(offset_y_[static_cast<size_t>(o)]);
+    const float max_u = static_cast<float>(width - 1) - kBorderMargin;
+    const float max_v = static_cast<float>(grey.height() - 1) - kBorderMargin;
+    for (int corner = 0; corner < 4; ++corner) {
+      const float ox = (corner & 1) ? s.max_x : s.min_x, oy = (corner & 2) ? s.max_y : s.min_y;
       const float hz = h0z + h(2, 0) * ox + h(2, 1) * oy;
-      if (!(hz > 0.0f)) return kNoDepthCost;
+      if (!(hz > 1e-6f)) return kNoDepthCost;
       const float u = (h0x + h(0, 0) * ox + h(0, 1) * oy) / hz;
       const float v = (h0y + h(1, 0) * ox + h(1, 1) * oy) / hz;
-      if (!(u >= 0.0f && v >= 0.0f && u < max_u && v < max_v)) return kNoDepthCost;
+      if (!(u >= kBorderMargin && v >= kBorderMargin && u <= max_u && v <= max_v)) return kNoDepthCost;
+    }
+    const float* pixels = grey.data();
+    const size_t stride = static_cast<size_t>(width);
+    float sum = 0.0f, sum_squares = 0.0f, sum_products = 0.0f;
+    for (int j = 0; j < s.count; ++j) {
+      const size_t k = static_cast<size_t>(j);
+      const float ox = s.offset_x[k], oy = s.offset_y[k];
+      const float inverse_z = 1.0f / (h0z + h(2, 0) * ox + h(2, 1) * oy);
+      const float u = (h0x + h(0, 0) * ox + h(0, 1) * oy) * inverse_z;
+      const float v = (h0y + h(1, 0) * ox + h(1, 1) * oy) * inverse_z;
       const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
       const float au = u - static_cast<float>(u0), av = v - static_cast<float>(v0);
-      const float* p = pixels + static_cast<size_t>(v0) * static_cast<size_t>(width) + u0;
+      const float* p = pixels + static_cast<size_t>(v0) * stride + static_cast<size_t>(u0);
       const float top = p[0] + au * (p[1] - p[0]);
-      const float bottom = p[width] + au * (p[width + 1] - p[width]);
+      const float bottom = p[stride] + au * (p[stride + 1] - p[stride]);
       const float value = top + av * (bottom - top);
-      const float w = s.weights[static_cast<size_t>(j)];
+      const float w = s.weights[k];
       sum += w * value;
       sum_squares += w * value * value;
-      sum_products += w * s.reference[static_cast<size_t>(j)] * value;
+      sum_products += w * s.reference[k] * value;
     }
     const float mean = sum / s.weight_sum;
     const float variance = sum_squares / s.weight_sum - mean * mean;

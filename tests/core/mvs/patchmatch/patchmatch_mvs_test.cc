@@ -161,10 +161,16 @@ Evaluation Evaluate(const TexturedBoxScene& scene, const TexturedBoxSceneOptions
   return e;
 }
 
+// PATCHMATCH_TEST_WIDTH (e.g. 640) renders the scene larger for a timing; PATCHMATCH_TEST_VIEWS
+// takes more of the ring's cameras. The bounds hold at any size: they scale with the footprint.
 void ExpectAccurateAndComplete(int geometric_iterations) {
-  const TexturedBoxSceneOptions scene_options = SceneOptions(160, 120);
+  const char* width = std::getenv("PATCHMATCH_TEST_WIDTH");
+  const int w = width ? std::max(64, std::atoi(width)) : 160;
+  const TexturedBoxSceneOptions scene_options = SceneOptions(w, w * 3 / 4);
   const TexturedBoxScene scene(scene_options);
-  const std::vector<const DenseView*> views = FirstViews(scene, 4);
+  const char* num_views = std::getenv("PATCHMATCH_TEST_VIEWS");
+  const std::vector<const DenseView*> views =
+      FirstViews(scene, num_views ? std::clamp(std::atoi(num_views), 2, 12) : 4);
   const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 300);
   PatchMatchOptions options;
   options.geometric_iterations = geometric_iterations;
