@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "core/base/thread_pool.h"
+#include "core/mvs/patchmatch/warp_sums.h"
 
 namespace reconar {
 namespace {
@@ -44,8 +45,8 @@ struct SourceGeometry {
   const Image<float>* grey = nullptr;
   const DepthMap* depth = nullptr;  // may be null or empty
   // Plane-induced homography H = A + b m^T / (n . X) (see PatchMatchViewSolver::Cost).
-  Eigen::Matrix3d a;
-  Eigen::Vector3d b;
+  Eigen::Matrix3f a;
+  Eigen::Vector3f b;
   Eigen::Matrix3d source_from_reference_rotation;
   Eigen::Vector3d source_from_reference_translation;
   Eigen::Matrix3d reference_from_source_rotation;
@@ -61,6 +62,7 @@ struct Scratch {
   std::vector<float> offset_y;
   std::vector<float> costs;  // one per source
   int count = 0;
+  int padded_count = 0;  // count rounded up to kWarpLanes (the padding has weight 0)
   float weight_sum = 0.0f;
   float variance = 0.0f;
   float min_x = 0.0f, max_x = 0.0f, min_y = 0.0f, max_y = 0.0f;  // bounding box of the offsets
@@ -100,8 +102,8 @@ class PatchMatchViewSolver {
       g.reference_from_source_translation = -(g.reference_from_source_rotation * g.source_from_reference_translation);
       Eigen::Matrix3d k_s;
       k_s << s.fx, 0.0, s.cx, 0.0, s.fy, s.cy, 0.0, 0.0, 1.0;
-      g.a = k_s * g.source_from_reference_rotation * k_inv_r;
-      g.b = k_s * g.source_from_reference_translation;
+      g.a = (k_s * g.source_from_reference_rotation * k_inv_r).cast<float>();
+      g.b = (k_s * g.source_from_reference_translation).cast<float>();
       g.fx = s.fx;
       g.fy = s.fy;
       g.cx = s.cx;
@@ -111,10 +113,11 @@ class PatchMatchViewSolver {
     top_k_ = std::min<int>(options.cost_top_k, static_cast<int>(sources_.size()));
     scratch_.resize(static_cast<size_t>(pool->num_threads()));
     for (Scratch& s : scratch_) {
-      s.reference.resize(offset_x_.size());
-      s.weights.resize(offset_x_.size());
-      s.offset_x.resize(offset_x_.size());
-      s.offset_y.resize(offset_x_.size());
+      const size_t padded = static_cast<size_t>(PaddedWarpCount(static_cast<int>(offset_x_.size())));
+      s.reference.resize(padded);
+      s.weights.resize(padded);
+      s.offset_x.resize(padded);
+      s.offset_y.resize(padded);
       s.costs.resize(sources_.size());
     }
   }
@@ -244,6 +247,14 @@ class PatchMatchViewSolver {
     s->max_y = static_cast<float>(max_y);
     if (!(s->variance >= kMinTextureVariance)) return false;
     for (int j = 0; j < s->count; ++j) s->reference[static_cast<size_t>(j)] -= mean;
+    // Padding for the kernels: weight 0 at the first sample's offset (inside the checked box).
+    s->padded_count = PaddedWarpCount(s->count);
+    for (size_t j = static_cast<size_t>(s->count); j < static_cast<size_t>(s->padded_count); ++j) {
+      s->offset_x[j] = s->offset_x[0];
+      s->offset_y[j] = s->offset_y[0];
+      s->reference[j] = 0.0f;
+      s->weights[j] = 0.0f;
+    }
     return true;
   }
 
@@ -254,9 +265,8 @@ class PatchMatchViewSolver {
   // then h maps the box to the convex quadrilateral of the corners' images, which holds every
   // sample. The corners keep kBorderMargin pixels from the last column and row, more than the
   // float rounding of any sample, so the bilinear reads stay inside the image.
-  float WindowCost(const SourceGeometry& g, const Eigen::Matrix3d& hd, int x, int y, const Scratch& s) const {
+  float WindowCost(const SourceGeometry& g, const Eigen::Matrix3f& h, int x, int y, const Scratch& s) const {
     constexpr float kBorderMargin = 0.01f;
-    const Eigen::Matrix3f h = hd.cast<float>();
     const float fx = static_cast<float>(x), fy = static_cast<float>(y);
     const float h0x = h(0, 0) * fx + h(0, 1) * fy + h(0, 2);
     const float h0y = h(1, 0) * fx + h(1, 1) * fy + h(1, 2);
@@ -269,30 +279,16 @@ class PatchMatchViewSolver {
       const float ox = (corner & 1) ? s.max_x : s.min_x, oy = (corner & 2) ? s.max_y : s.min_y;
       const float hz = h0z + h(2, 0) * ox + h(2, 1) * oy;
       if (!(hz > 1e-6f)) return kNoDepthCost;
-      const float u = (h0x + h(0, 0) * ox + h(0, 1) * oy) / hz;
-      const float v = (h0y + h(1, 0) * ox + h(1, 1) * oy) / hz;
-      if (!(u >= kBorderMargin && v >= kBorderMargin && u <= max_u && v <= max_v)) return kNoDepthCost;
+      // u = hx / hz in [margin, max_u] without dividing (hz > 0); likewise v.
+      const float hx = h0x + h(0, 0) * ox + h(0, 1) * oy, hy = h0y + h(1, 0) * ox + h(1, 1) * oy;
+      if (!(hx >= kBorderMargin * hz && hy >= kBorderMargin * hz && hx <= max_u * hz && hy <= max_v * hz)) {
+        return kNoDepthCost;
+      }
     }
-    const float* pixels = grey.data();
-    const size_t stride = static_cast<size_t>(width);
-    float sum = 0.0f, sum_squares = 0.0f, sum_products = 0.0f;
-    for (int j = 0; j < s.count; ++j) {
-      const size_t k = static_cast<size_t>(j);
-      const float ox = s.offset_x[k], oy = s.offset_y[k];
-      const float inverse_z = 1.0f / (h0z + h(2, 0) * ox + h(2, 1) * oy);
-      const float u = (h0x + h(0, 0) * ox + h(0, 1) * oy) * inverse_z;
-      const float v = (h0y + h(1, 0) * ox + h(1, 1) * oy) * inverse_z;
-      const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
-      const float au = u - static_cast<float>(u0), av = v - static_cast<float>(v0);
-      const float* p = pixels + static_cast<size_t>(v0) * stride + static_cast<size_t>(u0);
-      const float top = p[0] + au * (p[1] - p[0]);
-      const float bottom = p[stride] + au * (p[stride + 1] - p[stride]);
-      const float value = top + av * (bottom - top);
-      const float w = s.weights[k];
-      sum += w * value;
-      sum_squares += w * value * value;
-      sum_products += w * s.reference[k] * value;
-    }
+    const WarpHomography warp{h0x, h0y, h0z, h(0, 0), h(1, 0), h(2, 0), h(0, 1), h(1, 1), h(2, 1)};
+    const WarpWindow window{s.offset_x.data(), s.offset_y.data(), s.weights.data(), s.reference.data(), s.padded_count};
+    const WarpSums sums = warp_sums_(warp, window, grey.data(), width);
+    const float sum = sums.sum, sum_squares = sums.sum_squares, sum_products = sums.sum_products;
     const float mean = sum / s.weight_sum;
     const float variance = sum_squares / s.weight_sum - mean * mean;
     if (!(variance >= kMinTextureVariance)) return kNoDepthCost;
@@ -335,11 +331,11 @@ class PatchMatchViewSolver {
     if (!(plane < 0.0)) return kNoDepthCost;
     const Eigen::Vector3d m(n.x() * inv_fx_, n.y() * inv_fy_,
                             n.z() - n.x() * view_.cx * inv_fx_ - n.y() * view_.cy * inv_fy_);
-    const Eigen::Vector3d m_scaled = m / plane;
+    const Eigen::Vector3f m_scaled = (m / plane).cast<float>();
     const Eigen::Vector3d point = depth * ray;
     for (size_t k = 0; k < sources_.size(); ++k) {
       const SourceGeometry& g = sources_[k];
-      const Eigen::Matrix3d h = g.a + g.b * m_scaled.transpose();
+      const Eigen::Matrix3f h = g.a + g.b * m_scaled.transpose();
       float cost = WindowCost(g, h, x, y, *s);
       if (geometric) cost += static_cast<float>(options_.geometric_weight) * GeometricError(g, point, x, y);
       s->costs[k] = cost;
@@ -427,6 +423,7 @@ class PatchMatchViewSolver {
   std::vector<SourceGeometry> sources_;
   int top_k_ = 1;
   std::vector<Scratch> scratch_;
+  WarpSumsFn warp_sums_ = ActiveWarpSumsKernel().sums;
 };
 
 }  // namespace

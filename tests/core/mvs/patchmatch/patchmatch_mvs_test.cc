@@ -11,6 +11,8 @@
 #include <limits>
 #include <vector>
 
+#include "core/base/thread_pool.h"
+#include "core/mvs/patchmatch/view_selection.h"
 #include "tests/core/mvs/pmvs/textured_box_scene.h"
 
 namespace reconar {
@@ -220,6 +222,44 @@ void ExpectAccurateAndComplete(int geometric_iterations) {
 TEST(PatchMatchMvsTest, TexturedBoxIsAccurateAndComplete) { ExpectAccurateAndComplete(0); }
 
 TEST(PatchMatchMvsTest, GeometricConsistencyKeepsAccuracyAndCompleteness) { ExpectAccurateAndComplete(1); }
+
+// On the ring of 12 cameras 30 degrees apart, the angle at the target between cameras k steps
+// apart is 25.6, 50.8, 74.7 degrees for k = 1, 2, 3: with the default [3, 60] degrees every view
+// takes the two neighbours on each side as sources, those one step away first (they share the
+// most points). The depth range holds the true depth of every sparse point the view sees.
+TEST(PatchMatchMvsTest, SelectsNeighbouringSourcesAndDepthRange) {
+  const TexturedBoxScene scene(SceneOptions(80, 60));
+  const std::vector<const DenseView*> views = scene.view_pointers();
+  const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 600);
+  ThreadPool pool(2);
+  const std::vector<PatchMatchViewSetup> setups = SetUpPatchMatchViews(views, sparse, PatchMatchOptions(), &pool);
+  ASSERT_EQ(setups.size(), views.size());
+  for (int v = 0; v < 12; ++v) {
+    const PatchMatchViewSetup& setup = setups[static_cast<size_t>(v)];
+    ASSERT_TRUE(setup.valid) << v;
+    std::vector<int> sources = setup.sources;
+    ASSERT_EQ(sources.size(), 4u) << v;
+    std::vector<int> near = {(v + 1) % 12, (v + 11) % 12};
+    std::sort(near.begin(), near.end());
+    std::vector<int> first(sources.begin(), sources.begin() + 2);
+    std::sort(first.begin(), first.end());
+    EXPECT_EQ(first, near) << v;
+    std::sort(sources.begin(), sources.end());
+    std::vector<int> all = {(v + 1) % 12, (v + 2) % 12, (v + 10) % 12, (v + 11) % 12};
+    std::sort(all.begin(), all.end());
+    EXPECT_EQ(sources, all) << v;
+    for (const Eigen::Vector3d& x : sparse) {
+      const DenseView& view = *views[static_cast<size_t>(v)];
+      const Eigen::Vector2d p = view.Project(x);
+      if (view.Depth(x) <= 0.0 || p.x() < -0.5 || p.y() < -0.5 || p.x() >= view.width() - 0.5 ||
+          p.y() >= view.height() - 0.5 || !scene.Sees(view, x)) {
+        continue;
+      }
+      EXPECT_GE(view.Depth(x), setup.depth_min) << v;
+      EXPECT_LE(view.Depth(x), setup.depth_max) << v;
+    }
+  }
+}
 
 TEST(PatchMatchMvsTest, SameResultForAnyThreadCount) {
   const TexturedBoxScene scene(SceneOptions(80, 60));
