@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "core/base/prng.h"
 #include "core/base/thread_pool.h"
 #include "core/mvs/patchmatch/warp_sums.h"
 
@@ -19,26 +20,18 @@ constexpr float kDepthPerturbation = 0.1f;     // relative depth range of a pert
 constexpr float kNormalPerturbation = 0.5f;    // ... and of a normal's (added vector); both halve each sweep
 constexpr int kInitialisationSweep = 1 << 20;  // the random stream of the initial planes
 
-uint64_t Mix(uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ull;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
-// SplitMix64: a per-pixel stream, so the result does not depend on the thread count.
+// A per-pixel SplitMix64 stream keyed by (view seed, pixel, sweep), so the result does not depend
+// on the thread count.
 class PixelRandom {
  public:
   PixelRandom(uint64_t seed, size_t pixel, int sweep)
-      : state_(Mix(seed ^ Mix(static_cast<uint64_t>(pixel) * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(sweep)))) {}
-  float Uniform() {  // [0, 1)
-    state_ += 0x9E3779B97F4A7C15ull;
-    return static_cast<float>(Mix(state_) >> 40) * 0x1.0p-24f;
-  }
+      : generator_(
+            SplitMix64(seed ^ (static_cast<uint64_t>(pixel) * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(sweep)))
+                .Next()) {}
+  float Uniform() { return static_cast<float>(generator_.Next() >> 40) * 0x1.0p-24f; }  // [0, 1)
 
  private:
-  uint64_t state_;
+  SplitMix64 generator_;
 };
 
 struct SourceGeometry {

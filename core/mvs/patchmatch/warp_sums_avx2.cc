@@ -3,19 +3,10 @@
 // in lanes, four gathers for the bilinear corners.
 #include <immintrin.h>
 
+#include "core/base/horizontal_sum_avx2.h"
 #include "core/mvs/patchmatch/warp_sums_types.h"
 
 namespace reconar::internal {
-namespace {
-
-inline float HorizontalSum(__m256 v) {
-  __m128 s = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-  s = _mm_add_ps(s, _mm_movehl_ps(s, s));
-  s = _mm_add_ss(s, _mm_shuffle_ps(s, s, 1));
-  return _mm_cvtss_f32(s);
-}
-
-}  // namespace
 
 WarpSums WarpSumsAvx2(const WarpHomography& h, const WarpWindow& window, const float* image, int stride) {
   const __m256 h0x = _mm256_set1_ps(h.h0x), h0y = _mm256_set1_ps(h.h0y), h0z = _mm256_set1_ps(h.h0z);
@@ -47,9 +38,9 @@ WarpSums WarpSumsAvx2(const WarpHomography& h, const WarpWindow& window, const f
     sum_products = _mm256_fmadd_ps(weighted, _mm256_loadu_ps(window.reference + j), sum_products);
   }
   WarpSums s;
-  s.sum = HorizontalSum(sum);
-  s.sum_squares = HorizontalSum(sum_squares);
-  s.sum_products = HorizontalSum(sum_products);
+  s.sum = HorizontalSumAvx2(sum);
+  s.sum_squares = HorizontalSumAvx2(sum_squares);
+  s.sum_products = HorizontalSumAvx2(sum_products);
   return s;
 }
 

@@ -11,6 +11,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/base/prng.h"
 #include "core/base/thread_pool.h"
 #include "core/mvs/patchmatch/view_selection.h"
 #include "tests/core/mvs/pmvs/textured_box_scene.h"
@@ -51,11 +52,8 @@ Eigen::Vector3d PixelRay(const DenseView& view, double u, double v) {
 std::vector<Eigen::Vector3d> SparsePoints(const TexturedBoxScene& scene, const std::vector<const DenseView*>& views,
                                           int count) {
   std::vector<Eigen::Vector3d> points;
-  uint64_t state = 12345;
-  auto uniform = [&]() {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(state >> 11) * 0x1.0p-53;
-  };
+  SplitMix64 random(12345);
+  auto uniform = [&]() { return random.Uniform01(); };
   while (static_cast<int>(points.size()) < count) {
     const DenseView& view = *views[static_cast<size_t>(uniform() * views.size()) % views.size()];
     const SceneHit hit =

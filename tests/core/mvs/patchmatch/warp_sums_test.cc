@@ -7,18 +7,18 @@
 #include <cstring>
 #include <vector>
 
+#include "core/base/prng.h"
+
 namespace reconar {
 namespace {
 
+// Uniform floats in [low, high) from the project's generator.
 class Random {
  public:
-  float Uniform(float low, float high) {
-    state_ = state_ * 6364136223846793005ull + 1442695040888963407ull;
-    return low + (high - low) * static_cast<float>(state_ >> 40) * 0x1.0p-24f;
-  }
+  float Uniform(float low, float high) { return static_cast<float>(generator_.Uniform(low, high)); }
 
  private:
-  uint64_t state_ = 7;
+  SplitMix64 generator_{7};
 };
 
 // Every kernel against the scalar reference on random windows (any count, padded), random
