@@ -48,6 +48,11 @@ struct PatchMatchOptions {
   double sigma_color = 12.0;
   int cost_top_k = 2;
   int iterations = 4;  // red-black sweeps (each sweep: both colours)
+  // Added: propagation tests, in each of the four directions, the plane of the cheapest pixel
+  // among those 1, 3, ..., 11 pixels away (4 planes); with separate_near_neighbours the adjacent
+  // pixel's plane and the cheapest farther one (8 planes, as ACMH). On the test's box scene the
+  // 4 planes took 28 % less time for the same completeness and 4 % fewer consistent pixels.
+  bool separate_near_neighbours = false;
   // Added: geometric consistency (Schoenberger et al. 2016 sec. 4.2; Xu & Tao 2019): after the
   // photometric sweeps of all views, this many further sweeps per view add to every source view's
   // cost geometric_weight * min(forward-backward reprojection error in px, geometric_max_error_px)

@@ -368,14 +368,19 @@ class PatchMatchViewSolver {
       }
     };
     static constexpr int kDirections[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+    // In each direction the cheapest of the pixels at odd distances (the other colour), the
+    // adjacent one among them or, with options.separate_near_neighbours, tested on its own too.
+    const int first_far = options_.separate_near_neighbours ? 3 : 1;
     for (const auto& d : kDirections) {
-      const int nx = x + d[0], ny = y + d[1];
-      if (nx < 0 || ny < 0 || nx >= map_.width || ny >= map_.height) continue;
-      if (map_.cost[map_.Index(nx, ny)] < kNoDepthCost)
-        consider(PropagatedDepth(nx, ny, ray), Normal(map_.Index(nx, ny)));
+      if (options_.separate_near_neighbours) {
+        const int nx = x + d[0], ny = y + d[1];
+        if (nx >= 0 && ny >= 0 && nx < map_.width && ny < map_.height && map_.cost[map_.Index(nx, ny)] < kNoDepthCost) {
+          consider(PropagatedDepth(nx, ny, ray), Normal(map_.Index(nx, ny)));
+        }
+      }
       int far_x = -1, far_y = -1;
       float far_cost = kNoDepthCost;
-      for (int k = 3; k <= 2 * kFarSteps + 1; k += 2) {
+      for (int k = first_far; k <= 2 * kFarSteps + 1; k += 2) {
         const int fx = x + k * d[0], fy = y + k * d[1];
         if (fx < 0 || fy < 0 || fx >= map_.width || fy >= map_.height) break;
         const float c = map_.cost[map_.Index(fx, fy)];

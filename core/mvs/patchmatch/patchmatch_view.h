@@ -1,8 +1,8 @@
 #pragma once
 // PatchMatch on one reference view (Bleyer et al. 2011; Xu & Tao 2019, ACMH): random planes,
 // then sweeps that visit the pixels of one checkerboard colour in parallel (all of them depend
-// only on pixels of the other colour), each testing the planes of 8 neighbours (the adjacent
-// pixel and the cheapest of the pixels 3, 5, ... 11 away, in each of the four directions) and a
+// only on pixels of the other colour), each testing the planes of neighbours (in each of the four
+// directions the cheapest of the pixels 1, 3, ... 11 away; see separate_near_neighbours) and a
 // few random and perturbed planes of shrinking range. The cost of a plane is
 // 1 - NCC between a bilaterally weighted window of the reference and its homography warp into a
 // source view, averaged over the best cost_top_k sources; the geometric term of Schoenberger et

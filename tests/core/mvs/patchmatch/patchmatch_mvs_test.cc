@@ -163,7 +163,7 @@ Evaluation Evaluate(const TexturedBoxScene& scene, const TexturedBoxSceneOptions
 
 // PATCHMATCH_TEST_WIDTH (e.g. 640) renders the scene larger for a timing; PATCHMATCH_TEST_VIEWS
 // takes more of the ring's cameras. The bounds hold at any size: they scale with the footprint.
-void ExpectAccurateAndComplete(int geometric_iterations) {
+void ExpectAccurateAndComplete(int geometric_iterations, bool separate_near_neighbours) {
   const char* width = std::getenv("PATCHMATCH_TEST_WIDTH");
   const int w = width ? std::max(64, std::atoi(width)) : 160;
   const TexturedBoxSceneOptions scene_options = SceneOptions(w, w * 3 / 4);
@@ -174,6 +174,7 @@ void ExpectAccurateAndComplete(int geometric_iterations) {
   const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 300);
   PatchMatchOptions options;
   options.geometric_iterations = geometric_iterations;
+  options.separate_near_neighbours = separate_near_neighbours;
   if (const char* t = std::getenv("PATCHMATCH_TEST_THREADS")) options.num_threads = std::atoi(t);
   PatchMatchReport report;
   const auto start = std::chrono::steady_clock::now();
@@ -217,9 +218,10 @@ void ExpectAccurateAndComplete(int geometric_iterations) {
   EXPECT_GT(e.completeness, 0.9);
 }
 
-TEST(PatchMatchMvsTest, TexturedBoxIsAccurateAndComplete) { ExpectAccurateAndComplete(0); }
+TEST(PatchMatchMvsTest, TexturedBoxIsAccurateAndComplete) { ExpectAccurateAndComplete(0, false); }
 
-TEST(PatchMatchMvsTest, GeometricConsistencyKeepsAccuracyAndCompleteness) { ExpectAccurateAndComplete(1); }
+// The other propagation pattern (8 planes) with the geometric sweeps.
+TEST(PatchMatchMvsTest, GeometricConsistencyKeepsAccuracyAndCompleteness) { ExpectAccurateAndComplete(1, true); }
 
 // On the ring of 12 cameras 30 degrees apart, the angle at the target between cameras k steps
 // apart is 25.6, 50.8, 74.7 degrees for k = 1, 2, 3: with the default [3, 60] degrees every view
