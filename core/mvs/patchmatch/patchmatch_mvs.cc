@@ -158,6 +158,9 @@ Result<OrientedPoints> RunPatchMatchMvs(const std::vector<const DenseView*>& vie
   r.seconds_consistency = stats.seconds_consistency;
   r.seconds_fusion = stats.seconds_fusion;
   r.fused_points = points.size();
+  for (size_t v = 0; v < num_views; ++v) {
+    r.map_bytes += maps[v].SizeBytes() + greys[v].size_bytes() + 2 * maps[v].depth.size();
+  }
   if (points.size() == 0) {
     return FailedPrecondition(
         "PatchMatch MVS: no point fused (" + std::to_string(views_with_maps) + " depth maps, " +

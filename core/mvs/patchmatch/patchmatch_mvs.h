@@ -86,7 +86,13 @@ struct PatchMatchReport {
   double seconds_propagation = 0.0;  // initialisation, propagation and cost
   double seconds_consistency = 0.0;  // checks between depth maps
   double seconds_fusion = 0.0;
+  size_t map_bytes = 0;  // held by the depth maps, grey copies and fusion flags of all views
 };
+
+// Memory per pixel of every view while RunPatchMatchMvs runs: depth, normal (3) and cost floats,
+// the float grey copy, and the fusion's two byte flags (agreeing count, used); the per-thread
+// scratch and the sparse points' visibility table are small beside it.
+inline constexpr size_t kPatchMatchBytesPerPixel = 5 * sizeof(float) + sizeof(float) + 2;
 
 // Depth maps for every view of `views` (at least 2), sources among the others, then fused points.
 // `sparse_points` (world) give each view its depth range and its source views: a view whose

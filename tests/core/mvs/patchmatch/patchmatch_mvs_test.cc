@@ -202,6 +202,9 @@ void ExpectAccurateAndComplete(int geometric_iterations, bool separate_near_neig
       e.distance_90 / bound_scale, e.median_normal_degrees, e.completeness, e.eligible_cells);
   EXPECT_EQ(report.views, views.size());
   EXPECT_EQ(report.fused_points, points.size());
+  size_t pixels = 0;
+  for (const DenseView* v : views) pixels += static_cast<size_t>(v->width()) * v->height();
+  EXPECT_EQ(report.map_bytes, pixels * kPatchMatchBytesPerPixel);
   // Accuracy from the geometry: moving a point along its reference ray by D moves its image in a
   // source view by about D sin(angle) / footprint pixels, so a matching error of d pixels gives a
   // depth error of d footprint / sin(angle), and the distance to the surface is at most that. On
