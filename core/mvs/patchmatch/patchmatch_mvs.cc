@@ -13,12 +13,14 @@
 #include "core/mvs/patchmatch/depth_map.h"
 #include "core/mvs/patchmatch/patchmatch_view.h"
 #include "core/mvs/patchmatch/view_selection.h"
+#include "core/mvs/undistort.h"
 
 namespace reconar {
 namespace {
 
 constexpr int kMaxWindowRadius = 16;
 constexpr int kMaxSourceViews = 32;
+constexpr int kMinCoarseSide = 16;  // coarse to fine only when every half-resolution view is this large
 
 Status CheckViews(const std::vector<const DenseView*>& views) {
   if (views.size() < 2) {
@@ -39,6 +41,22 @@ Status CheckViews(const std::vector<const DenseView*>& views) {
     }
   }
   return Status::Ok();
+}
+
+// The view at half resolution (core/mvs/undistort.h's level convention: 2 x 2 area average,
+// f / 2, c -> (c + 0.5) / 2 - 0.5), grey only.
+DenseView HalfResolution(const DenseView& full) {
+  DenseView half;
+  half.name = full.name;
+  half.image_id = full.image_id;
+  half.level = full.level + 1;
+  half.gray = AreaAverageDown(full.gray, 1);
+  half.fx = 0.5 * full.fx;
+  half.fy = 0.5 * full.fy;
+  half.cx = 0.5 * (full.cx + 0.5) - 0.5;
+  half.cy = 0.5 * (full.cy + 0.5) - 0.5;
+  half.cam_from_world = full.cam_from_world;
+  return half;
 }
 
 }  // namespace
@@ -70,6 +88,7 @@ Status PatchMatchOptions::Check() const {
     return InvalidArgument(prefix + "cost_top_k must lie in [1, max_source_views]");
   }
   if (iterations < 1) return InvalidArgument(prefix + "iterations must be positive");
+  if (fine_iterations < 0) return InvalidArgument(prefix + "fine_iterations must be >= 0");
   if (geometric_iterations < 0) return InvalidArgument(prefix + "geometric_iterations must be >= 0");
   if (!(geometric_weight >= 0.0) || !(geometric_max_error_px > 0.0)) {
     return InvalidArgument(prefix + "geometric_weight must be >= 0 and geometric_max_error_px positive");
@@ -135,10 +154,40 @@ Result<OrientedPoints> RunPatchMatchMvs(const std::vector<const DenseView*>& vie
   const int passes = options.geometric_iterations > 0 ? 2 : 1;
   std::unique_ptr<Progress> progress;
   if (options.show_progress) progress = std::make_unique<Progress>(options.progress_label, views_with_maps * passes);
-  for (size_t v = 0; v < num_views; ++v) {
-    if (!setups[v].valid) continue;
-    RunPhotometricPatchMatch(inputs[v], options, &pool, &maps[v]);
-    if (progress) progress->Advance();
+  bool coarse_to_fine = options.coarse_to_fine;
+  for (const DenseView* v : views)
+    coarse_to_fine &= v->width() >= kMinCoarseSide * 2 && v->height() >= kMinCoarseSide * 2;
+  if (coarse_to_fine) {
+    // The views at half resolution, their maps, then each full-resolution map from its coarse one.
+    std::vector<DenseView> coarse_views(num_views);
+    std::vector<Image<float>> coarse_greys(num_views);
+    pool.ParallelFor(0, num_views, [&](size_t v, int) {
+      coarse_views[v] = HalfResolution(*views[v]);
+      coarse_greys[v] = Image<float>(coarse_views[v].width(), coarse_views[v].height(), 1);
+      Gray8ToFloat(coarse_views[v].gray.view(), coarse_greys[v].view());
+    });
+    DepthMap coarse_map;  // one view's at a time
+    for (size_t v = 0; v < num_views; ++v) {
+      if (!setups[v].valid) continue;
+      PatchMatchViewInput in = inputs[v];
+      in.reference = &coarse_views[v];
+      in.reference_grey = &coarse_greys[v];
+      for (size_t k = 0; k < in.sources.size(); ++k) {
+        const size_t s = static_cast<size_t>(setups[v].sources[k]);
+        in.sources[k] = &coarse_views[s];
+        in.source_greys[k] = &coarse_greys[s];
+        in.source_depths[k] = nullptr;
+      }
+      RunPhotometricPatchMatch(in, options, &pool, &coarse_map);
+      RunPatchMatchFromCoarse(inputs[v], coarse_map, coarse_views[v], options, &pool, &maps[v]);
+      if (progress) progress->Advance();
+    }
+  } else {
+    for (size_t v = 0; v < num_views; ++v) {
+      if (!setups[v].valid) continue;
+      RunPhotometricPatchMatch(inputs[v], options, &pool, &maps[v]);
+      if (progress) progress->Advance();
+    }
   }
   if (options.geometric_iterations > 0) {
     for (size_t v = 0; v < num_views; ++v) {

@@ -53,6 +53,14 @@ struct PatchMatchOptions {
   // pixel's plane and the cheapest farther one (8 planes, as ACMH). On the test's box scene the
   // 4 planes took 28 % less time for the same completeness and 4 % fewer consistent pixels.
   bool separate_near_neighbours = false;
+  // Added: coarse to fine (after Xu & Tao 2019): the `iterations` sweeps run on the views at half
+  // resolution, whose planes then start fine_iterations sweeps at full resolution: a quarter of
+  // the pixels for most sweeps, and texture-poor areas are matched at the coarser scale. On the
+  // test's box scene at 320 x 240 (1 thread) it took 1.66 s against 3.11 s at one resolution,
+  // with 4 % more consistent pixels and the same accuracy and completeness (2 fine sweeps: 2.37 s,
+  // 7 % more consistent pixels, 25 % lower median error).
+  bool coarse_to_fine = true;
+  int fine_iterations = 1;
   // Added: geometric consistency (Schoenberger et al. 2016 sec. 4.2; Xu & Tao 2019): after the
   // photometric sweeps of all views, this many further sweeps per view add to every source view's
   // cost geometric_weight * min(forward-backward reprojection error in px, geometric_max_error_px)
@@ -91,7 +99,8 @@ struct PatchMatchReport {
 
 // Memory per pixel of every view while RunPatchMatchMvs runs: depth, normal (3) and cost floats,
 // the float grey copy, and the fusion's two byte flags (agreeing count, used); the per-thread
-// scratch and the sparse points' visibility table are small beside it.
+// scratch, the sparse points' visibility table and the half-resolution copies of coarse to fine
+// (1.25 bytes per pixel and one coarse map, before the fusion flags exist) are small beside it.
 inline constexpr size_t kPatchMatchBytesPerPixel = 5 * sizeof(float) + sizeof(float) + 2;
 
 // Depth maps for every view of `views` (at least 2), sources among the others, then fused points.

@@ -128,6 +128,35 @@ class PatchMatchViewSolver {
     });
   }
 
+  // Every pixel starts from the plane of the nearest pixel of `coarse_map` (the same camera at
+  // half resolution: x_coarse = (x + 0.5) / 2 - 0.5), intersected with its own ray; a random
+  // plane where that has none or it leaves the depth range.
+  void InitialiseFromCoarse(const DepthMap& coarse_map, const DenseView& coarse_view) {
+    map_.Reset(view_.width(), view_.height());
+    ForRows([&](int y, Scratch* s) {
+      const int cy = std::clamp(static_cast<int>(std::lround((y + 0.5) / 2.0 - 0.5)), 0, coarse_map.height - 1);
+      for (int x = 0; x < map_.width; ++x) {
+        const size_t i = map_.Index(x, y);
+        const int cx = std::clamp(static_cast<int>(std::lround((x + 0.5) / 2.0 - 0.5)), 0, coarse_map.width - 1);
+        const size_t c = coarse_map.Index(cx, cy);
+        const Eigen::Vector3f ray = Ray(x, y);
+        Eigen::Vector3f normal(coarse_map.normal[3 * c], coarse_map.normal[3 * c + 1], coarse_map.normal[3 * c + 2]);
+        float depth = -1.0f;
+        if (coarse_map.cost[c] < kNoDepthCost && normal.dot(ray) < 0.0f) {
+          const Eigen::Vector3f coarse_ray(static_cast<float>((cx - coarse_view.cx) / coarse_view.fx),
+                                           static_cast<float>((cy - coarse_view.cy) / coarse_view.fy), 1.0f);
+          depth = coarse_map.depth[c] * normal.dot(coarse_ray) / normal.dot(ray);
+        }
+        if (!(depth >= input_.depth_min && depth <= input_.depth_max)) {
+          PixelRandom random(input_.seed, i, kInitialisationSweep);
+          depth = RandomDepth(&random);
+          normal = RandomNormal(&random, ray);
+        }
+        Store(i, depth, normal, ReferenceWindow(x, y, s) ? Cost(x, y, depth, normal, false, s) : kNoDepthCost);
+      }
+    });
+  }
+
   // Recomputes every pixel's cost for its current plane.
   void Rescore(bool geometric) {
     ForRows([&](int y, Scratch* s) {
@@ -433,11 +462,19 @@ void RunPhotometricPatchMatch(const PatchMatchViewInput& input, const PatchMatch
   for (int sweep = 0; sweep < options.iterations; ++sweep) solver.Sweep(sweep, false);
 }
 
+void RunPatchMatchFromCoarse(const PatchMatchViewInput& input, const DepthMap& coarse_map, const DenseView& coarse_view,
+                             const PatchMatchOptions& options, ThreadPool* pool, DepthMap* map) {
+  PatchMatchViewSolver solver(input, options, pool, map);
+  solver.InitialiseFromCoarse(coarse_map, coarse_view);
+  for (int k = 0; k < options.fine_iterations; ++k) solver.Sweep(options.iterations + k, false);
+}
+
 void RunGeometricPatchMatch(const PatchMatchViewInput& input, const PatchMatchOptions& options, ThreadPool* pool,
                             DepthMap* map) {
   PatchMatchViewSolver solver(input, options, pool, map);
   solver.Rescore(true);
-  for (int k = 0; k < options.geometric_iterations; ++k) solver.Sweep(options.iterations + k, true);
+  const int first = options.iterations + (options.coarse_to_fine ? options.fine_iterations : 0);
+  for (int k = 0; k < options.geometric_iterations; ++k) solver.Sweep(first + k, true);
   solver.Rescore(false);
 }
 

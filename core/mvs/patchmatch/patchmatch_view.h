@@ -35,6 +35,11 @@ struct PatchMatchViewInput {
 void RunPhotometricPatchMatch(const PatchMatchViewInput& input, const PatchMatchOptions& options, ThreadPool* pool,
                               DepthMap* map);
 
+// Coarse to fine: `coarse_map`, the photometric result on `coarse_view` (the reference at half
+// resolution, same pose), gives every pixel its starting plane; then options.fine_iterations sweeps.
+void RunPatchMatchFromCoarse(const PatchMatchViewInput& input, const DepthMap& coarse_map, const DenseView& coarse_view,
+                             const PatchMatchOptions& options, ThreadPool* pool, DepthMap* map);
+
 // Geometric consistency: from the planes in `map` (a photometric result), options.geometric_iterations
 // sweeps whose cost adds the geometric term against input.source_depths; map->cost is then the
 // photometric cost of the final planes again.

@@ -163,7 +163,7 @@ Evaluation Evaluate(const TexturedBoxScene& scene, const TexturedBoxSceneOptions
 
 // PATCHMATCH_TEST_WIDTH (e.g. 640) renders the scene larger for a timing; PATCHMATCH_TEST_VIEWS
 // takes more of the ring's cameras. The bounds hold at any size: they scale with the footprint.
-void ExpectAccurateAndComplete(int geometric_iterations, bool separate_near_neighbours) {
+void ExpectAccurateAndComplete(PatchMatchOptions options) {
   const char* width = std::getenv("PATCHMATCH_TEST_WIDTH");
   const int w = width ? std::max(64, std::atoi(width)) : 160;
   const TexturedBoxSceneOptions scene_options = SceneOptions(w, w * 3 / 4);
@@ -172,9 +172,6 @@ void ExpectAccurateAndComplete(int geometric_iterations, bool separate_near_neig
   const std::vector<const DenseView*> views =
       FirstViews(scene, num_views ? std::clamp(std::atoi(num_views), 2, 12) : 4);
   const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 300);
-  PatchMatchOptions options;
-  options.geometric_iterations = geometric_iterations;
-  options.separate_near_neighbours = separate_near_neighbours;
   if (const char* t = std::getenv("PATCHMATCH_TEST_THREADS")) options.num_threads = std::atoi(t);
   PatchMatchReport report;
   const auto start = std::chrono::steady_clock::now();
@@ -192,14 +189,16 @@ void ExpectAccurateAndComplete(int geometric_iterations, bool separate_near_neig
   const Evaluation e = Evaluate(scene, scene_options, views, options, points);
   const double bound_scale = e.footprint / e.sin_angle;  // depth error per pixel of matching error
   std::printf(
-      "geometric sweeps %d: %zu views, %zu depth pixels, %zu consistent, %zu points; %.2f s (selection %.3f, "
+      "coarse to fine %d, geometric sweeps %d: %zu views, %zu depth pixels, %zu consistent, %zu points; %.2f s "
+      "(selection %.3f, "
       "propagation %.2f, consistency %.3f, fusion %.3f)\nfootprint %.4f, sin(angle) %.3f, footprint / sin %.4f; "
       "distance median %.4f (%.3f px), 90%% %.4f (%.3f px); normal error median %.2f deg; completeness %.3f of "
       "%zu cells\n",
-      geometric_iterations, report.views, report.depth_pixels, report.consistent_pixels, report.fused_points, seconds,
-      report.seconds_selection, report.seconds_propagation, report.seconds_consistency, report.seconds_fusion,
-      e.footprint, e.sin_angle, bound_scale, e.median_distance, e.median_distance / bound_scale, e.distance_90,
-      e.distance_90 / bound_scale, e.median_normal_degrees, e.completeness, e.eligible_cells);
+      options.coarse_to_fine ? 1 : 0, options.geometric_iterations, report.views, report.depth_pixels,
+      report.consistent_pixels, report.fused_points, seconds, report.seconds_selection, report.seconds_propagation,
+      report.seconds_consistency, report.seconds_fusion, e.footprint, e.sin_angle, bound_scale, e.median_distance,
+      e.median_distance / bound_scale, e.distance_90, e.distance_90 / bound_scale, e.median_normal_degrees,
+      e.completeness, e.eligible_cells);
   EXPECT_EQ(report.views, views.size());
   EXPECT_EQ(report.fused_points, points.size());
   size_t pixels = 0;
@@ -221,10 +220,16 @@ void ExpectAccurateAndComplete(int geometric_iterations, bool separate_near_neig
   EXPECT_GT(e.completeness, 0.9);
 }
 
-TEST(PatchMatchMvsTest, TexturedBoxIsAccurateAndComplete) { ExpectAccurateAndComplete(0, false); }
+TEST(PatchMatchMvsTest, TexturedBoxIsAccurateAndComplete) { ExpectAccurateAndComplete(PatchMatchOptions()); }
 
-// The other propagation pattern (8 planes) with the geometric sweeps.
-TEST(PatchMatchMvsTest, GeometricConsistencyKeepsAccuracyAndCompleteness) { ExpectAccurateAndComplete(1, true); }
+// The other paths: one resolution, the 8-plane propagation, geometric sweeps.
+TEST(PatchMatchMvsTest, GeometricConsistencyKeepsAccuracyAndCompleteness) {
+  PatchMatchOptions options;
+  options.coarse_to_fine = false;
+  options.separate_near_neighbours = true;
+  options.geometric_iterations = 1;
+  ExpectAccurateAndComplete(options);
+}
 
 // On the ring of 12 cameras 30 degrees apart, the angle at the target between cameras k steps
 // apart is 25.6, 50.8, 74.7 degrees for k = 1, 2, 3: with the default [3, 60] degrees every view
