@@ -266,7 +266,7 @@ TEST(PatchMatchMvsTest, SelectsNeighbouringSourcesAndDepthRange) {
 }
 
 TEST(PatchMatchMvsTest, SameResultForAnyThreadCount) {
-  const TexturedBoxScene scene(SceneOptions(80, 60));
+  const TexturedBoxScene scene(SceneOptions(120, 90));
   const std::vector<const DenseView*> views = FirstViews(scene, 3);
   const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 200);
   PatchMatchOptions options;
