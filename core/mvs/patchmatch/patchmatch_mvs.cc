@@ -1,9 +1,11 @@
 #include "core/mvs/patchmatch/patchmatch_mvs.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "core/base/elapsed.h"
 #include "core/base/progress.h"
@@ -20,7 +22,8 @@ namespace {
 
 constexpr int kMaxWindowRadius = 16;
 constexpr int kMaxSourceViews = 32;
-constexpr int kMinCoarseSide = 16;  // coarse to fine only when every half-resolution view is this large
+constexpr int kMinCoarseSide = 16;  // the smallest side of a coarse level
+constexpr int kMaxCoarseLevels = 4;
 
 Status CheckViews(const std::vector<const DenseView*>& views) {
   if (views.size() < 2) {
@@ -88,6 +91,9 @@ Status PatchMatchOptions::Check() const {
     return InvalidArgument(prefix + "cost_top_k must lie in [1, max_source_views]");
   }
   if (iterations < 1) return InvalidArgument(prefix + "iterations must be positive");
+  if (coarse_levels < 0 || coarse_levels > kMaxCoarseLevels) {
+    return InvalidArgument(prefix + "coarse_levels must lie in [0, " + std::to_string(kMaxCoarseLevels) + "]");
+  }
   if (fine_iterations < 0) return InvalidArgument(prefix + "fine_iterations must be >= 0");
   if (geometric_iterations < 0) return InvalidArgument(prefix + "geometric_iterations must be >= 0");
   if (!(geometric_weight >= 0.0) || !(geometric_max_error_px > 0.0)) {
@@ -154,41 +160,52 @@ Result<OrientedPoints> RunPatchMatchMvs(const std::vector<const DenseView*>& vie
   const int passes = options.geometric_iterations > 0 ? 2 : 1;
   std::unique_ptr<Progress> progress;
   if (options.show_progress) progress = std::make_unique<Progress>(options.progress_label, views_with_maps * passes);
-  bool coarse_to_fine = options.coarse_to_fine;
-  for (const DenseView* v : views)
-    coarse_to_fine &= v->width() >= kMinCoarseSide * 2 && v->height() >= kMinCoarseSide * 2;
-  if (coarse_to_fine) {
-    // The views at half resolution, their maps, then each full-resolution map from its coarse one.
-    std::vector<DenseView> coarse_views(num_views);
-    std::vector<Image<float>> coarse_greys(num_views);
+  // Coarse to fine: levels 1..levels of the views (each half the one before), as many as keep
+  // every view at least kMinCoarseSide pixels on each side.
+  int levels = options.coarse_levels;
+  for (const DenseView* v : views) {
+    while (levels > 0 && std::min(v->width(), v->height()) >> levels < kMinCoarseSide) --levels;
+  }
+  std::vector<std::vector<DenseView>> pyramid(static_cast<size_t>(levels) + 1);
+  std::vector<std::vector<Image<float>>> pyramid_greys(static_cast<size_t>(levels) + 1);
+  for (size_t l = 1; l <= static_cast<size_t>(levels); ++l) {
+    pyramid[l].resize(num_views);
+    pyramid_greys[l].resize(num_views);
     pool.ParallelFor(0, num_views, [&](size_t v, int) {
-      coarse_views[v] = HalfResolution(*views[v]);
-      coarse_greys[v] = Image<float>(coarse_views[v].width(), coarse_views[v].height(), 1);
-      Gray8ToFloat(coarse_views[v].gray.view(), coarse_greys[v].view());
+      pyramid[l][v] = HalfResolution(l == 1 ? *views[v] : pyramid[l - 1][v]);
+      pyramid_greys[l][v] = Image<float>(pyramid[l][v].width(), pyramid[l][v].height(), 1);
+      Gray8ToFloat(pyramid[l][v].gray.view(), pyramid_greys[l][v].view());
     });
-    DepthMap coarse_map;  // one view's at a time
-    for (size_t v = 0; v < num_views; ++v) {
-      if (!setups[v].valid) continue;
+  }
+  for (size_t v = 0; v < num_views; ++v) {
+    if (!setups[v].valid) continue;
+    DepthMap coarse_map, finer_map;  // one view's, at two adjacent levels
+    for (size_t l = static_cast<size_t>(levels); l >= 1; --l) {
       PatchMatchViewInput in = inputs[v];
-      in.reference = &coarse_views[v];
-      in.reference_grey = &coarse_greys[v];
+      in.reference = &pyramid[l][v];
+      in.reference_grey = &pyramid_greys[l][v];
       for (size_t k = 0; k < in.sources.size(); ++k) {
         const size_t s = static_cast<size_t>(setups[v].sources[k]);
-        in.sources[k] = &coarse_views[s];
-        in.source_greys[k] = &coarse_greys[s];
+        in.sources[k] = &pyramid[l][s];
+        in.source_greys[k] = &pyramid_greys[l][s];
         in.source_depths[k] = nullptr;
       }
-      RunPhotometricPatchMatch(in, options, &pool, &coarse_map);
-      RunPatchMatchFromCoarse(inputs[v], coarse_map, coarse_views[v], options, &pool, &maps[v]);
-      if (progress) progress->Advance();
+      if (l == static_cast<size_t>(levels)) {
+        RunPhotometricPatchMatch(in, options, &pool, &coarse_map);
+      } else {
+        RunPatchMatchFromCoarse(in, coarse_map, pyramid[l + 1][v], options, &pool, &finer_map);
+        std::swap(coarse_map, finer_map);
+      }
     }
-  } else {
-    for (size_t v = 0; v < num_views; ++v) {
-      if (!setups[v].valid) continue;
+    if (levels > 0) {
+      RunPatchMatchFromCoarse(inputs[v], coarse_map, pyramid[1][v], options, &pool, &maps[v]);
+    } else {
       RunPhotometricPatchMatch(inputs[v], options, &pool, &maps[v]);
-      if (progress) progress->Advance();
     }
+    if (progress) progress->Advance();
   }
+  pyramid.clear();
+  pyramid_greys.clear();
   if (options.geometric_iterations > 0) {
     for (size_t v = 0; v < num_views; ++v) {
       if (!setups[v].valid) continue;

@@ -473,7 +473,7 @@ void RunGeometricPatchMatch(const PatchMatchViewInput& input, const PatchMatchOp
                             DepthMap* map) {
   PatchMatchViewSolver solver(input, options, pool, map);
   solver.Rescore(true);
-  const int first = options.iterations + (options.coarse_to_fine ? options.fine_iterations : 0);
+  const int first = options.iterations + (options.coarse_levels > 0 ? options.fine_iterations : 0);
   for (int k = 0; k < options.geometric_iterations; ++k) solver.Sweep(first + k, true);
   solver.Rescore(false);
 }

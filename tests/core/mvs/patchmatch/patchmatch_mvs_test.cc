@@ -173,6 +173,7 @@ void ExpectAccurateAndComplete(PatchMatchOptions options) {
       FirstViews(scene, num_views ? std::clamp(std::atoi(num_views), 2, 12) : 4);
   const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 300);
   if (const char* t = std::getenv("PATCHMATCH_TEST_THREADS")) options.num_threads = std::atoi(t);
+  if (const char* c = std::getenv("PATCHMATCH_TEST_LEVELS")) options.coarse_levels = std::atoi(c);
   PatchMatchReport report;
   const auto start = std::chrono::steady_clock::now();
   Result<OrientedPoints> result = RunPatchMatchMvs(views, sparse, options, &report);
@@ -189,16 +190,15 @@ void ExpectAccurateAndComplete(PatchMatchOptions options) {
   const Evaluation e = Evaluate(scene, scene_options, views, options, points);
   const double bound_scale = e.footprint / e.sin_angle;  // depth error per pixel of matching error
   std::printf(
-      "coarse to fine %d, geometric sweeps %d: %zu views, %zu depth pixels, %zu consistent, %zu points; %.2f s "
+      "coarse levels %d, geometric sweeps %d: %zu views, %zu depth pixels, %zu consistent, %zu points; %.2f s "
       "(selection %.3f, "
       "propagation %.2f, consistency %.3f, fusion %.3f)\nfootprint %.4f, sin(angle) %.3f, footprint / sin %.4f; "
       "distance median %.4f (%.3f px), 90%% %.4f (%.3f px); normal error median %.2f deg; completeness %.3f of "
       "%zu cells\n",
-      options.coarse_to_fine ? 1 : 0, options.geometric_iterations, report.views, report.depth_pixels,
-      report.consistent_pixels, report.fused_points, seconds, report.seconds_selection, report.seconds_propagation,
-      report.seconds_consistency, report.seconds_fusion, e.footprint, e.sin_angle, bound_scale, e.median_distance,
-      e.median_distance / bound_scale, e.distance_90, e.distance_90 / bound_scale, e.median_normal_degrees,
-      e.completeness, e.eligible_cells);
+      options.coarse_levels, options.geometric_iterations, report.views, report.depth_pixels, report.consistent_pixels,
+      report.fused_points, seconds, report.seconds_selection, report.seconds_propagation, report.seconds_consistency,
+      report.seconds_fusion, e.footprint, e.sin_angle, bound_scale, e.median_distance, e.median_distance / bound_scale,
+      e.distance_90, e.distance_90 / bound_scale, e.median_normal_degrees, e.completeness, e.eligible_cells);
   EXPECT_EQ(report.views, views.size());
   EXPECT_EQ(report.fused_points, points.size());
   size_t pixels = 0;
@@ -225,7 +225,7 @@ TEST(PatchMatchMvsTest, TexturedBoxIsAccurateAndComplete) { ExpectAccurateAndCom
 // The other paths: one resolution, the 8-plane propagation, geometric sweeps.
 TEST(PatchMatchMvsTest, GeometricConsistencyKeepsAccuracyAndCompleteness) {
   PatchMatchOptions options;
-  options.coarse_to_fine = false;
+  options.coarse_levels = 0;
   options.separate_near_neighbours = true;
   options.geometric_iterations = 1;
   ExpectAccurateAndComplete(options);
@@ -308,6 +308,8 @@ TEST(PatchMatchMvsTest, RejectsBadOptionsAndViews) {
   expect_bad_option([](PatchMatchOptions* o) { o->min_triangulation_angle_deg = 70.0; });
   expect_bad_option([](PatchMatchOptions* o) { o->depth_margin = std::nan(""); });
   expect_bad_option([](PatchMatchOptions* o) { o->geometric_iterations = -1; });
+  expect_bad_option([](PatchMatchOptions* o) { o->coarse_levels = 5; });
+  expect_bad_option([](PatchMatchOptions* o) { o->fine_iterations = -1; });
 
   const PatchMatchOptions options;
   std::vector<const DenseView*> with_null = views;
