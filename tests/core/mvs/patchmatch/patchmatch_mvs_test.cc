@@ -327,6 +327,29 @@ TEST(PatchMatchMvsTest, RejectsBadOptionsAndViews) {
   EXPECT_EQ(RunPatchMatchMvs(views, {}, options).status().code(), StatusCode::kFailedPrecondition);
 }
 
+// Non-finite sparse points and a degenerate (zero) rotation: a status or points, never a crash
+// or an out-of-bounds read (run under the sanitizers too).
+TEST(PatchMatchMvsTest, HostileInputIsHandled) {
+  const TexturedBoxScene scene(SceneOptions(64, 48));
+  std::vector<DenseView> views;
+  for (const DenseView* v : FirstViews(scene, 3)) views.push_back(*v);
+  views[2].cam_from_world.rotation.setZero();
+  std::vector<const DenseView*> pointers;
+  for (const DenseView& v : views) pointers.push_back(&v);
+  std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, pointers, 100);
+  sparse.push_back(Eigen::Vector3d(std::nan(""), 0.0, 1.0));
+  sparse.push_back(Eigen::Vector3d(std::numeric_limits<double>::infinity(), 0.0, 1.0));
+  sparse.push_back(views[0].Center());  // at a camera centre: depth 0
+  PatchMatchOptions options;
+  options.geometric_iterations = 1;
+  Result<OrientedPoints> result = RunPatchMatchMvs(pointers, sparse, options);
+  if (result.ok()) {
+    for (size_t i = 0; i < result.value().size(); ++i) ASSERT_TRUE(result.value().positions[i].allFinite());
+  } else {
+    EXPECT_EQ(result.status().code(), StatusCode::kFailedPrecondition) << result.status().ToString();
+  }
+}
+
 TEST(PatchMatchMvsTest, TexturelessViewsFailCleanly) {
   const TexturedBoxScene scene(SceneOptions(80, 60));
   std::vector<DenseView> views;
