@@ -128,8 +128,9 @@ OrientedPoints FuseDepthMaps(const std::vector<const DenseView*>& views, const s
   for (int v = 0; v < num_views; ++v) {
     const DepthMap& m = maps[static_cast<size_t>(v)];
     const DenseView& view = *views[static_cast<size_t>(v)];
-    for (int y = 0; y < m.height; ++y) {
-      for (int x = 0; x < m.width; ++x) {
+    const int step = options.fusion_pixel_step;
+    for (int y = 0; y < m.height; y += step) {
+      for (int x = 0; x < m.width; x += step) {
         const size_t i = m.Index(x, y);
         if (used[static_cast<size_t>(v)][i] || agreeing[static_cast<size_t>(v)][i] < options.fusion_min_views) continue;
         Eigen::Vector3d point, normal, source_point, source_normal;

@@ -102,6 +102,9 @@ Status PatchMatchOptions::Check() const {
   if (fusion_min_views < 1 || fusion_min_views > max_source_views) {
     return InvalidArgument(prefix + "fusion_min_views must lie in [1, max_source_views]");
   }
+  if (fusion_pixel_step < 1 || fusion_pixel_step > 16) {
+    return InvalidArgument(prefix + "fusion_pixel_step must lie in [1, 16]");
+  }
   if (!(fusion_max_reprojection_px > 0.0) || !(fusion_max_relative_depth > 0.0) ||
       !(fusion_max_normal_deg > 0.0 && fusion_max_normal_deg <= 180.0)) {
     return InvalidArgument(prefix + "fusion tolerances must be positive (normal angle at most 180 degrees)");

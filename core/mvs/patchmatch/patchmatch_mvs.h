@@ -75,6 +75,9 @@ struct PatchMatchOptions {
   // fusion_max_relative_depth, normals within fusion_max_normal_deg) and its cost is below
   // max_cost.
   int fusion_min_views = 2;
+  // Added: only pixels on a grid of this step start a point (2: at most one per 2 x 2 block, the
+  // density of PMVS's cell_size 2), for a lighter point cloud; agreeing pixels anywhere still join.
+  int fusion_pixel_step = 1;
   double fusion_max_reprojection_px = 2.0;
   double fusion_max_relative_depth = 0.01;
   double fusion_max_normal_deg = 10.0;

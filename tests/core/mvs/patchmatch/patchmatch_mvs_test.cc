@@ -284,6 +284,13 @@ TEST(PatchMatchMvsTest, SameResultForAnyThreadCount) {
     ASSERT_EQ(one.value().normals[i], three.value().normals[i]) << i;
     ASSERT_EQ(one.value().scores[i], three.value().scores[i]) << i;
   }
+  // A fusion grid of step 2 lets a quarter of the pixels start points: fewer points, yet more than
+  // an eighth of the step-1 count (a start is lost only when an earlier point used its pixel).
+  options.fusion_pixel_step = 2;
+  Result<OrientedPoints> sparse_grid = RunPatchMatchMvs(views, sparse, options);
+  ASSERT_TRUE(sparse_grid.ok()) << sparse_grid.status().ToString();
+  EXPECT_LT(sparse_grid.value().size(), one.value().size());
+  EXPECT_GT(sparse_grid.value().size(), one.value().size() / 8);
 }
 
 TEST(PatchMatchMvsTest, RejectsBadOptionsAndViews) {
@@ -309,6 +316,7 @@ TEST(PatchMatchMvsTest, RejectsBadOptionsAndViews) {
   expect_bad_option([](PatchMatchOptions* o) { o->depth_margin = std::nan(""); });
   expect_bad_option([](PatchMatchOptions* o) { o->geometric_iterations = -1; });
   expect_bad_option([](PatchMatchOptions* o) { o->coarse_levels = 5; });
+  expect_bad_option([](PatchMatchOptions* o) { o->fusion_pixel_step = 0; });
   expect_bad_option([](PatchMatchOptions* o) { o->fine_iterations = -1; });
 
   const PatchMatchOptions options;
