@@ -34,7 +34,7 @@ class DepthMapChecker {
     const Eigen::Vector3d cam(z * (x - view.cx) / view.fx, z * (y - view.cy) / view.fy, z);
     const Eigen::Matrix3d& r = view.cam_from_world.rotation;
     *point = r.transpose() * (cam - view.cam_from_world.translation);
-    *normal = r.transpose() * Eigen::Vector3d(m.normal[3 * i], m.normal[3 * i + 1], m.normal[3 * i + 2]);
+    *normal = r.transpose() * m.Normal(i).cast<double>();
   }
 
   // Whether source view s agrees with (point, normal) seen at pixel (x, y) of view v; on success

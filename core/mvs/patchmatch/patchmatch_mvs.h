@@ -101,11 +101,12 @@ struct PatchMatchReport {
   size_t map_bytes = 0;  // held by the depth maps, grey copies and fusion flags of all views
 };
 
-// Memory per pixel of every view while RunPatchMatchMvs runs: depth, normal (3) and cost floats,
-// the float grey copy, and the fusion's two byte flags (agreeing count, used); the per-thread
-// scratch, the sparse points' visibility table and the half-resolution copies of coarse to fine
-// (1.25 bytes per pixel and one coarse map, before the fusion flags exist) are small beside it.
-inline constexpr size_t kPatchMatchBytesPerPixel = 5 * sizeof(float) + sizeof(float) + 2;
+// Memory per pixel of every view while RunPatchMatchMvs runs: depth and cost floats, the normal
+// (three 16-bit values, core/mvs/patchmatch/depth_map.h), the float grey copy, and the fusion's
+// two byte flags (agreeing count, used); the per-thread scratch, the sparse points' visibility
+// table and the half-resolution copies of coarse to fine (1.67 bytes per pixel and one coarse
+// map, before the fusion flags exist) are small beside it.
+inline constexpr size_t kPatchMatchBytesPerPixel = 2 * sizeof(float) + 3 * sizeof(int16_t) + sizeof(float) + 2;
 
 // Depth maps for every view of `views` (at least 2), sources among the others, then fused points.
 // `sparse_points` (world) give each view its depth range and its source views: a view whose

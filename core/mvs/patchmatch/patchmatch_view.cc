@@ -140,7 +140,7 @@ class PatchMatchViewSolver {
         const int cx = std::clamp(static_cast<int>(std::lround((x + 0.5) / 2.0 - 0.5)), 0, coarse_map.width - 1);
         const size_t c = coarse_map.Index(cx, cy);
         const Eigen::Vector3f ray = Ray(x, y);
-        Eigen::Vector3f normal(coarse_map.normal[3 * c], coarse_map.normal[3 * c + 1], coarse_map.normal[3 * c + 2]);
+        Eigen::Vector3f normal = coarse_map.Normal(c);
         float depth = -1.0f;
         if (coarse_map.cost[c] < kNoDepthCost && normal.dot(ray) < 0.0f) {
           const Eigen::Vector3f coarse_ray(static_cast<float>((cx - coarse_view.cx) / coarse_view.fx),
@@ -162,7 +162,8 @@ class PatchMatchViewSolver {
     ForRows([&](int y, Scratch* s) {
       for (int x = 0; x < map_.width; ++x) {
         const size_t i = map_.Index(x, y);
-        map_.cost[i] = ReferenceWindow(x, y, s) ? Cost(x, y, map_.depth[i], Normal(i), geometric, s) : kNoDepthCost;
+        map_.cost[i] =
+            ReferenceWindow(x, y, s) ? Cost(x, y, map_.depth[i], map_.Normal(i), geometric, s) : kNoDepthCost;
       }
     });
   }
@@ -187,14 +188,9 @@ class PatchMatchViewSolver {
     return Eigen::Vector3f(static_cast<float>((x - view_.cx) * inv_fx_), static_cast<float>((y - view_.cy) * inv_fy_),
                            1.0f);
   }
-  Eigen::Vector3f Normal(size_t i) const {
-    return Eigen::Vector3f(map_.normal[3 * i], map_.normal[3 * i + 1], map_.normal[3 * i + 2]);
-  }
   void Store(size_t i, float depth, const Eigen::Vector3f& normal, float cost) {
     map_.depth[i] = depth;
-    map_.normal[3 * i] = normal.x();
-    map_.normal[3 * i + 1] = normal.y();
-    map_.normal[3 * i + 2] = normal.z();
+    map_.SetNormal(i, normal);
     map_.cost[i] = cost;
   }
 
@@ -371,7 +367,7 @@ class PatchMatchViewSolver {
   // The depth at the ray `ray` of the plane stored at pixel q; <= 0 when the ray misses its front.
   float PropagatedDepth(int qx, int qy, const Eigen::Vector3f& ray) const {
     const size_t q = map_.Index(qx, qy);
-    const Eigen::Vector3f n = Normal(q);
+    const Eigen::Vector3f n = map_.Normal(q);
     const float denominator = n.dot(ray);
     if (!(denominator < 0.0f)) return -1.0f;
     return map_.depth[q] * n.dot(Ray(qx, qy)) / denominator;
@@ -385,7 +381,7 @@ class PatchMatchViewSolver {
     }
     const Eigen::Vector3f ray = Ray(x, y);
     float best_depth = map_.depth[i], best_cost = map_.cost[i];
-    Eigen::Vector3f best_normal = Normal(i);
+    Eigen::Vector3f best_normal = map_.Normal(i);
     const float depth_min = static_cast<float>(input_.depth_min), depth_max = static_cast<float>(input_.depth_max);
     auto consider = [&](float depth, const Eigen::Vector3f& normal) {
       if (!(depth >= depth_min && depth <= depth_max)) return;
@@ -404,7 +400,7 @@ class PatchMatchViewSolver {
       if (options_.separate_near_neighbours) {
         const int nx = x + d[0], ny = y + d[1];
         if (nx >= 0 && ny >= 0 && nx < map_.width && ny < map_.height && map_.cost[map_.Index(nx, ny)] < kNoDepthCost) {
-          consider(PropagatedDepth(nx, ny, ray), Normal(map_.Index(nx, ny)));
+          consider(PropagatedDepth(nx, ny, ray), map_.Normal(map_.Index(nx, ny)));
         }
       }
       int far_x = -1, far_y = -1;
@@ -419,7 +415,7 @@ class PatchMatchViewSolver {
           far_y = fy;
         }
       }
-      if (far_x >= 0) consider(PropagatedDepth(far_x, far_y, ray), Normal(map_.Index(far_x, far_y)));
+      if (far_x >= 0) consider(PropagatedDepth(far_x, far_y, ray), map_.Normal(map_.Index(far_x, far_y)));
     }
     // Refinement around the best plane so far: random and perturbed depth and normal.
     PixelRandom random(input_.seed, i, sweep);
