@@ -11,6 +11,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/base/elapsed.h"
 #include "core/base/prng.h"
 #include "core/base/thread_pool.h"
 #include "core/mvs/patchmatch/view_selection.h"
@@ -177,12 +178,11 @@ void ExpectAccurateAndComplete(PatchMatchOptions options) {
   PatchMatchReport report;
   const auto start = std::chrono::steady_clock::now();
   Result<OrientedPoints> result = RunPatchMatchMvs(views, sparse, options, &report);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = SecondsSince(start);
   ASSERT_TRUE(result.ok()) << result.status().ToString();
   const OrientedPoints& points = result.value();
-  ASSERT_EQ(points.normals.size(), points.size());
-  ASSERT_EQ(points.colors.size(), points.size());
-  ASSERT_EQ(points.scores.size(), points.size());
+  const size_t n = points.size();
+  ASSERT_TRUE(points.normals.size() == n && points.colors.size() == n && points.scores.size() == n);
   for (size_t i = 0; i < points.size(); ++i) {
     ASSERT_NEAR(points.normals[i].norm(), 1.0f, 1e-4f);
     ASSERT_GE(points.scores[i], static_cast<float>(1.0 - options.max_cost) - 1e-6f);
