@@ -34,7 +34,7 @@ class DepthMapChecker {
     const Eigen::Vector3d cam(z * (x - view.cx) / view.fx, z * (y - view.cy) / view.fy, z);
     const Eigen::Matrix3d& r = view.cam_from_world.rotation;
     *point = r.transpose() * (cam - view.cam_from_world.translation);
-    *normal = r.transpose() * Eigen::Vector3d(m.normal[3 * i], m.normal[3 * i + 1], m.normal[3 * i + 2]);
+    *normal = r.transpose() * m.Normal(i).cast<double>();
   }
 
   // Whether source view s agrees with (point, normal) seen at pixel (x, y) of view v; on success
@@ -128,8 +128,9 @@ OrientedPoints FuseDepthMaps(const std::vector<const DenseView*>& views, const s
   for (int v = 0; v < num_views; ++v) {
     const DepthMap& m = maps[static_cast<size_t>(v)];
     const DenseView& view = *views[static_cast<size_t>(v)];
-    for (int y = 0; y < m.height; ++y) {
-      for (int x = 0; x < m.width; ++x) {
+    const int step = options.fusion_pixel_step;
+    for (int y = 0; y < m.height; y += step) {
+      for (int x = 0; x < m.width; x += step) {
         const size_t i = m.Index(x, y);
         if (used[static_cast<size_t>(v)][i] || agreeing[static_cast<size_t>(v)][i] < options.fusion_min_views) continue;
         Eigen::Vector3d point, normal, source_point, source_normal;

@@ -5,6 +5,7 @@
 // depth matches (relative difference), its own point reprojects close to the pixel and the
 // normals agree. A pixel with at least fusion_min_views agreeing sources becomes one point, the
 // mean of its own and the agreeing sources' points and normals; those source pixels are used up.
+// Only every fusion_pixel_step-th pixel of every fusion_pixel_step-th row starts a point.
 #include <cstddef>
 #include <vector>
 

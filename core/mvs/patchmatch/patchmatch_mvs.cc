@@ -1,9 +1,11 @@
 #include "core/mvs/patchmatch/patchmatch_mvs.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "core/base/elapsed.h"
 #include "core/base/progress.h"
@@ -13,12 +15,15 @@
 #include "core/mvs/patchmatch/depth_map.h"
 #include "core/mvs/patchmatch/patchmatch_view.h"
 #include "core/mvs/patchmatch/view_selection.h"
+#include "core/mvs/undistort.h"
 
 namespace reconar {
 namespace {
 
 constexpr int kMaxWindowRadius = 16;
 constexpr int kMaxSourceViews = 32;
+constexpr int kMinCoarseSide = 16;  // the smallest side of a coarse level
+constexpr int kMaxCoarseLevels = 4;
 
 Status CheckViews(const std::vector<const DenseView*>& views) {
   if (views.size() < 2) {
@@ -39,6 +44,22 @@ Status CheckViews(const std::vector<const DenseView*>& views) {
     }
   }
   return Status::Ok();
+}
+
+// The view at half resolution (core/mvs/undistort.h's level convention: 2 x 2 area average,
+// f / 2, c -> (c + 0.5) / 2 - 0.5), grey only.
+DenseView HalfResolution(const DenseView& full) {
+  DenseView half;
+  half.name = full.name;
+  half.image_id = full.image_id;
+  half.level = full.level + 1;
+  half.gray = AreaAverageDown(full.gray, 1);
+  half.fx = 0.5 * full.fx;
+  half.fy = 0.5 * full.fy;
+  half.cx = 0.5 * (full.cx + 0.5) - 0.5;
+  half.cy = 0.5 * (full.cy + 0.5) - 0.5;
+  half.cam_from_world = full.cam_from_world;
+  return half;
 }
 
 }  // namespace
@@ -70,12 +91,19 @@ Status PatchMatchOptions::Check() const {
     return InvalidArgument(prefix + "cost_top_k must lie in [1, max_source_views]");
   }
   if (iterations < 1) return InvalidArgument(prefix + "iterations must be positive");
+  if (coarse_levels < 0 || coarse_levels > kMaxCoarseLevels) {
+    return InvalidArgument(prefix + "coarse_levels must lie in [0, " + std::to_string(kMaxCoarseLevels) + "]");
+  }
+  if (fine_iterations < 0) return InvalidArgument(prefix + "fine_iterations must be >= 0");
   if (geometric_iterations < 0) return InvalidArgument(prefix + "geometric_iterations must be >= 0");
   if (!(geometric_weight >= 0.0) || !(geometric_max_error_px > 0.0)) {
     return InvalidArgument(prefix + "geometric_weight must be >= 0 and geometric_max_error_px positive");
   }
   if (fusion_min_views < 1 || fusion_min_views > max_source_views) {
     return InvalidArgument(prefix + "fusion_min_views must lie in [1, max_source_views]");
+  }
+  if (fusion_pixel_step < 1 || fusion_pixel_step > 16) {
+    return InvalidArgument(prefix + "fusion_pixel_step must lie in [1, 16]");
   }
   if (!(fusion_max_reprojection_px > 0.0) || !(fusion_max_relative_depth > 0.0) ||
       !(fusion_max_normal_deg > 0.0 && fusion_max_normal_deg <= 180.0)) {
@@ -135,11 +163,52 @@ Result<OrientedPoints> RunPatchMatchMvs(const std::vector<const DenseView*>& vie
   const int passes = options.geometric_iterations > 0 ? 2 : 1;
   std::unique_ptr<Progress> progress;
   if (options.show_progress) progress = std::make_unique<Progress>(options.progress_label, views_with_maps * passes);
+  // Coarse to fine: levels 1..levels of the views (each half the one before), as many as keep
+  // every view at least kMinCoarseSide pixels on each side.
+  int levels = options.coarse_levels;
+  for (const DenseView* v : views) {
+    while (levels > 0 && std::min(v->width(), v->height()) >> levels < kMinCoarseSide) --levels;
+  }
+  std::vector<std::vector<DenseView>> pyramid(static_cast<size_t>(levels) + 1);
+  std::vector<std::vector<Image<float>>> pyramid_greys(static_cast<size_t>(levels) + 1);
+  for (size_t l = 1; l <= static_cast<size_t>(levels); ++l) {
+    pyramid[l].resize(num_views);
+    pyramid_greys[l].resize(num_views);
+    pool.ParallelFor(0, num_views, [&](size_t v, int) {
+      pyramid[l][v] = HalfResolution(l == 1 ? *views[v] : pyramid[l - 1][v]);
+      pyramid_greys[l][v] = Image<float>(pyramid[l][v].width(), pyramid[l][v].height(), 1);
+      Gray8ToFloat(pyramid[l][v].gray.view(), pyramid_greys[l][v].view());
+    });
+  }
   for (size_t v = 0; v < num_views; ++v) {
     if (!setups[v].valid) continue;
-    RunPhotometricPatchMatch(inputs[v], options, &pool, &maps[v]);
+    DepthMap coarse_map, finer_map;  // one view's, at two adjacent levels
+    for (size_t l = static_cast<size_t>(levels); l >= 1; --l) {
+      PatchMatchViewInput in = inputs[v];
+      in.reference = &pyramid[l][v];
+      in.reference_grey = &pyramid_greys[l][v];
+      for (size_t k = 0; k < in.sources.size(); ++k) {
+        const size_t s = static_cast<size_t>(setups[v].sources[k]);
+        in.sources[k] = &pyramid[l][s];
+        in.source_greys[k] = &pyramid_greys[l][s];
+        in.source_depths[k] = nullptr;
+      }
+      if (l == static_cast<size_t>(levels)) {
+        RunPhotometricPatchMatch(in, options, &pool, &coarse_map);
+      } else {
+        RunPatchMatchFromCoarse(in, coarse_map, pyramid[l + 1][v], options, &pool, &finer_map);
+        std::swap(coarse_map, finer_map);
+      }
+    }
+    if (levels > 0) {
+      RunPatchMatchFromCoarse(inputs[v], coarse_map, pyramid[1][v], options, &pool, &maps[v]);
+    } else {
+      RunPhotometricPatchMatch(inputs[v], options, &pool, &maps[v]);
+    }
     if (progress) progress->Advance();
   }
+  pyramid.clear();
+  pyramid_greys.clear();
   if (options.geometric_iterations > 0) {
     for (size_t v = 0; v < num_views; ++v) {
       if (!setups[v].valid) continue;
@@ -158,6 +227,9 @@ Result<OrientedPoints> RunPatchMatchMvs(const std::vector<const DenseView*>& vie
   r.seconds_consistency = stats.seconds_consistency;
   r.seconds_fusion = stats.seconds_fusion;
   r.fused_points = points.size();
+  for (size_t v = 0; v < num_views; ++v) {
+    r.map_bytes += maps[v].SizeBytes() + greys[v].size_bytes() + 2 * maps[v].depth.size();
+  }
   if (points.size() == 0) {
     return FailedPrecondition(
         "PatchMatch MVS: no point fused (" + std::to_string(views_with_maps) + " depth maps, " +

@@ -48,6 +48,20 @@ struct PatchMatchOptions {
   double sigma_color = 12.0;
   int cost_top_k = 2;
   int iterations = 4;  // red-black sweeps (each sweep: both colours)
+  // Added: propagation tests, in each of the four directions, the plane of the cheapest pixel
+  // among those 1, 3, ..., 11 pixels away (4 planes); with separate_near_neighbours the adjacent
+  // pixel's plane and the cheapest farther one (8 planes, as ACMH). On the test's box scene the
+  // 4 planes took 28 % less time for the same completeness and 4 % fewer consistent pixels.
+  bool separate_near_neighbours = false;
+  // Added: coarse to fine (after Xu & Tao 2019): the `iterations` sweeps run on the views at
+  // 1 / 2^coarse_levels resolution (fewer levels where a view would fall below 16 pixels), whose
+  // planes then start fine_iterations sweeps at each finer level: most sweeps see a fraction of
+  // the pixels, and texture-poor areas are matched at the coarser scale. On the test's box scene
+  // at 640 x 480 (4 views, 2 threads) levels 1, 2, 3 took 4.60, 3.42, 3.19 s with 522k, 534k, 509k
+  // consistent pixels and the same accuracy and completeness; at 320 x 240 one resolution took
+  // 3.11 s (1 thread) against 1.65 s with one level and 1.28 s with two.
+  int coarse_levels = 2;
+  int fine_iterations = 1;
   // Added: geometric consistency (Schoenberger et al. 2016 sec. 4.2; Xu & Tao 2019): after the
   // photometric sweeps of all views, this many further sweeps per view add to every source view's
   // cost geometric_weight * min(forward-backward reprojection error in px, geometric_max_error_px)
@@ -61,6 +75,9 @@ struct PatchMatchOptions {
   // fusion_max_relative_depth, normals within fusion_max_normal_deg) and its cost is below
   // max_cost.
   int fusion_min_views = 2;
+  // Added: only pixels on a grid of this step start a point (2: at most one per 2 x 2 block, the
+  // density of PMVS's cell_size 2), for a lighter point cloud; agreeing pixels anywhere still join.
+  int fusion_pixel_step = 1;
   double fusion_max_reprojection_px = 2.0;
   double fusion_max_relative_depth = 0.01;
   double fusion_max_normal_deg = 10.0;
@@ -81,7 +98,15 @@ struct PatchMatchReport {
   double seconds_propagation = 0.0;  // initialisation, propagation and cost
   double seconds_consistency = 0.0;  // checks between depth maps
   double seconds_fusion = 0.0;
+  size_t map_bytes = 0;  // held by the depth maps, grey copies and fusion flags of all views
 };
+
+// Memory per pixel of every view while RunPatchMatchMvs runs: depth and cost floats, the normal
+// (three 16-bit values, core/mvs/patchmatch/depth_map.h), the float grey copy, and the fusion's
+// two byte flags (agreeing count, used); the per-thread scratch, the sparse points' visibility
+// table and the half-resolution copies of coarse to fine (1.67 bytes per pixel and one coarse
+// map, before the fusion flags exist) are small beside it.
+inline constexpr size_t kPatchMatchBytesPerPixel = 2 * sizeof(float) + 3 * sizeof(int16_t) + sizeof(float) + 2;
 
 // Depth maps for every view of `views` (at least 2), sources among the others, then fused points.
 // `sparse_points` (world) give each view its depth range and its source views: a view whose

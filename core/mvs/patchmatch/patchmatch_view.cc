@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "core/base/prng.h"
 #include "core/base/thread_pool.h"
+#include "core/mvs/patchmatch/warp_sums.h"
 
 namespace reconar {
 namespace {
@@ -18,34 +20,26 @@ constexpr float kDepthPerturbation = 0.1f;     // relative depth range of a pert
 constexpr float kNormalPerturbation = 0.5f;    // ... and of a normal's (added vector); both halve each sweep
 constexpr int kInitialisationSweep = 1 << 20;  // the random stream of the initial planes
 
-uint64_t Mix(uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ull;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
-// SplitMix64: a per-pixel stream, so the result does not depend on the thread count.
+// A per-pixel SplitMix64 stream keyed by (view seed, pixel, sweep), so the result does not depend
+// on the thread count.
 class PixelRandom {
  public:
   PixelRandom(uint64_t seed, size_t pixel, int sweep)
-      : state_(Mix(seed ^ Mix(static_cast<uint64_t>(pixel) * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(sweep)))) {}
-  float Uniform() {  // [0, 1)
-    state_ += 0x9E3779B97F4A7C15ull;
-    return static_cast<float>(Mix(state_) >> 40) * 0x1.0p-24f;
-  }
+      : generator_(
+            SplitMix64(seed ^ (static_cast<uint64_t>(pixel) * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(sweep)))
+                .Next()) {}
+  float Uniform() { return static_cast<float>(generator_.Next() >> 40) * 0x1.0p-24f; }  // [0, 1)
 
  private:
-  uint64_t state_;
+  SplitMix64 generator_;
 };
 
 struct SourceGeometry {
   const Image<float>* grey = nullptr;
   const DepthMap* depth = nullptr;  // may be null or empty
   // Plane-induced homography H = A + b m^T / (n . X) (see PatchMatchViewSolver::Cost).
-  Eigen::Matrix3d a;
-  Eigen::Vector3d b;
+  Eigen::Matrix3f a;
+  Eigen::Vector3f b;
   Eigen::Matrix3d source_from_reference_rotation;
   Eigen::Vector3d source_from_reference_translation;
   Eigen::Matrix3d reference_from_source_rotation;
@@ -57,11 +51,14 @@ struct SourceGeometry {
 struct Scratch {
   std::vector<float> reference;  // centred grey values of the active window samples
   std::vector<float> weights;    // their bilateral weights
-  std::vector<int> active;       // their offset indices (samples inside the reference image)
-  std::vector<float> costs;      // one per source
+  std::vector<float> offset_x;   // their offsets (the samples inside the reference image)
+  std::vector<float> offset_y;
+  std::vector<float> costs;  // one per source
   int count = 0;
+  int padded_count = 0;  // count rounded up to kWarpLanes (the padding has weight 0)
   float weight_sum = 0.0f;
   float variance = 0.0f;
+  float min_x = 0.0f, max_x = 0.0f, min_y = 0.0f, max_y = 0.0f;  // bounding box of the offsets
 };
 
 class PatchMatchViewSolver {
@@ -98,8 +95,8 @@ class PatchMatchViewSolver {
       g.reference_from_source_translation = -(g.reference_from_source_rotation * g.source_from_reference_translation);
       Eigen::Matrix3d k_s;
       k_s << s.fx, 0.0, s.cx, 0.0, s.fy, s.cy, 0.0, 0.0, 1.0;
-      g.a = k_s * g.source_from_reference_rotation * k_inv_r;
-      g.b = k_s * g.source_from_reference_translation;
+      g.a = (k_s * g.source_from_reference_rotation * k_inv_r).cast<float>();
+      g.b = (k_s * g.source_from_reference_translation).cast<float>();
       g.fx = s.fx;
       g.fy = s.fy;
       g.cx = s.cx;
@@ -109,9 +106,11 @@ class PatchMatchViewSolver {
     top_k_ = std::min<int>(options.cost_top_k, static_cast<int>(sources_.size()));
     scratch_.resize(static_cast<size_t>(pool->num_threads()));
     for (Scratch& s : scratch_) {
-      s.reference.resize(offset_x_.size());
-      s.weights.resize(offset_x_.size());
-      s.active.resize(offset_x_.size());
+      const size_t padded = static_cast<size_t>(PaddedWarpCount(static_cast<int>(offset_x_.size())));
+      s.reference.resize(padded);
+      s.weights.resize(padded);
+      s.offset_x.resize(padded);
+      s.offset_y.resize(padded);
       s.costs.resize(sources_.size());
     }
   }
@@ -129,12 +128,42 @@ class PatchMatchViewSolver {
     });
   }
 
+  // Every pixel starts from the plane of the nearest pixel of `coarse_map` (the same camera at
+  // half resolution: x_coarse = (x + 0.5) / 2 - 0.5), intersected with its own ray; a random
+  // plane where that has none or it leaves the depth range.
+  void InitialiseFromCoarse(const DepthMap& coarse_map, const DenseView& coarse_view) {
+    map_.Reset(view_.width(), view_.height());
+    ForRows([&](int y, Scratch* s) {
+      const int cy = std::clamp(static_cast<int>(std::lround((y + 0.5) / 2.0 - 0.5)), 0, coarse_map.height - 1);
+      for (int x = 0; x < map_.width; ++x) {
+        const size_t i = map_.Index(x, y);
+        const int cx = std::clamp(static_cast<int>(std::lround((x + 0.5) / 2.0 - 0.5)), 0, coarse_map.width - 1);
+        const size_t c = coarse_map.Index(cx, cy);
+        const Eigen::Vector3f ray = Ray(x, y);
+        Eigen::Vector3f normal = coarse_map.Normal(c);
+        float depth = -1.0f;
+        if (coarse_map.cost[c] < kNoDepthCost && normal.dot(ray) < 0.0f) {
+          const Eigen::Vector3f coarse_ray(static_cast<float>((cx - coarse_view.cx) / coarse_view.fx),
+                                           static_cast<float>((cy - coarse_view.cy) / coarse_view.fy), 1.0f);
+          depth = coarse_map.depth[c] * normal.dot(coarse_ray) / normal.dot(ray);
+        }
+        if (!(depth >= input_.depth_min && depth <= input_.depth_max)) {
+          PixelRandom random(input_.seed, i, kInitialisationSweep);
+          depth = RandomDepth(&random);
+          normal = RandomNormal(&random, ray);
+        }
+        Store(i, depth, normal, ReferenceWindow(x, y, s) ? Cost(x, y, depth, normal, false, s) : kNoDepthCost);
+      }
+    });
+  }
+
   // Recomputes every pixel's cost for its current plane.
   void Rescore(bool geometric) {
     ForRows([&](int y, Scratch* s) {
       for (int x = 0; x < map_.width; ++x) {
         const size_t i = map_.Index(x, y);
-        map_.cost[i] = ReferenceWindow(x, y, s) ? Cost(x, y, map_.depth[i], Normal(i), geometric, s) : kNoDepthCost;
+        map_.cost[i] =
+            ReferenceWindow(x, y, s) ? Cost(x, y, map_.depth[i], map_.Normal(i), geometric, s) : kNoDepthCost;
       }
     });
   }
@@ -159,14 +188,9 @@ class PatchMatchViewSolver {
     return Eigen::Vector3f(static_cast<float>((x - view_.cx) * inv_fx_), static_cast<float>((y - view_.cy) * inv_fy_),
                            1.0f);
   }
-  Eigen::Vector3f Normal(size_t i) const {
-    return Eigen::Vector3f(map_.normal[3 * i], map_.normal[3 * i + 1], map_.normal[3 * i + 2]);
-  }
   void Store(size_t i, float depth, const Eigen::Vector3f& normal, float cost) {
     map_.depth[i] = depth;
-    map_.normal[3 * i] = normal.x();
-    map_.normal[3 * i + 1] = normal.y();
-    map_.normal[3 * i + 2] = normal.z();
+    map_.SetNormal(i, normal);
     map_.cost[i] = cost;
   }
 
@@ -207,14 +231,25 @@ class PatchMatchViewSolver {
     const int w = grey.width(), h = grey.height();
     s->count = 0;
     float weight_sum = 0.0f, sum = 0.0f, sum_squares = 0.0f;
+    int min_x = 0, max_x = 0, min_y = 0, max_y = 0;
     for (size_t o = 0; o < offset_x_.size(); ++o) {
       const int px = x + offset_x_[o], py = y + offset_y_[o];
       if (px < 0 || py < 0 || px >= w || py >= h) continue;
       const float value = grey.row(py)[px];
       const float weight = spatial_[o] * color_[std::abs(view_.gray.row(py)[px] - centre)];
-      s->active[static_cast<size_t>(s->count)] = static_cast<int>(o);
-      s->reference[static_cast<size_t>(s->count)] = value;
-      s->weights[static_cast<size_t>(s->count)] = weight;
+      const size_t j = static_cast<size_t>(s->count);
+      if (j == 0) {
+        min_x = max_x = offset_x_[o];
+        min_y = max_y = offset_y_[o];
+      }
+      min_x = std::min(min_x, offset_x_[o]);
+      max_x = std::max(max_x, offset_x_[o]);
+      min_y = std::min(min_y, offset_y_[o]);
+      max_y = std::max(max_y, offset_y_[o]);
+      s->offset_x[j] = static_cast<float>(offset_x_[o]);
+      s->offset_y[j] = static_cast<float>(offset_y_[o]);
+      s->reference[j] = value;
+      s->weights[j] = weight;
       ++s->count;
       weight_sum += weight;
       sum += weight * value;
@@ -224,45 +259,54 @@ class PatchMatchViewSolver {
     const float mean = sum / weight_sum;
     s->variance = sum_squares / weight_sum - mean * mean;
     s->weight_sum = weight_sum;
+    s->min_x = static_cast<float>(min_x);
+    s->max_x = static_cast<float>(max_x);
+    s->min_y = static_cast<float>(min_y);
+    s->max_y = static_cast<float>(max_y);
     if (!(s->variance >= kMinTextureVariance)) return false;
     for (int j = 0; j < s->count; ++j) s->reference[static_cast<size_t>(j)] -= mean;
+    // Padding for the kernels: weight 0 at the first sample's offset (inside the checked box).
+    s->padded_count = PaddedWarpCount(s->count);
+    for (size_t j = static_cast<size_t>(s->count); j < static_cast<size_t>(s->padded_count); ++j) {
+      s->offset_x[j] = s->offset_x[0];
+      s->offset_y[j] = s->offset_y[0];
+      s->reference[j] = 0.0f;
+      s->weights[j] = 0.0f;
+    }
     return true;
   }
 
   // 1 - weighted NCC of the reference window (in `s`) and its warp by `h` into the source;
-  // kNoDepthCost when a sample falls outside the source image or behind its camera, or the warped
-  // window is textureless.
-  float WindowCost(const SourceGeometry& g, const Eigen::Matrix3d& hd, int x, int y, const Scratch& s) const {
-    const Eigen::Matrix3f h = hd.cast<float>();
+  // kNoDepthCost when the window reaches outside the source image or behind its camera, or the
+  // warped window is textureless. The check is made on the corners of the offsets' bounding box:
+  // h's third row is affine in the offset, so positive at the corners means positive inside, and
+  // then h maps the box to the convex quadrilateral of the corners' images, which holds every
+  // sample. The corners keep kBorderMargin pixels from the last column and row, more than the
+  // float rounding of any sample, so the bilinear reads stay inside the image.
+  float WindowCost(const SourceGeometry& g, const Eigen::Matrix3f& h, int x, int y, const Scratch& s) const {
+    constexpr float kBorderMargin = 0.01f;
     const float fx = static_cast<float>(x), fy = static_cast<float>(y);
     const float h0x = h(0, 0) * fx + h(0, 1) * fy + h(0, 2);
     const float h0y = h(1, 0) * fx + h(1, 1) * fy + h(1, 2);
     const float h0z = h(2, 0) * fx + h(2, 1) * fy + h(2, 2);
     const Image<float>& grey = *g.grey;
     const int width = grey.width();
-    const float max_u = static_cast<float>(width - 1), max_v = static_cast<float>(grey.height() - 1);
-    const float* pixels = grey.data();
-    float sum = 0.0f, sum_squares = 0.0f, sum_products = 0.0f;
-    for (int j = 0; j < s.count; ++j) {
-      const int o = s.active[static_cast<size_t>(j)];
-      const float ox = static_cast<float>(offset_x_[static_cast<size_t>(o)]);
-      const float oy = static_cast<float>(offset_y_[static_cast<size_t>(o)]);
+    const float max_u = static_cast<float>(width - 1) - kBorderMargin;
+    const float max_v = static_cast<float>(grey.height() - 1) - kBorderMargin;
+    for (int corner = 0; corner < 4; ++corner) {
+      const float ox = (corner & 1) ? s.max_x : s.min_x, oy = (corner & 2) ? s.max_y : s.min_y;
       const float hz = h0z + h(2, 0) * ox + h(2, 1) * oy;
-      if (!(hz > 0.0f)) return kNoDepthCost;
-      const float u = (h0x + h(0, 0) * ox + h(0, 1) * oy) / hz;
-      const float v = (h0y + h(1, 0) * ox + h(1, 1) * oy) / hz;
-      if (!(u >= 0.0f && v >= 0.0f && u < max_u && v < max_v)) return kNoDepthCost;
-      const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
-      const float au = u - static_cast<float>(u0), av = v - static_cast<float>(v0);
-      const float* p = pixels + static_cast<size_t>(v0) * static_cast<size_t>(width) + u0;
-      const float top = p[0] + au * (p[1] - p[0]);
-      const float bottom = p[width] + au * (p[width + 1] - p[width]);
-      const float value = top + av * (bottom - top);
-      const float w = s.weights[static_cast<size_t>(j)];
-      sum += w * value;
-      sum_squares += w * value * value;
-      sum_products += w * s.reference[static_cast<size_t>(j)] * value;
+      if (!(hz > 1e-6f)) return kNoDepthCost;
+      // u = hx / hz in [margin, max_u] without dividing (hz > 0); likewise v.
+      const float hx = h0x + h(0, 0) * ox + h(0, 1) * oy, hy = h0y + h(1, 0) * ox + h(1, 1) * oy;
+      if (!(hx >= kBorderMargin * hz && hy >= kBorderMargin * hz && hx <= max_u * hz && hy <= max_v * hz)) {
+        return kNoDepthCost;
+      }
     }
+    const WarpHomography warp{h0x, h0y, h0z, h(0, 0), h(1, 0), h(2, 0), h(0, 1), h(1, 1), h(2, 1)};
+    const WarpWindow window{s.offset_x.data(), s.offset_y.data(), s.weights.data(), s.reference.data(), s.padded_count};
+    const WarpSums sums = warp_sums_(warp, window, grey.data(), width);
+    const float sum = sums.sum, sum_squares = sums.sum_squares, sum_products = sums.sum_products;
     const float mean = sum / s.weight_sum;
     const float variance = sum_squares / s.weight_sum - mean * mean;
     if (!(variance >= kMinTextureVariance)) return kNoDepthCost;
@@ -305,11 +349,11 @@ class PatchMatchViewSolver {
     if (!(plane < 0.0)) return kNoDepthCost;
     const Eigen::Vector3d m(n.x() * inv_fx_, n.y() * inv_fy_,
                             n.z() - n.x() * view_.cx * inv_fx_ - n.y() * view_.cy * inv_fy_);
-    const Eigen::Vector3d m_scaled = m / plane;
+    const Eigen::Vector3f m_scaled = (m / plane).cast<float>();
     const Eigen::Vector3d point = depth * ray;
     for (size_t k = 0; k < sources_.size(); ++k) {
       const SourceGeometry& g = sources_[k];
-      const Eigen::Matrix3d h = g.a + g.b * m_scaled.transpose();
+      const Eigen::Matrix3f h = g.a + g.b * m_scaled.transpose();
       float cost = WindowCost(g, h, x, y, *s);
       if (geometric) cost += static_cast<float>(options_.geometric_weight) * GeometricError(g, point, x, y);
       s->costs[k] = cost;
@@ -323,7 +367,7 @@ class PatchMatchViewSolver {
   // The depth at the ray `ray` of the plane stored at pixel q; <= 0 when the ray misses its front.
   float PropagatedDepth(int qx, int qy, const Eigen::Vector3f& ray) const {
     const size_t q = map_.Index(qx, qy);
-    const Eigen::Vector3f n = Normal(q);
+    const Eigen::Vector3f n = map_.Normal(q);
     const float denominator = n.dot(ray);
     if (!(denominator < 0.0f)) return -1.0f;
     return map_.depth[q] * n.dot(Ray(qx, qy)) / denominator;
@@ -337,7 +381,7 @@ class PatchMatchViewSolver {
     }
     const Eigen::Vector3f ray = Ray(x, y);
     float best_depth = map_.depth[i], best_cost = map_.cost[i];
-    Eigen::Vector3f best_normal = Normal(i);
+    Eigen::Vector3f best_normal = map_.Normal(i);
     const float depth_min = static_cast<float>(input_.depth_min), depth_max = static_cast<float>(input_.depth_max);
     auto consider = [&](float depth, const Eigen::Vector3f& normal) {
       if (!(depth >= depth_min && depth <= depth_max)) return;
@@ -349,14 +393,19 @@ class PatchMatchViewSolver {
       }
     };
     static constexpr int kDirections[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+    // In each direction the cheapest of the pixels at odd distances (the other colour), the
+    // adjacent one among them or, with options.separate_near_neighbours, tested on its own too.
+    const int first_far = options_.separate_near_neighbours ? 3 : 1;
     for (const auto& d : kDirections) {
-      const int nx = x + d[0], ny = y + d[1];
-      if (nx < 0 || ny < 0 || nx >= map_.width || ny >= map_.height) continue;
-      if (map_.cost[map_.Index(nx, ny)] < kNoDepthCost)
-        consider(PropagatedDepth(nx, ny, ray), Normal(map_.Index(nx, ny)));
+      if (options_.separate_near_neighbours) {
+        const int nx = x + d[0], ny = y + d[1];
+        if (nx >= 0 && ny >= 0 && nx < map_.width && ny < map_.height && map_.cost[map_.Index(nx, ny)] < kNoDepthCost) {
+          consider(PropagatedDepth(nx, ny, ray), map_.Normal(map_.Index(nx, ny)));
+        }
+      }
       int far_x = -1, far_y = -1;
       float far_cost = kNoDepthCost;
-      for (int k = 3; k <= 2 * kFarSteps + 1; k += 2) {
+      for (int k = first_far; k <= 2 * kFarSteps + 1; k += 2) {
         const int fx = x + k * d[0], fy = y + k * d[1];
         if (fx < 0 || fy < 0 || fx >= map_.width || fy >= map_.height) break;
         const float c = map_.cost[map_.Index(fx, fy)];
@@ -366,7 +415,7 @@ class PatchMatchViewSolver {
           far_y = fy;
         }
       }
-      if (far_x >= 0) consider(PropagatedDepth(far_x, far_y, ray), Normal(map_.Index(far_x, far_y)));
+      if (far_x >= 0) consider(PropagatedDepth(far_x, far_y, ray), map_.Normal(map_.Index(far_x, far_y)));
     }
     // Refinement around the best plane so far: random and perturbed depth and normal.
     PixelRandom random(input_.seed, i, sweep);
@@ -397,6 +446,7 @@ class PatchMatchViewSolver {
   std::vector<SourceGeometry> sources_;
   int top_k_ = 1;
   std::vector<Scratch> scratch_;
+  WarpSumsFn warp_sums_ = ActiveWarpSumsKernel().sums;
 };
 
 }  // namespace
@@ -408,11 +458,19 @@ void RunPhotometricPatchMatch(const PatchMatchViewInput& input, const PatchMatch
   for (int sweep = 0; sweep < options.iterations; ++sweep) solver.Sweep(sweep, false);
 }
 
+void RunPatchMatchFromCoarse(const PatchMatchViewInput& input, const DepthMap& coarse_map, const DenseView& coarse_view,
+                             const PatchMatchOptions& options, ThreadPool* pool, DepthMap* map) {
+  PatchMatchViewSolver solver(input, options, pool, map);
+  solver.InitialiseFromCoarse(coarse_map, coarse_view);
+  for (int k = 0; k < options.fine_iterations; ++k) solver.Sweep(options.iterations + k, false);
+}
+
 void RunGeometricPatchMatch(const PatchMatchViewInput& input, const PatchMatchOptions& options, ThreadPool* pool,
                             DepthMap* map) {
   PatchMatchViewSolver solver(input, options, pool, map);
   solver.Rescore(true);
-  for (int k = 0; k < options.geometric_iterations; ++k) solver.Sweep(options.iterations + k, true);
+  const int first = options.iterations + (options.coarse_levels > 0 ? options.fine_iterations : 0);
+  for (int k = 0; k < options.geometric_iterations; ++k) solver.Sweep(first + k, true);
   solver.Rescore(false);
 }
 

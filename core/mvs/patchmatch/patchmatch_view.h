@@ -1,8 +1,8 @@
 #pragma once
 // PatchMatch on one reference view (Bleyer et al. 2011; Xu & Tao 2019, ACMH): random planes,
 // then sweeps that visit the pixels of one checkerboard colour in parallel (all of them depend
-// only on pixels of the other colour), each testing the planes of 8 neighbours (the adjacent
-// pixel and the cheapest of the pixels 3, 5, ... 11 away, in each of the four directions) and a
+// only on pixels of the other colour), each testing the planes of neighbours (in each of the four
+// directions the cheapest of the pixels 1, 3, ... 11 away; see separate_near_neighbours) and a
 // few random and perturbed planes of shrinking range. The cost of a plane is
 // 1 - NCC between a bilaterally weighted window of the reference and its homography warp into a
 // source view, averaged over the best cost_top_k sources; the geometric term of Schoenberger et
@@ -34,6 +34,11 @@ struct PatchMatchViewInput {
 // options.iterations sweeps.
 void RunPhotometricPatchMatch(const PatchMatchViewInput& input, const PatchMatchOptions& options, ThreadPool* pool,
                               DepthMap* map);
+
+// Coarse to fine: `coarse_map`, the photometric result on `coarse_view` (the reference at half
+// resolution, same pose), gives every pixel its starting plane; then options.fine_iterations sweeps.
+void RunPatchMatchFromCoarse(const PatchMatchViewInput& input, const DepthMap& coarse_map, const DenseView& coarse_view,
+                             const PatchMatchOptions& options, ThreadPool* pool, DepthMap* map);
 
 // Geometric consistency: from the planes in `map` (a photometric result), options.geometric_iterations
 // sweeps whose cost adds the geometric term against input.source_depths; map->cost is then the

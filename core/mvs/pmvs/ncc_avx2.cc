@@ -2,19 +2,10 @@
 // called once the CPU reports AVX2 and FMA (ncc.cc). One 8-lane block per step.
 #include <immintrin.h>
 
+#include "core/base/horizontal_sum_avx2.h"
 #include "core/mvs/pmvs/ncc_kernels.h"
 
 namespace reconar::internal {
-namespace {
-
-inline float HorizontalSum(__m256 v) {
-  __m128 s = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-  s = _mm_add_ps(s, _mm_movehl_ps(s, s));
-  s = _mm_add_ss(s, _mm_shuffle_ps(s, s, 1));
-  return _mm_cvtss_f32(s);
-}
-
-}  // namespace
 
 NccSums NccSumsAvx2(const float* normalized_reference, const float* samples, int padded_count) {
   __m256 sum = _mm256_setzero_ps(), sum_squares = _mm256_setzero_ps(), sum_products = _mm256_setzero_ps();
@@ -26,9 +17,9 @@ NccSums NccSumsAvx2(const float* normalized_reference, const float* samples, int
     sum_products = _mm256_fmadd_ps(r, b, sum_products);
   }
   NccSums s;
-  s.sum = HorizontalSum(sum);
-  s.sum_squares = HorizontalSum(sum_squares);
-  s.sum_products = HorizontalSum(sum_products);
+  s.sum = HorizontalSumAvx2(sum);
+  s.sum_squares = HorizontalSumAvx2(sum_squares);
+  s.sum_products = HorizontalSumAvx2(sum_products);
   return s;
 }
 

@@ -11,6 +11,10 @@
 #include <limits>
 #include <vector>
 
+#include "core/base/elapsed.h"
+#include "core/base/prng.h"
+#include "core/base/thread_pool.h"
+#include "core/mvs/patchmatch/view_selection.h"
 #include "tests/core/mvs/pmvs/textured_box_scene.h"
 
 namespace reconar {
@@ -49,11 +53,8 @@ Eigen::Vector3d PixelRay(const DenseView& view, double u, double v) {
 std::vector<Eigen::Vector3d> SparsePoints(const TexturedBoxScene& scene, const std::vector<const DenseView*>& views,
                                           int count) {
   std::vector<Eigen::Vector3d> points;
-  uint64_t state = 12345;
-  auto uniform = [&]() {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(state >> 11) * 0x1.0p-53;
-  };
+  SplitMix64 random(12345);
+  auto uniform = [&]() { return random.Uniform01(); };
   while (static_cast<int>(points.size()) < count) {
     const DenseView& view = *views[static_cast<size_t>(uniform() * views.size()) % views.size()];
     const SceneHit hit =
@@ -161,23 +162,27 @@ Evaluation Evaluate(const TexturedBoxScene& scene, const TexturedBoxSceneOptions
   return e;
 }
 
-void ExpectAccurateAndComplete(int geometric_iterations) {
-  const TexturedBoxSceneOptions scene_options = SceneOptions(160, 120);
+// PATCHMATCH_TEST_WIDTH (e.g. 640) renders the scene larger for a timing; PATCHMATCH_TEST_VIEWS
+// takes more of the ring's cameras. The bounds hold at any size: they scale with the footprint.
+void ExpectAccurateAndComplete(PatchMatchOptions options) {
+  const char* width = std::getenv("PATCHMATCH_TEST_WIDTH");
+  const int w = width ? std::max(64, std::atoi(width)) : 160;
+  const TexturedBoxSceneOptions scene_options = SceneOptions(w, w * 3 / 4);
   const TexturedBoxScene scene(scene_options);
-  const std::vector<const DenseView*> views = FirstViews(scene, 4);
+  const char* num_views = std::getenv("PATCHMATCH_TEST_VIEWS");
+  const std::vector<const DenseView*> views =
+      FirstViews(scene, num_views ? std::clamp(std::atoi(num_views), 2, 12) : 4);
   const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 300);
-  PatchMatchOptions options;
-  options.geometric_iterations = geometric_iterations;
   if (const char* t = std::getenv("PATCHMATCH_TEST_THREADS")) options.num_threads = std::atoi(t);
+  if (const char* c = std::getenv("PATCHMATCH_TEST_LEVELS")) options.coarse_levels = std::atoi(c);
   PatchMatchReport report;
   const auto start = std::chrono::steady_clock::now();
   Result<OrientedPoints> result = RunPatchMatchMvs(views, sparse, options, &report);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = SecondsSince(start);
   ASSERT_TRUE(result.ok()) << result.status().ToString();
   const OrientedPoints& points = result.value();
-  ASSERT_EQ(points.normals.size(), points.size());
-  ASSERT_EQ(points.colors.size(), points.size());
-  ASSERT_EQ(points.scores.size(), points.size());
+  const size_t n = points.size();
+  ASSERT_TRUE(points.normals.size() == n && points.colors.size() == n && points.scores.size() == n);
   for (size_t i = 0; i < points.size(); ++i) {
     ASSERT_NEAR(points.normals[i].norm(), 1.0f, 1e-4f);
     ASSERT_GE(points.scores[i], static_cast<float>(1.0 - options.max_cost) - 1e-6f);
@@ -185,16 +190,20 @@ void ExpectAccurateAndComplete(int geometric_iterations) {
   const Evaluation e = Evaluate(scene, scene_options, views, options, points);
   const double bound_scale = e.footprint / e.sin_angle;  // depth error per pixel of matching error
   std::printf(
-      "geometric sweeps %d: %zu views, %zu depth pixels, %zu consistent, %zu points; %.2f s (selection %.3f, "
+      "coarse levels %d, geometric sweeps %d: %zu views, %zu depth pixels, %zu consistent, %zu points; %.2f s "
+      "(selection %.3f, "
       "propagation %.2f, consistency %.3f, fusion %.3f)\nfootprint %.4f, sin(angle) %.3f, footprint / sin %.4f; "
       "distance median %.4f (%.3f px), 90%% %.4f (%.3f px); normal error median %.2f deg; completeness %.3f of "
       "%zu cells\n",
-      geometric_iterations, report.views, report.depth_pixels, report.consistent_pixels, report.fused_points, seconds,
-      report.seconds_selection, report.seconds_propagation, report.seconds_consistency, report.seconds_fusion,
-      e.footprint, e.sin_angle, bound_scale, e.median_distance, e.median_distance / bound_scale, e.distance_90,
-      e.distance_90 / bound_scale, e.median_normal_degrees, e.completeness, e.eligible_cells);
+      options.coarse_levels, options.geometric_iterations, report.views, report.depth_pixels, report.consistent_pixels,
+      report.fused_points, seconds, report.seconds_selection, report.seconds_propagation, report.seconds_consistency,
+      report.seconds_fusion, e.footprint, e.sin_angle, bound_scale, e.median_distance, e.median_distance / bound_scale,
+      e.distance_90, e.distance_90 / bound_scale, e.median_normal_degrees, e.completeness, e.eligible_cells);
   EXPECT_EQ(report.views, views.size());
   EXPECT_EQ(report.fused_points, points.size());
+  size_t pixels = 0;
+  for (const DenseView* v : views) pixels += static_cast<size_t>(v->width()) * v->height();
+  EXPECT_EQ(report.map_bytes, pixels * kPatchMatchBytesPerPixel);
   // Accuracy from the geometry: moving a point along its reference ray by D moves its image in a
   // source view by about D sin(angle) / footprint pixels, so a matching error of d pixels gives a
   // depth error of d footprint / sin(angle), and the distance to the surface is at most that. On
@@ -211,12 +220,53 @@ void ExpectAccurateAndComplete(int geometric_iterations) {
   EXPECT_GT(e.completeness, 0.9);
 }
 
-TEST(PatchMatchMvsTest, TexturedBoxIsAccurateAndComplete) { ExpectAccurateAndComplete(0); }
+TEST(PatchMatchMvsTest, TexturedBoxIsAccurateAndComplete) { ExpectAccurateAndComplete(PatchMatchOptions()); }
 
-TEST(PatchMatchMvsTest, GeometricConsistencyKeepsAccuracyAndCompleteness) { ExpectAccurateAndComplete(1); }
+// The other paths: one resolution, the 8-plane propagation, geometric sweeps.
+TEST(PatchMatchMvsTest, GeometricConsistencyKeepsAccuracyAndCompleteness) {
+  PatchMatchOptions options;
+  options.coarse_levels = 0;
+  options.separate_near_neighbours = true;
+  options.geometric_iterations = 1;
+  ExpectAccurateAndComplete(options);
+}
+
+// On the ring of 12 cameras 30 degrees apart, the angle at the target between cameras k steps
+// apart is 25.6, 50.8, 74.7 degrees for k = 1, 2, 3: with the default [3, 60] degrees every view
+// takes the two neighbours on each side as sources (their order, by shared points, is not
+// asserted: the sparse points carry no visibility, so the counts of near and far neighbours can
+// tie). The depth range holds the true depth of every sparse point the view sees.
+TEST(PatchMatchMvsTest, SelectsNeighbouringSourcesAndDepthRange) {
+  const TexturedBoxScene scene(SceneOptions(80, 60));
+  const std::vector<const DenseView*> views = scene.view_pointers();
+  const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 600);
+  ThreadPool pool(2);
+  const std::vector<PatchMatchViewSetup> setups = SetUpPatchMatchViews(views, sparse, PatchMatchOptions(), &pool);
+  ASSERT_EQ(setups.size(), views.size());
+  for (int v = 0; v < 12; ++v) {
+    const PatchMatchViewSetup& setup = setups[static_cast<size_t>(v)];
+    ASSERT_TRUE(setup.valid) << v;
+    std::vector<int> sources = setup.sources;
+    ASSERT_EQ(sources.size(), 4u) << v;
+    std::sort(sources.begin(), sources.end());
+    std::vector<int> all = {(v + 1) % 12, (v + 2) % 12, (v + 10) % 12, (v + 11) % 12};
+    std::sort(all.begin(), all.end());
+    EXPECT_EQ(sources, all) << v;
+    for (const Eigen::Vector3d& x : sparse) {
+      const DenseView& view = *views[static_cast<size_t>(v)];
+      const Eigen::Vector2d p = view.Project(x);
+      if (view.Depth(x) <= 0.0 || p.x() < -0.5 || p.y() < -0.5 || p.x() >= view.width() - 0.5 ||
+          p.y() >= view.height() - 0.5 || !scene.Sees(view, x)) {
+        continue;
+      }
+      EXPECT_GE(view.Depth(x), setup.depth_min) << v;
+      EXPECT_LE(view.Depth(x), setup.depth_max) << v;
+    }
+  }
+}
 
 TEST(PatchMatchMvsTest, SameResultForAnyThreadCount) {
-  const TexturedBoxScene scene(SceneOptions(80, 60));
+  const TexturedBoxScene scene(SceneOptions(120, 90));
   const std::vector<const DenseView*> views = FirstViews(scene, 3);
   const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 200);
   PatchMatchOptions options;
@@ -234,6 +284,13 @@ TEST(PatchMatchMvsTest, SameResultForAnyThreadCount) {
     ASSERT_EQ(one.value().normals[i], three.value().normals[i]) << i;
     ASSERT_EQ(one.value().scores[i], three.value().scores[i]) << i;
   }
+  // A fusion grid of step 2 lets a quarter of the pixels start points: fewer points, yet more than
+  // an eighth of the step-1 count (a start is lost only when an earlier point used its pixel).
+  options.fusion_pixel_step = 2;
+  Result<OrientedPoints> sparse_grid = RunPatchMatchMvs(views, sparse, options);
+  ASSERT_TRUE(sparse_grid.ok()) << sparse_grid.status().ToString();
+  EXPECT_LT(sparse_grid.value().size(), one.value().size());
+  EXPECT_GT(sparse_grid.value().size(), one.value().size() / 8);
 }
 
 TEST(PatchMatchMvsTest, RejectsBadOptionsAndViews) {
@@ -258,6 +315,9 @@ TEST(PatchMatchMvsTest, RejectsBadOptionsAndViews) {
   expect_bad_option([](PatchMatchOptions* o) { o->min_triangulation_angle_deg = 70.0; });
   expect_bad_option([](PatchMatchOptions* o) { o->depth_margin = std::nan(""); });
   expect_bad_option([](PatchMatchOptions* o) { o->geometric_iterations = -1; });
+  expect_bad_option([](PatchMatchOptions* o) { o->coarse_levels = 5; });
+  expect_bad_option([](PatchMatchOptions* o) { o->fusion_pixel_step = 0; });
+  expect_bad_option([](PatchMatchOptions* o) { o->fine_iterations = -1; });
 
   const PatchMatchOptions options;
   std::vector<const DenseView*> with_null = views;
@@ -273,6 +333,29 @@ TEST(PatchMatchMvsTest, RejectsBadOptionsAndViews) {
   EXPECT_EQ(RunPatchMatchMvs({views[0], &no_focal}, sparse, options).status().code(), StatusCode::kInvalidArgument);
   // No sparse point: no view has a depth range.
   EXPECT_EQ(RunPatchMatchMvs(views, {}, options).status().code(), StatusCode::kFailedPrecondition);
+}
+
+// Non-finite sparse points and a degenerate (zero) rotation: a status or points, never a crash
+// or an out-of-bounds read (run under the sanitizers too).
+TEST(PatchMatchMvsTest, HostileInputIsHandled) {
+  const TexturedBoxScene scene(SceneOptions(64, 48));
+  std::vector<DenseView> views;
+  for (const DenseView* v : FirstViews(scene, 3)) views.push_back(*v);
+  views[2].cam_from_world.rotation.setZero();
+  std::vector<const DenseView*> pointers;
+  for (const DenseView& v : views) pointers.push_back(&v);
+  std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, pointers, 100);
+  sparse.push_back(Eigen::Vector3d(std::nan(""), 0.0, 1.0));
+  sparse.push_back(Eigen::Vector3d(std::numeric_limits<double>::infinity(), 0.0, 1.0));
+  sparse.push_back(views[0].Center());  // at a camera centre: depth 0
+  PatchMatchOptions options;
+  options.geometric_iterations = 1;
+  Result<OrientedPoints> result = RunPatchMatchMvs(pointers, sparse, options);
+  if (result.ok()) {
+    for (size_t i = 0; i < result.value().size(); ++i) ASSERT_TRUE(result.value().positions[i].allFinite());
+  } else {
+    EXPECT_EQ(result.status().code(), StatusCode::kFailedPrecondition) << result.status().ToString();
+  }
 }
 
 TEST(PatchMatchMvsTest, TexturelessViewsFailCleanly) {
