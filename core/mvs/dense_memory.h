@@ -9,9 +9,7 @@
 //                                   cell, and at most one patch per cell of each image, each
 //                                   patch (about 128 bytes with its image list and cell entries)
 //                                   lying in the cells of at least 3 images (PMVS's gamma)
-//   PatchMatch (kPatchMatchBytesPerPixel)
-//     the grey image as floats (4), the plane (depth 4, normal 12) and cost (4) of every pixel,
-//     and the fusion's per-pixel mark (1)
+//   PatchMatch: kPatchMatchBytesPerPixel (core/mvs/patchmatch/patchmatch_mvs.h)
 // plus, during undistortion, one decoded full-resolution photo (3 bytes per pixel) and its level
 // copy per worker thread. The constants are a model, not a bound: the stage reports the measured
 // peak RSS next to the estimate.
@@ -25,7 +23,6 @@ namespace reconar {
 constexpr double kViewBytesPerPixel = 4.0;
 constexpr double kPmvsBytesPerPixel = 16.0;
 constexpr double kPmvsBytesPerCell = 4.0 + 128.0 / 3.0;
-constexpr double kPatchMatchBytesPerPixel = 4.0 + 16.0 + 4.0 + 1.0;
 
 inline double PmvsWorkBytesPerPixel(int cell_size) {
   const double cell = static_cast<double>(cell_size < 1 ? 1 : cell_size);

@@ -45,6 +45,8 @@ class PhaseTimer {
 void AddReports(const PatchMatchReport& part, PatchMatchReport* sum) {
   sum->views += part.views;
   sum->depth_pixels += part.depth_pixels;
+  sum->consistent_pixels += part.consistent_pixels;
+  sum->map_bytes = std::max(sum->map_bytes, part.map_bytes);
   sum->fused_points += part.fused_points;
   sum->seconds_selection += part.seconds_selection;
   sum->seconds_propagation += part.seconds_propagation;
@@ -197,7 +199,7 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   }
   memory.max_cluster_size = options.clustering.max_cluster_size;
   const bool patchmatch = options.method == DenseMethod::kPatchMatch;
-  memory.work_bytes_per_pixel = patchmatch ? kPatchMatchBytesPerPixel : PmvsWorkBytesPerPixel(options.mvs.cell_size);
+  memory.work_bytes_per_pixel = patchmatch ? static_cast<double>(kPatchMatchBytesPerPixel) : PmvsWorkBytesPerPixel(options.mvs.cell_size);
   memory.num_threads = num_threads;
   memory.baseline_bytes = CurrentMemoryUsage().resident_bytes;
   // The fewest views a cluster needs for the method to make a point.
@@ -369,6 +371,8 @@ std::string DenseReportJson(const DenseStageReport& report) {
   json.Key("patchmatch").BeginObject();
   json.Key("views").Int(static_cast<long long>(report.patchmatch.views));
   json.Key("depth_pixels").Int(static_cast<long long>(report.patchmatch.depth_pixels));
+  json.Key("consistent_pixels").Int(static_cast<long long>(report.patchmatch.consistent_pixels));
+  json.Key("map_mib").Double(static_cast<double>(report.patchmatch.map_bytes) / (1 << 20));
   json.Key("fused_points").Int(static_cast<long long>(report.patchmatch.fused_points));
   json.Key("seconds_selection").Double(report.patchmatch.seconds_selection);
   json.Key("seconds_propagation").Double(report.patchmatch.seconds_propagation);

@@ -70,7 +70,7 @@ struct DenseStageReport {
   DensePhase load, clustering, undistort, mvs, merge, outlier_filter, write;
   bool peak_rss_resettable = false;
   PatchMvsReport pmvs;            // summed over clusters (PMVS)
-  PatchMatchReport patchmatch;    // summed over clusters (PatchMatch)
+  PatchMatchReport patchmatch;    // summed over clusters (PatchMatch; map_bytes: the largest cluster's)
   std::string points_path, report_path;
 };
 

@@ -1,10 +1,9 @@
 #include "core/mvs/patchmatch/view_selection.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <utility>
-
-#include <Eigen/Eigenvalues>
 
 #include "core/base/thread_pool.h"
 
