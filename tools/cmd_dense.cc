@@ -17,8 +17,8 @@ constexpr char kHelp[] =
     "Dense multi-view stereo on a project made by `reconar sfm`: the registered images are grouped\n"
     "into overlapping view clusters (CMVS; redundant images dropped), each cluster's photos are\n"
     "undistorted at the chosen resolution level and PMVS grows oriented patches from them (or\n"
-    "PatchMatch makes a depth map per view and fuses them: --method); the clusters' points are merged. Reads PROJECT_DIR/sparse and PROJECT_DIR/features/images.txt,\n"
-    "writes:\n"
+    "PatchMatch makes a depth map per view and fuses them: --method); the clusters' points are\n"
+    "merged. Reads PROJECT_DIR/sparse and PROJECT_DIR/features/images.txt, writes:\n"
     "  dense/points.ply      binary PLY: position, normal, RGBA colour per point\n"
     "  dense/report.json     level, clusters, counts, seconds and peak memory per phase\n"
     "  --method pmvs|patchmatch  PMVS's patches (default; the paper's method) or a PatchMatch depth\n"
@@ -45,13 +45,15 @@ void PrintSummary(const DenseStageReport& r) {
   if (r.clusters_from_cameras) std::printf("dense: no sparse points; clusters from camera positions\n");
   if (r.method == DenseMethod::kPatchMatch) {
     const PatchMatchReport& m = r.patchmatch;
-    std::printf("dense: %zu points (%zu before merging clusters) by PatchMatch: %zu depth maps, %zu depth pixels, "
-                "%zu fused; %.1fs selection, %.1fs propagation, %.1fs consistency, %.1fs fusion\n",
-                r.points, r.points_before_merge, m.views, m.depth_pixels, m.fused_points, m.seconds_selection,
-                m.seconds_propagation, m.seconds_consistency, m.seconds_fusion);
+    std::printf(
+        "dense: %zu points (%zu before merging clusters) by PatchMatch: %zu depth maps, %zu depth pixels, "
+        "%zu fused; %.1fs selection, %.1fs propagation, %.1fs consistency, %.1fs fusion\n",
+        r.points, r.points_before_merge, m.views, m.depth_pixels, m.fused_points, m.seconds_selection,
+        m.seconds_propagation, m.seconds_consistency, m.seconds_fusion);
   } else {
-    std::printf("dense: %zu points (%zu before merging clusters), %zu PMVS features, %zu initial + %zu expanded patches\n",
-                r.points, r.points_before_merge, r.pmvs.features, r.pmvs.initial_patches, r.pmvs.expanded_patches);
+    std::printf(
+        "dense: %zu points (%zu before merging clusters), %zu PMVS features, %zu initial + %zu expanded patches\n",
+        r.points, r.points_before_merge, r.pmvs.features, r.pmvs.initial_patches, r.pmvs.expanded_patches);
   }
   if (r.outliers.input_points > 0) {
     std::printf("dense: outliers removed: %zu isolated, %zu in %d small pieces (median spacing %.4g)\n",

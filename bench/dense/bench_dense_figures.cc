@@ -9,12 +9,13 @@
 // --keep-outliers runs the dense stage without its outlier filter, then applies the filter here and
 // says how many of the points each of its two tests removes, and keeps, are wrong by the scene's
 // truth: farther than two pixel footprints from bun_zipper's surface, or outside templeRing's box.
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
-#include <unistd.h>
 
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/poisson/point_outliers.h"
@@ -56,10 +57,11 @@ void PrintDense(const DenseStageReport& dense) {
               dense.merge.seconds, dense.outlier_filter.seconds, dense.write.seconds);
   if (dense.method == DenseMethod::kPatchMatch) {
     const PatchMatchReport& m = dense.patchmatch;
-    std::printf("patchmatch: %zu depth maps, %zu depth pixels, %zu fused; s: selection %.1f propagation %.1f "
-                "consistency %.1f fusion %.1f\n",
-                m.views, m.depth_pixels, m.fused_points, m.seconds_selection, m.seconds_propagation,
-                m.seconds_consistency, m.seconds_fusion);
+    std::printf(
+        "patchmatch: %zu depth maps, %zu depth pixels, %zu fused; s: selection %.1f propagation %.1f "
+        "consistency %.1f fusion %.1f\n",
+        m.views, m.depth_pixels, m.fused_points, m.seconds_selection, m.seconds_propagation, m.seconds_consistency,
+        m.seconds_fusion);
   } else {
     std::printf("pmvs: %zu features, %zu initial, %zu expanded, %zu final patches\n", dense.pmvs.features,
                 dense.pmvs.initial_patches, dense.pmvs.expanded_patches, dense.pmvs.final_patches);
@@ -87,10 +89,10 @@ void PrintFilterAgainstTruth(const std::vector<Eigen::Vector3f>& points, const s
   }
   const char* names[3] = {"isolated, removed", "small pieces, removed", "kept"};
   for (int v = 0; v < 3; ++v) {
-    std::printf("FILTER %-22s %8zu points: %8zu right, %8zu wrong (%.3f wrong)\n", names[v],
-                counts[v][0] + counts[v][1], counts[v][0], counts[v][1],
-                counts[v][0] + counts[v][1] == 0 ? 0.0
-                                                 : static_cast<double>(counts[v][1]) / (counts[v][0] + counts[v][1]));
+    std::printf(
+        "FILTER %-22s %8zu points: %8zu right, %8zu wrong (%.3f wrong)\n", names[v], counts[v][0] + counts[v][1],
+        counts[v][0], counts[v][1],
+        counts[v][0] + counts[v][1] == 0 ? 0.0 : static_cast<double>(counts[v][1]) / (counts[v][0] + counts[v][1]));
   }
 }
 

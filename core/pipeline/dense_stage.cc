@@ -138,9 +138,7 @@ void PhaseJson(const char* name, const DensePhase& phase, JsonWriter* json) {
 
 }  // namespace
 
-const char* DenseMethodName(DenseMethod method) {
-  return method == DenseMethod::kPatchMatch ? "patchmatch" : "pmvs";
-}
+const char* DenseMethodName(DenseMethod method) { return method == DenseMethod::kPatchMatch ? "patchmatch" : "pmvs"; }
 
 Result<DenseMethod> ParseDenseMethod(const std::string& name) {
   if (name == "pmvs") return DenseMethod::kPmvs;
@@ -199,7 +197,8 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   }
   memory.max_cluster_size = options.clustering.max_cluster_size;
   const bool patchmatch = options.method == DenseMethod::kPatchMatch;
-  memory.work_bytes_per_pixel = patchmatch ? static_cast<double>(kPatchMatchBytesPerPixel) : PmvsWorkBytesPerPixel(options.mvs.cell_size);
+  memory.work_bytes_per_pixel =
+      patchmatch ? static_cast<double>(kPatchMatchBytesPerPixel) : PmvsWorkBytesPerPixel(options.mvs.cell_size);
   memory.num_threads = num_threads;
   memory.baseline_bytes = CurrentMemoryUsage().resident_bytes;
   // The fewest views a cluster needs for the method to make a point.

@@ -69,8 +69,8 @@ struct DenseStageReport {
   size_t points = 0;
   DensePhase load, clustering, undistort, mvs, merge, outlier_filter, write;
   bool peak_rss_resettable = false;
-  PatchMvsReport pmvs;            // summed over clusters (PMVS)
-  PatchMatchReport patchmatch;    // summed over clusters (PatchMatch; map_bytes: the largest cluster's)
+  PatchMvsReport pmvs;          // summed over clusters (PMVS)
+  PatchMatchReport patchmatch;  // summed over clusters (PatchMatch; map_bytes: the largest cluster's)
   std::string points_path, report_path;
 };
 

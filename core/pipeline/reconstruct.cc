@@ -369,8 +369,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     if (dense.method != DenseMethod::kPmvs) {
       dense_settings += " " + Settings({{"method", static_cast<double>(dense.method)}});
     }
-    RECONAR_RETURN_IF_ERROR(runner.Run("dense", dense_settings, Exists(project.root() + "/dense/report.json"),
-                                       runner.redone(), run_dense));
+    RECONAR_RETURN_IF_ERROR(
+        runner.Run("dense", dense_settings, Exists(project.root() + "/dense/report.json"), runner.redone(), run_dense));
   }
 
   if (options.run_mesh) {
