@@ -5,7 +5,7 @@
 //
 // Usage: bench_dense_figures bunny|templering [--method pmvs|patchmatch] [--level L] [--threads N]
 //                            [--depth D] [--trim T] [--stride S] [--project DIR] [--keep-outliers]
-//                            [shared_data_dir]
+//                            [--visibility-angle DEG] [shared_data_dir]
 // --keep-outliers runs the dense stage without its outlier filter, then applies the filter here and
 // says how many of the points each of its two tests removes, and keeps, are wrong by the scene's
 // truth: farther than two pixel footprints from bun_zipper's surface, or outside templeRing's box.
@@ -35,6 +35,7 @@ struct Args {
   int depth = 8;
   double trim = 7.0;
   int stride = 1;
+  double visibility_angle_deg = 60.0;  // bunny: the angle within which a view counts as seeing a vertex
   std::string project;
   std::string data_dir = RECONAR_SHARED_DATA_DIR;
 };
@@ -44,7 +45,7 @@ int Usage(const char* message) {
                "bench_dense_figures: %s\n"
                "usage: bench_dense_figures bunny|templering [--method pmvs|patchmatch] [--level L] [--threads N]\n"
                "                           [--depth D] [--trim T] [--stride S] [--project DIR] [--keep-outliers]\n"
-               "                           [shared_data_dir]\n",
+               "                           [--visibility-angle DEG] [shared_data_dir]\n",
                message);
   return 2;
 }
@@ -112,16 +113,19 @@ int RunBunny(const Args& args, const std::string& project) {
   options.num_threads = args.threads;
   options.poisson.depth = args.depth;
   options.poisson.trim = args.trim;
+  options.project.visibility_max_angle_deg = args.visibility_angle_deg;
   auto figures = testing::RunBunnyDense(*bunny, project, options);
   if (!figures.ok()) {
     std::fprintf(stderr, "bench_dense_figures: %s\n", figures.status().ToString().c_str());
     return 1;
   }
   const testing::BunnySceneReport& scene = figures->scene;
-  std::printf("bunny scene: %d views %dx%d, foreground %.3f, seen by >= 3 views within 60 deg %.3f, "
-              "footprint %.3f mm; render %.1f s\n",
-              scene.views, options.project.scene.width, options.project.scene.height, scene.mean_foreground_fraction,
-              scene.visibility.seen_by_3_fraction, 1e3 * scene.pixel_footprint_at_center_m, figures->seconds_render);
+  std::printf(
+      "bunny scene: %d views %dx%d, foreground %.3f, seen by >= 2 / >= 3 views within %.0f deg %.3f / %.3f, "
+      "footprint %.3f mm; render %.1f s\n",
+      scene.views, options.project.scene.width, options.project.scene.height, scene.mean_foreground_fraction,
+      args.visibility_angle_deg, scene.visibility.seen_by_2_fraction, scene.visibility.seen_by_3_fraction,
+      1e3 * scene.pixel_footprint_at_center_m, figures->seconds_render);
   PrintDense(figures->dense);
   std::printf("dense wall %.1f s\n", figures->seconds_dense);
   std::printf("POINTS  accuracy(90%%) %.3f mm  completeness(1.25 mm) %.3f  (%zu points)\n",
@@ -208,6 +212,8 @@ int main(int argc, char** argv) {
       args.depth = std::atoi(argv[++i]);
     } else if (arg == "--trim" && has_value) {
       args.trim = std::atof(argv[++i]);
+    } else if (arg == "--visibility-angle" && has_value) {
+      args.visibility_angle_deg = std::atof(argv[++i]);
     } else if (arg == "--stride" && has_value) {
       args.stride = std::atoi(argv[++i]);
     } else if (arg == "--project" && has_value) {

@@ -59,4 +59,20 @@ Result<DenseLevelChoice> ChooseDenseLevel(const DenseMemoryInput& input, int req
                            " MiB, more than the memory budget of " + std::to_string(budget_bytes >> 20) + " MiB");
 }
 
+DenseLevelChoice GrowClusterToBudget(const DenseMemoryInput& input, const DenseLevelChoice& choice,
+                                     size_t budget_bytes) {
+  DenseLevelChoice grown = choice;
+  if (choice.reduced_cluster_size) return grown;
+  const int images = static_cast<int>(input.image_sizes.size());
+  for (int size = images; size > choice.max_cluster_size; --size) {
+    const size_t bytes = EstimateDenseBytes(input, choice.level, size);
+    if (bytes <= budget_bytes) {
+      grown.max_cluster_size = size;
+      grown.estimated_bytes = bytes;
+      break;
+    }
+  }
+  return grown;
+}
+
 }  // namespace reconar

@@ -53,4 +53,9 @@ struct DenseLevelChoice {
 Result<DenseLevelChoice> ChooseDenseLevel(const DenseMemoryInput& input, int requested_level, size_t budget_bytes,
                                           int min_cluster_size);
 
+// `choice` with its cluster size raised to the largest (up to every image) whose estimate at
+// choice.level still fits the budget; unchanged when it was reduced for the budget already.
+DenseLevelChoice GrowClusterToBudget(const DenseMemoryInput& input, const DenseLevelChoice& choice,
+                                     size_t budget_bytes);
+
 }  // namespace reconar

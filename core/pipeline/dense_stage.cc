@@ -204,8 +204,11 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   // The fewest views a cluster needs for the method to make a point.
   const int min_views = patchmatch ? options.patchmatch.fusion_min_views + 1 : options.mvs.min_visible_views;
   const int min_cluster = std::max(options.clustering.min_views_per_point, min_views);
-  RECONAR_ASSIGN_OR_RETURN(const DenseLevelChoice choice,
+  RECONAR_ASSIGN_OR_RETURN(DenseLevelChoice choice,
                            ChooseDenseLevel(memory, options.level, options.memory_budget_bytes, min_cluster));
+  // PatchMatch makes a depth map of every view in each cluster the view is in, so overlapping
+  // clusters repeat its work: its clusters grow to what the budget holds at the chosen level.
+  if (patchmatch) choice = GrowClusterToBudget(memory, choice, options.memory_budget_bytes);
   report.level = choice.level;
   report.level_auto = options.level < 0;
   report.estimated_bytes = choice.estimated_bytes;

@@ -19,11 +19,18 @@ class DepthMapChecker {
       : views_(views), maps_(maps), options_(options) {
     cos_max_normal_ = std::cos(options.fusion_max_normal_deg * M_PI / 180.0);
     max_reprojection_squared_ = options.fusion_max_reprojection_px * options.fusion_max_reprojection_px;
+    cos_max_view_angle_ = std::cos(options.max_view_angle_deg * M_PI / 180.0);
   }
 
+  // A depth below max_cost whose plane faces the view within max_view_angle_deg.
   bool Valid(int v, size_t i) const {
     const DepthMap& m = maps_[static_cast<size_t>(v)];
-    return m.depth[i] > 0.0f && m.cost[i] <= options_.max_cost;
+    if (!(m.depth[i] > 0.0f && m.cost[i] <= options_.max_cost)) return false;
+    const DenseView& view = *views_[static_cast<size_t>(v)];
+    const int x = static_cast<int>(i % static_cast<size_t>(m.width)),
+              y = static_cast<int>(i / static_cast<size_t>(m.width));
+    const Eigen::Vector3d ray((x - view.cx) / view.fx, (y - view.cy) / view.fy, 1.0);
+    return -m.Normal(i).cast<double>().dot(ray) >= cos_max_view_angle_ * ray.norm();
   }
   // World point and world normal of pixel (x, y) of view v.
   void PointAndNormal(int v, int x, int y, Eigen::Vector3d* point, Eigen::Vector3d* normal) const {
@@ -69,6 +76,7 @@ class DepthMapChecker {
   const PatchMatchOptions& options_;
   double cos_max_normal_ = 1.0;
   double max_reprojection_squared_ = 0.0;
+  double cos_max_view_angle_ = 0.0;
 };
 
 }  // namespace

@@ -110,6 +110,12 @@ Status PatchMatchOptions::Check() const {
     return InvalidArgument(prefix + "fusion tolerances must be positive (normal angle at most 180 degrees)");
   }
   if (!(max_cost > 0.0 && max_cost <= 2.0)) return InvalidArgument(prefix + "max_cost must lie in (0, 2]");
+  if (!(max_view_angle_deg > 0.0 && max_view_angle_deg <= 90.0)) {
+    return InvalidArgument(prefix + "max_view_angle_deg must lie in (0, 90]");
+  }
+  if (!(image_noise_std >= 0.0 && image_noise_std < 64.0)) {
+    return InvalidArgument(prefix + "image_noise_std must lie in [0, 64) grey levels");
+  }
   return Status::Ok();
 }
 

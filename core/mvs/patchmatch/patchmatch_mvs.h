@@ -11,6 +11,7 @@
 // cam_from_world poses; depths along the camera's z axis. Output in world coordinates, normals
 // towards the cameras.
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -47,6 +48,13 @@ struct PatchMatchOptions {
   double sigma_spatial = 3.0;
   double sigma_color = 12.0;
   int cost_top_k = 2;
+  // Added: standard deviation of the image noise in grey levels (0..255), as PatchMvsOptions's. It
+  // sets the texture floor MinTextureStd() = image_noise_std / sqrt(max_cost): under noise, a true
+  // match of texture deviation s correlates at about s^2 / (s^2 + image_noise_std^2), which
+  // reaches 1 - max_cost only when the observed deviation is at least that floor. A reference
+  // window below it (bilaterally weighted) gets no depth: what would match there is noise (black
+  // velvet behind a studio object, a white wall's grain).
+  double image_noise_std = 2.0;
   int iterations = 4;  // red-black sweeps (each sweep: both colours)
   // Added: propagation tests, in each of the four directions, the plane of the cheapest pixel
   // among those 1, 3, ..., 11 pixels away (4 planes); with separate_near_neighbours the adjacent
@@ -82,11 +90,17 @@ struct PatchMatchOptions {
   double fusion_max_relative_depth = 0.01;
   double fusion_max_normal_deg = 10.0;
   double max_cost = 0.5;
+  // Added: a pixel's plane joins fusion only when it faces that pixel's camera within this angle
+  // (PatchMvsOptions::max_view_angle, PMVS's iota): at grazing angles a window spans a long strip
+  // of surface and its match is unreliable. On templeRing the planes past it were the platform
+  // under the temple, seen at 63-75 degrees from every camera.
+  double max_view_angle_deg = 60.0;
   int num_threads = 0;  // 0 = all cores
   bool show_progress = false;
   std::string progress_label = "PatchMatch depth maps";
 
   Status Check() const;  // InvalidArgument naming the first offending field
+  double MinTextureStd() const { return image_noise_std / std::sqrt(max_cost); }  // grey levels
 };
 
 struct PatchMatchReport {

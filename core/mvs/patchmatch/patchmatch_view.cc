@@ -12,8 +12,8 @@
 namespace reconar {
 namespace {
 
-// A window whose weighted grey variance is below this (one grey level squared, in [0, 1] units)
-// carries no texture: its NCC is noise.
+// A warped source window whose weighted grey variance is below this (one grey level squared, in
+// [0, 1] units) carries no texture: its NCC is noise. The reference's floor is the options'.
 constexpr float kMinTextureVariance = 1.0f / (255.0f * 255.0f);
 constexpr int kFarSteps = 5;                   // far neighbours 3, 5, ..., 2 kFarSteps + 1 pixels away
 constexpr float kDepthPerturbation = 0.1f;     // relative depth range of a perturbation in sweep 0, ...
@@ -68,6 +68,8 @@ class PatchMatchViewSolver {
       : input_(input), options_(options), pool_(pool), map_(*map), view_(*input.reference) {
     inv_fx_ = 1.0 / view_.fx;
     inv_fy_ = 1.0 / view_.fy;
+    const float min_std = static_cast<float>(options.MinTextureStd() / 255.0);
+    min_reference_variance_ = std::max(kMinTextureVariance, min_std * min_std);
     const int r = options.window_radius, step = options.window_step;
     for (int oy = -r; oy <= r; oy += step) {
       for (int ox = -r; ox <= r; ox += step) {
@@ -263,7 +265,7 @@ class PatchMatchViewSolver {
     s->max_x = static_cast<float>(max_x);
     s->min_y = static_cast<float>(min_y);
     s->max_y = static_cast<float>(max_y);
-    if (!(s->variance >= kMinTextureVariance)) return false;
+    if (!(s->variance >= min_reference_variance_)) return false;
     for (int j = 0; j < s->count; ++j) s->reference[static_cast<size_t>(j)] -= mean;
     // Padding for the kernels: weight 0 at the first sample's offset (inside the checked box).
     s->padded_count = PaddedWarpCount(s->count);
@@ -440,6 +442,7 @@ class PatchMatchViewSolver {
   DepthMap& map_;
   const DenseView& view_;
   double inv_fx_ = 0.0, inv_fy_ = 0.0;
+  float min_reference_variance_ = kMinTextureVariance;
   std::vector<int> offset_x_, offset_y_;
   std::vector<float> spatial_;
   float color_[256];

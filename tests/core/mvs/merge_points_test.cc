@@ -78,5 +78,26 @@ TEST(DenseMemory, FinestLevelThatFitsThenSmallerClusters) {
   EXPECT_EQ(ChooseDenseLevel(input, 3, level0, 3).status().code(), StatusCode::kInvalidArgument);
 }
 
+TEST(DenseMemory, ClustersGrowToWhatTheBudgetHolds) {
+  DenseMemoryInput input;
+  input.image_sizes.assign(30, {3072, 2048});
+  input.max_cluster_size = 20;
+  input.num_threads = 2;
+  const size_t level1_of_25 = EstimateDenseBytes(input, 1, 25);
+  auto choice = ChooseDenseLevel(input, -1, level1_of_25, 3);
+  ASSERT_TRUE(choice.ok());
+  ASSERT_EQ(choice->level, 1);
+  const DenseLevelChoice grown = GrowClusterToBudget(input, *choice, level1_of_25);
+  EXPECT_EQ(grown.level, 1);
+  EXPECT_EQ(grown.max_cluster_size, 25);
+  EXPECT_EQ(grown.estimated_bytes, level1_of_25);
+  EXPECT_EQ(GrowClusterToBudget(input, *choice, EstimateDenseBytes(input, 1, 30) * 2).max_cluster_size, 30);
+  // A cluster size already reduced for the budget stays.
+  auto reduced = ChooseDenseLevel(input, 0, EstimateDenseBytes(input, 0, 10), 3);
+  ASSERT_TRUE(reduced.ok() && reduced->reduced_cluster_size);
+  EXPECT_EQ(GrowClusterToBudget(input, *reduced, EstimateDenseBytes(input, 0, 10)).max_cluster_size,
+            reduced->max_cluster_size);
+}
+
 }  // namespace
 }  // namespace reconar
