@@ -110,6 +110,7 @@ Status PatchMatchOptions::Check() const {
     return InvalidArgument(prefix + "fusion tolerances must be positive (normal angle at most 180 degrees)");
   }
   if (!(max_cost > 0.0 && max_cost <= 2.0)) return InvalidArgument(prefix + "max_cost must lie in (0, 2]");
+  if (source_subset < 0) return InvalidArgument(prefix + "source_subset must be >= 0");
   if (!(max_view_angle_deg > 0.0 && max_view_angle_deg <= 90.0)) {
     return InvalidArgument(prefix + "max_view_angle_deg must lie in (0, 90]");
   }
