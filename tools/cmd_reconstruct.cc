@@ -28,7 +28,7 @@ constexpr char kHelp[] =
     "  --principal-point fixed|auto|refine, --fixed-distortion, --max-error PX   as `reconar sfm`\n"
     "  --ratio R, --min-inliers N, --checks N, --f-threshold T   matching (defaults 0.8, 30, 200, 0.006)\n"
     "  --level 0|1|2|auto    dense image resolution (default auto: the finest that fits the budget)\n"
-    "  --method pmvs|patchmatch  dense multi-view stereo (default pmvs), as `reconar dense`\n"
+    "  --method patchmatch|pmvs  dense multi-view stereo (default patchmatch), as `reconar dense`\n"
     "  --depth N             finest Poisson depth (default 10; never finer than the points' spacing,\n"
     "                        lowered when the budget demands)\n"
     "  --trim T              Poisson density trim (default 7)\n"

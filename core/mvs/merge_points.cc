@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <tuple>
-#include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace reconar {
 namespace {
@@ -14,11 +14,59 @@ struct CellKey {
   bool operator==(const CellKey& other) const { return x == other.x && y == other.y && z == other.z; }
 };
 
-struct CellHash {
-  size_t operator()(const CellKey& key) const {
-    return static_cast<size_t>(key.x * 73856093) ^ static_cast<size_t>(key.y * 19349663) ^
-           static_cast<size_t>(key.z * 83492791);
+// Cell -> the kept points in it, as a chain through `next` (open addressing, linear probing,
+// grown at half load): no allocation per cell, unlike a map of vectors.
+class CellChains {
+ public:
+  CellChains() { Rehash(1 << 12); }
+
+  int32_t Head(const CellKey& key) const {
+    for (size_t slot = Hash(key) & mask_;; slot = (slot + 1) & mask_) {
+      if (heads_[slot] < 0) return -1;
+      if (keys_[slot] == key) return heads_[slot];
+    }
   }
+  int32_t Next(int32_t point) const { return next_[static_cast<size_t>(point)]; }
+  // Adds point `point` (the next index, 0, 1, 2, ...) to the cell's chain.
+  void Add(const CellKey& key, int32_t point) {
+    if (2 * (used_ + 1) > heads_.size()) Rehash(2 * heads_.size());
+    size_t slot = Hash(key) & mask_;
+    while (heads_[slot] >= 0 && !(keys_[slot] == key)) slot = (slot + 1) & mask_;
+    if (heads_[slot] < 0) {
+      keys_[slot] = key;
+      ++used_;
+    }
+    next_.push_back(heads_[slot]);
+    heads_[slot] = point;
+  }
+
+ private:
+  static size_t Hash(const CellKey& key) {
+    uint64_t h = static_cast<uint64_t>(key.x) * 0x9E3779B97F4A7C15ull;
+    h ^= static_cast<uint64_t>(key.y) * 0xC2B2AE3D27D4EB4Full + (h >> 29);
+    h ^= static_cast<uint64_t>(key.z) * 0x165667B19E3779F9ull + (h >> 32);
+    return static_cast<size_t>(h ^ (h >> 31));
+  }
+  void Rehash(size_t capacity) {
+    std::vector<CellKey> old_keys = std::move(keys_);
+    std::vector<int32_t> old_heads = std::move(heads_);
+    keys_.assign(capacity, CellKey{0, 0, 0});
+    heads_.assign(capacity, -1);
+    mask_ = capacity - 1;
+    for (size_t i = 0; i < old_heads.size(); ++i) {
+      if (old_heads[i] < 0) continue;
+      size_t slot = Hash(old_keys[i]) & mask_;
+      while (heads_[slot] >= 0) slot = (slot + 1) & mask_;
+      keys_[slot] = old_keys[i];
+      heads_[slot] = old_heads[i];
+    }
+  }
+
+  std::vector<CellKey> keys_;
+  std::vector<int32_t> heads_;  // -1: empty slot
+  std::vector<int32_t> next_;   // per point: the next point of its cell, -1 at the end
+  size_t mask_ = 0;
+  size_t used_ = 0;
 };
 
 }  // namespace
@@ -60,11 +108,8 @@ OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeRe
     std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2, footprints.end());
     cell = footprints[footprints.size() / 2];
   }
-  const auto key_of = [cell](const Eigen::Vector3f& x) {
-    return CellKey{static_cast<int64_t>(std::floor(x.x() / cell)), static_cast<int64_t>(std::floor(x.y() / cell)),
-                   static_cast<int64_t>(std::floor(x.z() / cell))};
-  };
-  std::unordered_map<CellKey, std::vector<uint32_t>, CellHash> grid;  // cell -> indices into `merged`
+  const auto cell_of = [cell](float v) { return static_cast<int64_t>(std::floor(v / cell)); };
+  CellChains grid;
   OrientedPoints merged;
   size_t dropped = 0;
   for (const Ref& ref : order) {
@@ -72,20 +117,26 @@ OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeRe
     const Eigen::Vector3f& position = source.positions[ref.index];
     const Eigen::Vector3f normal =
         ref.index < source.normals.size() ? source.normals[ref.index] : Eigen::Vector3f::Zero();
-    const float footprint = ref.index < parts[ref.part].footprints.size() ? parts[ref.part].footprints[ref.index] : 0.0f;
-    const CellKey key = key_of(position);
+    const float footprint =
+        ref.index < parts[ref.part].footprints.size() ? parts[ref.part].footprints[ref.index] : 0.0f;
     bool duplicate = false;
     if (footprint > 0.0f && std::isfinite(footprint)) {
-      // Search the cells within one footprint; a footprint many cells wide is capped (rare outliers).
-      const int64_t reach = std::min<int64_t>(4, static_cast<int64_t>(std::ceil(footprint / cell)));
+      // The cells the ball of radius `footprint` reaches (2 per axis when it is at most a cell); a
+      // footprint many cells wide is capped to 9 cells per axis (rare outliers).
+      int64_t low[3], high[3];
+      for (int a = 0; a < 3; ++a) {
+        const int64_t centre = cell_of(position[a]);
+        low[a] = std::max(cell_of(position[a] - footprint), centre - 4);
+        high[a] = std::min(cell_of(position[a] + footprint), centre + 4);
+      }
       const float radius2 = footprint * footprint;
-      for (int64_t dz = -reach; dz <= reach && !duplicate; ++dz) {
-        for (int64_t dy = -reach; dy <= reach && !duplicate; ++dy) {
-          for (int64_t dx = -reach; dx <= reach && !duplicate; ++dx) {
-            const auto it = grid.find(CellKey{key.x + dx, key.y + dy, key.z + dz});
-            if (it == grid.end()) continue;
-            for (uint32_t k : it->second) {
-              if ((merged.positions[k] - position).squaredNorm() <= radius2 && merged.normals[k].dot(normal) > 0.0f) {
+      for (int64_t z = low[2]; z <= high[2] && !duplicate; ++z) {
+        for (int64_t y = low[1]; y <= high[1] && !duplicate; ++y) {
+          for (int64_t x = low[0]; x <= high[0] && !duplicate; ++x) {
+            for (int32_t k = grid.Head(CellKey{x, y, z}); k >= 0; k = grid.Next(k)) {
+              const size_t kept = static_cast<size_t>(k);
+              if ((merged.positions[kept] - position).squaredNorm() <= radius2 &&
+                  merged.normals[kept].dot(normal) > 0.0f) {
                 duplicate = true;
                 break;
               }
@@ -98,7 +149,8 @@ OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeRe
       ++dropped;
       continue;
     }
-    grid[key].push_back(static_cast<uint32_t>(merged.positions.size()));
+    grid.Add(CellKey{cell_of(position.x()), cell_of(position.y()), cell_of(position.z())},
+             static_cast<int32_t>(merged.positions.size()));
     merged.positions.push_back(position);
     merged.normals.push_back(normal);
     merged.colors.push_back(ref.index < source.colors.size() ? source.colors[ref.index] : std::array<uint8_t, 3>{0, 0, 0});

@@ -21,6 +21,10 @@ struct DepthMap {
   std::vector<float> depth;
   std::vector<int16_t> normal;  // 3 per pixel, times kNormalScale
   std::vector<float> cost;
+  // Per pixel, a bit per source view: the sources that served its plane best (the candidates of
+  // the next sweep are scored on them). Carried from a coarse level to the next finer one of the
+  // same view, then released: not part of SizeBytes.
+  std::vector<uint32_t> source_masks;
 
   bool empty() const { return width <= 0 || height <= 0; }
   static constexpr float kNormalScale = 32767.0f;

@@ -212,6 +212,7 @@ Result<OrientedPoints> RunPatchMatchMvs(const std::vector<const DenseView*>& vie
     } else {
       RunPhotometricPatchMatch(inputs[v], options, &pool, &maps[v]);
     }
+    maps[v].source_masks = std::vector<uint32_t>();
     if (progress) progress->Advance();
   }
   pyramid.clear();
@@ -220,6 +221,7 @@ Result<OrientedPoints> RunPatchMatchMvs(const std::vector<const DenseView*>& vie
     for (size_t v = 0; v < num_views; ++v) {
       if (!setups[v].valid) continue;
       RunGeometricPatchMatch(inputs[v], options, &pool, &maps[v]);
+      maps[v].source_masks = std::vector<uint32_t>();
       if (progress) progress->Advance();
     }
   }

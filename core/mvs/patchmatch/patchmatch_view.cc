@@ -54,8 +54,10 @@ struct Scratch {
   std::vector<float> weights;    // their bilateral weights
   std::vector<float> offset_x;   // their offsets (the samples inside the reference image)
   std::vector<float> offset_y;
-  std::vector<float> costs;                   // one per scored source
   std::vector<std::pair<float, int>> ranked;  // (cost, source) of the scored sources
+  int scored = 0;                             // entries of `ranked` filled by the last Cost
+  std::vector<std::pair<float, int>> winner;  // `ranked` of the best candidate so far
+  int winner_count = 0;
   int count = 0;
   int padded_count = 0;  // count rounded up to kWarpLanes (the padding has weight 0)
   float weight_sum = 0.0f;
@@ -123,8 +125,8 @@ class PatchMatchViewSolver {
       s.weights.resize(padded);
       s.offset_x.resize(padded);
       s.offset_y.resize(padded);
-      s.costs.resize(sources_.size());
       s.ranked.resize(sources_.size());
+      s.winner.resize(sources_.size());
     }
   }
 
@@ -160,19 +162,28 @@ class PatchMatchViewSolver {
                                            static_cast<float>((cy - coarse_view.cy) / coarse_view.fy), 1.0f);
           depth = coarse_map.depth[c] * normal.dot(coarse_ray) / normal.dot(ray);
         }
+        // The coarse pixel's sources serve its plane here too; a random plane is scored on all.
+        const uint32_t coarse_mask = c < coarse_map.source_masks.size() ? coarse_map.source_masks[c] : all_sources_;
         if (!(depth >= input_.depth_min && depth <= input_.depth_max)) {
           PixelRandom random(input_.seed, i, kInitialisationSweep);
           depth = RandomDepth(&random);
           normal = RandomNormal(&random, ray);
+        } else {
+          map_.source_masks[i] = coarse_mask;
         }
-        Store(i, depth, normal, ReferenceWindow(x, y, s) ? FullCost(i, x, y, depth, normal, false, s) : kNoDepthCost);
+        float cost = kNoDepthCost;
+        if (ReferenceWindow(x, y, s)) {
+          cost = map_.source_masks[i] == all_sources_ ? FullCost(i, x, y, depth, normal, false, s)
+                                                      : Cost(x, y, depth, normal, false, map_.source_masks[i], s);
+        }
+        Store(i, depth, normal, cost);
       }
     });
   }
 
   // Recomputes every pixel's cost for its current plane.
   void Rescore(bool geometric) {
-    source_masks_.assign(map_.depth.size(), all_sources_);
+    map_.source_masks.assign(map_.depth.size(), all_sources_);
     ForRows([&](int y, Scratch* s) {
       for (int x = 0; x < map_.width; ++x) {
         const size_t i = map_.Index(x, y);
@@ -200,12 +211,12 @@ class PatchMatchViewSolver {
 
   void Reset() {
     map_.Reset(view_.width(), view_.height());
-    source_masks_.assign(map_.depth.size(), all_sources_);
+    map_.source_masks.assign(map_.depth.size(), all_sources_);
   }
 
   // The cost over all sources, remembering pixel i's best subset_size_ of them for its next sweep.
   float FullCost(size_t i, int x, int y, float depth, const Eigen::Vector3f& normal, bool geometric, Scratch* s) {
-    return Cost(x, y, depth, normal, geometric, all_sources_, s, &source_masks_[i]);
+    return Cost(x, y, depth, normal, geometric, all_sources_, s, &map_.source_masks[i]);
   }
 
   Eigen::Vector3f Ray(int x, int y) const {
@@ -363,12 +374,13 @@ class PatchMatchViewSolver {
   }
 
   // The cost of plane (depth, normal) at (x, y): the mean of the best top_k_ costs of the sources
-  // in `mask`; with best_subset, the subset_size_ cheapest of them are stored there as a mask. For
+  // in `mask` and of the `known` (cost, source) pairs already in s->ranked; with best_subset, the
+  // subset_size_ cheapest of them all are stored there as a mask. For
   // points X on the plane n . X = n . X0 (X0 = depth K^-1 (x, y, 1)), X_s = R X + t = (R + t n^T /
   // (n . X0)) X, so the homography is K_s (R + t n^T / (n . X0)) K_r^-1 = A + b m^T / (n . X0)
   // with A = K_s R K_r^-1, b = K_s t, m = K_r^-T n.
   float Cost(int x, int y, float depth, const Eigen::Vector3f& normal, bool geometric, uint32_t mask, Scratch* s,
-             uint32_t* best_subset = nullptr) const {
+             uint32_t* best_subset = nullptr, int known = 0) const {
     const Eigen::Vector3d ray((x - view_.cx) * inv_fx_, (y - view_.cy) * inv_fy_, 1.0);
     const Eigen::Vector3d n = normal.cast<double>();
     const double plane = depth * n.dot(ray);
@@ -377,7 +389,7 @@ class PatchMatchViewSolver {
                             n.z() - n.x() * view_.cx * inv_fx_ - n.y() * view_.cy * inv_fy_);
     const Eigen::Vector3f m_scaled = (m / plane).cast<float>();
     const Eigen::Vector3d point = depth * ray;
-    int scored = 0;
+    int scored = known;
     for (size_t k = 0; k < sources_.size(); ++k) {
       if (!(mask >> k & 1u)) continue;
       const SourceGeometry& g = sources_[k];
@@ -386,6 +398,7 @@ class PatchMatchViewSolver {
       if (geometric) cost += static_cast<float>(options_.geometric_weight) * GeometricError(g, point, x, y);
       s->ranked[static_cast<size_t>(scored++)] = {cost, static_cast<int>(k)};
     }
+    s->scored = scored;
     const int k_used = std::min(top_k_, scored);
     if (k_used == 0) return kNoDepthCost;
     const auto ranked_end = s->ranked.begin() + scored;
@@ -424,13 +437,15 @@ class PatchMatchViewSolver {
     const float depth_min = static_cast<float>(input_.depth_min), depth_max = static_cast<float>(input_.depth_max);
     // Candidates are scored on the sources that served the pixel's current plane best; that plane's
     // cost on them equals its cost on all (top_k_ <= subset_size_), so the comparison is fair.
-    const uint32_t mask = source_masks_[i];
+    const uint32_t mask = map_.source_masks[i];
     bool changed = false;
     auto consider = [&](float depth, const Eigen::Vector3f& normal) {
       if (!(depth >= depth_min && depth <= depth_max)) return;
       const float cost = Cost(x, y, depth, normal, geometric, mask, s);
       if (cost < best_cost) {
         changed = true;
+        std::copy(s->ranked.begin(), s->ranked.begin() + s->scored, s->winner.begin());
+        s->winner_count = s->scored;
         best_cost = cost;
         best_depth = depth;
         best_normal = normal;
@@ -478,7 +493,12 @@ class PatchMatchViewSolver {
     consider(perturbed_depth, perturbed_normal);
     consider(perturbed_depth, normal);
     consider(depth, perturbed_normal);
-    if (changed && mask != all_sources_) best_cost = FullCost(i, x, y, best_depth, best_normal, geometric, s);
+    // The winner on all sources: those of the subset are scored already.
+    if (changed && mask != all_sources_) {
+      std::copy(s->winner.begin(), s->winner.begin() + s->winner_count, s->ranked.begin());
+      best_cost = Cost(x, y, best_depth, best_normal, geometric, all_sources_ & ~mask, s, &map_.source_masks[i],
+                       s->winner_count);
+    }
     Store(i, best_depth, best_normal, best_cost);
   }
 
@@ -496,7 +516,6 @@ class PatchMatchViewSolver {
   int top_k_ = 1;
   int subset_size_ = 1;
   uint32_t all_sources_ = 0;
-  std::vector<uint32_t> source_masks_;  // per pixel: the sources its candidates are scored on
   std::vector<Scratch> scratch_;
   WarpSumsFn warp_sums_ = ActiveWarpSumsKernel().sums;
 };
