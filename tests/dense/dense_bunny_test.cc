@@ -33,18 +33,28 @@ constexpr double kPointCompletenessShareOfReachable = 0.75;
 // smooths the points: accuracy bar = the points' bar + one cell; completeness as for the points.
 constexpr double kMeshAccuracyExtraCells = 1.0;
 
-TEST(DenseBunnyTest, PointsAndPoissonMeshMatchTheRenderedBunny) {
-  ASSERT_NE(SharedSurfacelessContext(), nullptr);
-  auto bunny = ReadPly(kBunnyPath);
-  ASSERT_TRUE(bunny.ok()) << bunny.status().ToString();
-  const std::string dir = MakeTestDirectory("reconar_dense_bunny");
-
+// The scene through the dense stage with `method` at full resolution on 2 threads, then Poisson
+// at depth 8, trimmed at 7.
+BunnyDenseOptions TestOptions(DenseMethod method) {
   BunnyDenseOptions options;
+  options.method = method;
   options.level = 0;
   options.num_threads = 2;
   options.poisson.depth = 8;
   options.poisson.trim = options.poisson.depth - 1;
-  auto figures = RunBunnyDense(*bunny, dir, options);
+  return options;
+}
+
+Result<BunnyDenseFigures> RunTestScene(const BunnyDenseOptions& options, const std::string& directory_name) {
+  if (SharedSurfacelessContext() == nullptr) return FailedPrecondition("no surfaceless GLES context");
+  auto bunny = ReadPly(kBunnyPath);
+  if (!bunny.ok()) return bunny.status();
+  return RunBunnyDense(*bunny, MakeTestDirectory(directory_name), options);
+}
+
+TEST(DenseBunnyTest, PointsAndPoissonMeshMatchTheRenderedBunny) {
+  const BunnyDenseOptions options = TestOptions(DenseMethod::kPmvs);
+  auto figures = RunTestScene(options, "reconar_dense_bunny");
   ASSERT_TRUE(figures.ok()) << figures.status().ToString();
 
   const BunnySceneReport& scene = figures->scene;
@@ -85,18 +95,8 @@ TEST(DenseBunnyTest, PointsAndPoissonMeshMatchTheRenderedBunny) {
 constexpr double kPatchMatchAccuracyBarM = 1.0e-3;
 
 TEST(DenseBunnyTest, PatchMatchPointsMatchTheRenderedBunny) {
-  ASSERT_NE(SharedSurfacelessContext(), nullptr);
-  auto bunny = ReadPly(kBunnyPath);
-  ASSERT_TRUE(bunny.ok()) << bunny.status().ToString();
-  const std::string dir = MakeTestDirectory("reconar_dense_bunny_patchmatch");
-
-  BunnyDenseOptions options;
-  options.method = DenseMethod::kPatchMatch;
-  options.level = 0;
-  options.num_threads = 2;
-  options.poisson.depth = 8;
-  options.poisson.trim = options.poisson.depth - 1;
-  auto figures = RunBunnyDense(*bunny, dir, options);
+  const BunnyDenseOptions options = TestOptions(DenseMethod::kPatchMatch);
+  auto figures = RunTestScene(options, "reconar_dense_bunny_patchmatch");
   ASSERT_TRUE(figures.ok()) << figures.status().ToString();
   const double reachable = figures->scene.visibility.seen_by_3_fraction;
   std::printf(

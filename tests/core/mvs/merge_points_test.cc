@@ -49,11 +49,17 @@ TEST(MergePoints, PixelFootprintIsDepthOverFocalInTheClosestView) {
   EXPECT_EQ(PixelFootprint({&far, &near}, Eigen::Vector3f(0, 0, -10)), 0.0f);  // behind both
 }
 
-TEST(DenseMemory, FinestLevelThatFitsThenSmallerClusters) {
+// 30 photos of 6 megapixels, clusters of 20, 2 threads.
+DenseMemoryInput ThirtyPhotos() {
   DenseMemoryInput input;
   input.image_sizes.assign(30, {3072, 2048});
   input.max_cluster_size = 20;
   input.num_threads = 2;
+  return input;
+}
+
+TEST(DenseMemory, FinestLevelThatFitsThenSmallerClusters) {
+  const DenseMemoryInput input = ThirtyPhotos();
   const size_t level0 = EstimateDenseBytes(input, 0, 20);
   const size_t level1 = EstimateDenseBytes(input, 1, 20);
   const size_t level2 = EstimateDenseBytes(input, 2, 20);
@@ -79,10 +85,7 @@ TEST(DenseMemory, FinestLevelThatFitsThenSmallerClusters) {
 }
 
 TEST(DenseMemory, ClustersGrowToWhatTheBudgetHolds) {
-  DenseMemoryInput input;
-  input.image_sizes.assign(30, {3072, 2048});
-  input.max_cluster_size = 20;
-  input.num_threads = 2;
+  const DenseMemoryInput input = ThirtyPhotos();
   const size_t level1_of_25 = EstimateDenseBytes(input, 1, 25);
   auto choice = ChooseDenseLevel(input, -1, level1_of_25, 3);
   ASSERT_TRUE(choice.ok());
