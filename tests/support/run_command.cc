@@ -14,6 +14,9 @@ namespace reconar::testing {
 std::string MakeTestDirectory(const std::string& prefix) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / (prefix + "_" + std::to_string(::getpid()));
+  // Emptied first: a directory left by an earlier run whose process had the same id (CI's
+  // LocalizeRoom failed on a stale symlink there).
+  std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
 }
