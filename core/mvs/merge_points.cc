@@ -87,7 +87,9 @@ float PixelFootprint(const std::vector<const DenseView*>& views, const Eigen::Ve
   return static_cast<float>(best);
 }
 
-OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeReport* report) {
+OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeReport* report,
+                                   std::vector<float>* kept_footprints) {
+  if (kept_footprints != nullptr) kept_footprints->clear();
   struct Ref {
     float score;
     uint32_t part, index;
@@ -155,6 +157,7 @@ OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeRe
     merged.normals.push_back(normal);
     merged.colors.push_back(ref.index < source.colors.size() ? source.colors[ref.index] : std::array<uint8_t, 3>{0, 0, 0});
     merged.scores.push_back(ref.score);
+    if (kept_footprints != nullptr) kept_footprints->push_back(footprint);
   }
   if (report != nullptr) {
     report->input_points = order.size();

@@ -27,6 +27,9 @@ struct MergeReport {
   size_t duplicates_dropped = 0;
 };
 
-OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeReport* report = nullptr);
+// `kept_footprints`, when given, receives the footprint of every kept point (in the result's order),
+// so that the result can be merged again without computing them anew.
+OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeReport* report = nullptr,
+                                   std::vector<float>* kept_footprints = nullptr);
 
 }  // namespace reconar

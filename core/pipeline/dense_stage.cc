@@ -297,14 +297,10 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
     // each cluster's points hold a third of the memory until the merge across clusters (fountain-P11
     // at level 0 in 3 clusters under 1 GiB: the merge's peak was 1071 MiB with all of them whole).
     if (patchmatch) {
-      std::vector<MergeInput> single(1);
-      single[0] = std::move(part);
-      part.points = MergeOrientedPoints(single, nullptr);
-      single.clear();
-      part.footprints.clear();
-      for (const Eigen::Vector3f& position : part.points.positions) {
-        part.footprints.push_back(PixelFootprint(views, position));
-      }
+      std::vector<MergeInput> single;
+      single.push_back(std::move(part));
+      part = MergeInput();
+      part.points = MergeOrientedPoints(single, nullptr, &part.footprints);
     }
     parts.push_back(std::move(part));
   }
@@ -317,7 +313,8 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   OrientedPoints merged;
   {
     PhaseTimer timer(&report.merge);
-    merged = MergeOrientedPoints(parts, nullptr);
+    // A single part that was thinned already would come back unchanged (same order, same tests).
+    merged = patchmatch && parts.size() == 1 ? std::move(parts[0].points) : MergeOrientedPoints(parts, nullptr);
     parts.clear();
   }
   if (options.remove_outliers) {

@@ -38,19 +38,21 @@ struct PatchMatchOptions {
   double depth_margin = 0.25;
   int min_range_points = 8;
   // Photometric cost: 1 - NCC over a (2 window_radius + 1)^2 window sampled every window_step
-  // pixels (those within window_radius + window_step / 2 of the centre), bilaterally weighted (sigma_spatial in pixels,
-  // sigma_color in grey levels), warped by the pixel's plane into each source view; a pixel's cost is the mean over its
-  // best `cost_top_k` source views (2, changed from 3: a window outside a source costs 2, so with k above
-  // fusion_min_views a pixel that enough sources see to be fused was dropped wherever a further source missed it; on
-  // the test's box scene k = 3 lost 11 % of the completeness).
+  // pixels (those within window_radius + window_step / 2 of the centre), bilaterally weighted
+  // (sigma_spatial in pixels, sigma_color in grey levels), warped by the pixel's plane into each
+  // source view; a pixel's cost is the mean over its best `cost_top_k` source views (2, changed
+  // from 3: a window outside a source costs 2, so with k above fusion_min_views a pixel that
+  // enough sources see to be fused was dropped wherever a further source missed it; on the test's
+  // box scene k = 3 lost 11 % of the completeness).
   int window_radius = 5;
   int window_step = 2;
   double sigma_spatial = 3.0;
   double sigma_color = 12.0;
   int cost_top_k = 2;
   // Added: per-pixel view selection (after ACMM's): a propagation sweep scores a pixel's candidate
-  // planes on the source_subset sources that served its current plane best, and only the winner
-  // on all sources (which picks the subset for the next sweep). 0 scores every candidate on all.
+  // planes on the source_subset sources that served its current plane best; a plane that wins is
+  // then scored on the other sources too, which picks the subset for the next sweep (a finer level
+  // starts from the coarse pixel's). 0 scores every candidate on all sources.
   int source_subset = 4;
   // Added: standard deviation of the image noise in grey levels (0..255), as PatchMvsOptions's. It
   // sets the texture floor MinTextureStd() = image_noise_std / sqrt(max_cost): under noise, a true

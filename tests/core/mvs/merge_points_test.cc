@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 #include "core/mvs/dense_memory.h"
 
 namespace reconar {
@@ -26,7 +29,9 @@ TEST(MergePoints, DropsDuplicatesWithinOneFootprintAndKeepsTheBetter) {
   }
   Add(&parts[1], Eigen::Vector3f(0, 0, 0.002f), -up, 0.95f, 0.01f);  // the other side of a thin sheet
   MergeReport report;
-  const OrientedPoints merged = MergeOrientedPoints(parts, &report);
+  std::vector<float> kept_footprints;
+  const OrientedPoints merged = MergeOrientedPoints(parts, &report, &kept_footprints);
+  EXPECT_EQ(kept_footprints, std::vector<float>(merged.size(), 0.01f));
   EXPECT_EQ(report.input_points, 21u);
   EXPECT_EQ(report.duplicates_dropped, 10u);
   ASSERT_EQ(merged.size(), 11u);
@@ -34,6 +39,26 @@ TEST(MergePoints, DropsDuplicatesWithinOneFootprintAndKeepsTheBetter) {
     EXPECT_GE(merged.scores[i], 0.9f);  // the better-scored copy survived
     EXPECT_EQ(merged.colors[i][0], static_cast<uint8_t>(100 * merged.scores[i]));
   }
+}
+
+// Merging a merged result again, with the footprints it reports, changes nothing: the dense stage
+// relies on it for a single thinned cluster.
+TEST(MergePoints, MergingAMergedResultAgainKeepsIt) {
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  std::vector<MergeInput> parts(1);
+  for (int i = 0; i < 200; ++i) {
+    const float t = 0.37f * static_cast<float>(i);
+    Add(&parts[0], Eigen::Vector3f(0.004f * std::cos(t) * i / 20, 0.004f * std::sin(t) * i / 20, 0.0f),
+        i % 7 == 0 ? -up : up, 0.5f + 0.002f * static_cast<float>(i % 13), 0.005f + 0.0001f * (i % 5));
+  }
+  std::vector<MergeInput> once(1);
+  once[0].points = MergeOrientedPoints(parts, nullptr, &once[0].footprints);
+  ASSERT_LT(once[0].points.size(), parts[0].points.size());
+  MergeReport report;
+  const OrientedPoints twice = MergeOrientedPoints(once, &report);
+  EXPECT_EQ(report.duplicates_dropped, 0u);
+  EXPECT_EQ(twice.positions, once[0].points.positions);
+  EXPECT_EQ(twice.scores, once[0].points.scores);
 }
 
 TEST(MergePoints, PixelFootprintIsDepthOverFocalInTheClosestView) {
