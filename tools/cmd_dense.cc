@@ -25,10 +25,14 @@ constexpr char kHelp[] =
     "  --method patchmatch|pmvs  PatchMatch depth maps (default) or PMVS's patches (the paper's\n"
     "                         method, our reference; several times slower)\n"
     "  --level 0|1|2|auto     image resolution: full, half, quarter; auto (default) takes the finest\n"
-    "                         whose memory estimate fits --memory-budget\n"
+    "                         within --max-image-size whose memory estimate fits --memory-budget\n"
+    "  --max-image-size N     auto level: longest image side at most N pixels (default 2400, as\n"
+    "                         COLMAP's; 0: no limit)\n"
     "  --max-cluster-size N   images per PMVS run (default 20; smaller needs less memory); PatchMatch\n"
     "                         takes as many views at once as the budget holds\n"
     "  --memory-budget SIZE   memory the run may use: MiB, or 512K, 1500M, 1G (default 2560M)\n"
+    "  --no-fill              PatchMatch: leave texture-poor pixels (white walls) empty instead of\n"
+    "                         giving them the plane their textured surroundings agree on\n"
     "  --keep-outliers        keep isolated points and small floating pieces (removed by default)\n"
     "  --threads N            worker threads (default: one per core)\n"
     "  --json                 print the report as JSON instead of a summary\n";
@@ -82,7 +86,7 @@ void PrintSummary(const DenseStageReport& r) {
 int RunDense(int argc, char** argv, int first) {
   std::set<std::string> valued = {"max-cluster-size", "threads", "memory-budget"};
   valued.insert(kDenseValuedOptions.begin(), kDenseValuedOptions.end());
-  Args args(valued, {"json", "keep-outliers"});
+  Args args(valued, {"json", "keep-outliers", "no-fill"});
   if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 1, 1)) return *exit_code;
   const Project project(args.positionals()[0]);
   if (!IsDirectory(project.root())) {

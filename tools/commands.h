@@ -42,10 +42,10 @@ Status ReadMatchArgs(const Args& args, MatchStageOptions* options);
 inline const std::set<std::string> kMatchValuedOptions = {"ratio", "checks", "min-inliers", "f-threshold",
                                                             "threads"};
 
-// --level 0|1|2|auto and --method pmvs|patchmatch, shared by dense and reconstruct
-// (reconstruct_command.cc).
+// --level 0|1|2|auto, --max-image-size N, --method pmvs|patchmatch and the flag --no-fill, shared by dense and
+// reconstruct (reconstruct_command.cc).
 Status ReadDenseArgs(const Args& args, DenseStageOptions* dense);
-inline const std::set<std::string> kDenseValuedOptions = {"level", "method"};
+inline const std::set<std::string> kDenseValuedOptions = {"level", "method", "max-image-size"};
 
 // Shared by export and mesh (cmd_export.cc): creates the parent directory of an output file, and
 // prints "<verb> <path>: N vertices, M triangles[, normals][, colours]" on stdout.

@@ -15,7 +15,7 @@
 namespace reconar::tools {
 namespace {
 
-const std::set<std::string> kFlags = {"no-tags-in-ba", "no-preview", "force", "json", "fixed-distortion"};
+const std::set<std::string> kFlags = {"no-tags-in-ba", "no-preview", "force", "json", "fixed-distortion", "no-fill"};
 
 std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
@@ -71,6 +71,8 @@ Status ReadDenseArgs(const Args& args, DenseStageOptions* dense) {
   } else {
     return InvalidArgument("--level must be 0, 1, 2 or auto, got '" + level + "'");
   }
+  RECONAR_ASSIGN_OR_RETURN(dense->max_image_size, args.GetInt("max-image-size", dense->max_image_size, 0, 1 << 20));
+  if (args.Has("no-fill")) dense->patchmatch.fill_min_support = 0;
   if (args.Has("method")) {
     RECONAR_ASSIGN_OR_RETURN(dense->method, ParseDenseMethod(args.Get("method")));
   }

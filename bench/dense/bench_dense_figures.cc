@@ -5,7 +5,7 @@
 //
 // Usage: bench_dense_figures bunny|templering [--method pmvs|patchmatch] [--level L] [--threads N]
 //                            [--depth D] [--trim T] [--stride S] [--project DIR] [--keep-outliers]
-//                            [--visibility-angle DEG] [shared_data_dir]
+//                            [--visibility-angle DEG] [--no-fill] [shared_data_dir]
 // --keep-outliers runs the dense stage without its outlier filter, then applies the filter here and
 // says how many of the points each of its two tests removes, and keeps, are wrong by the scene's
 // truth: farther than two pixel footprints from bun_zipper's surface, or outside templeRing's box.
@@ -29,6 +29,7 @@ namespace {
 struct Args {
   std::string scene;
   DenseMethod method = DenseMethod::kPmvs;
+  PatchMatchOptions patchmatch;  // --no-fill: PatchMatchOptions::fill_min_support 0
   bool keep_outliers = false;
   int level = -2;  // -2: the scene's default (bunny 0, templeRing 1)
   int threads = 0;
@@ -45,7 +46,7 @@ int Usage(const char* message) {
                "bench_dense_figures: %s\n"
                "usage: bench_dense_figures bunny|templering [--method pmvs|patchmatch] [--level L] [--threads N]\n"
                "                           [--depth D] [--trim T] [--stride S] [--project DIR] [--keep-outliers]\n"
-               "                           [--visibility-angle DEG] [shared_data_dir]\n",
+               "                           [--visibility-angle DEG] [--no-fill] [shared_data_dir]\n",
                message);
   return 2;
 }
@@ -109,6 +110,7 @@ int RunBunny(const Args& args, const std::string& project) {
   testing::BunnyDenseOptions options;
   options.method = args.method;
   options.remove_outliers = !args.keep_outliers;
+  options.patchmatch = args.patchmatch;
   options.level = args.level == -2 ? 0 : args.level;
   options.num_threads = args.threads;
   options.poisson.depth = args.depth;
@@ -158,6 +160,7 @@ int RunTempleRing(const Args& args, const std::string& project) {
   testing::TempleRingDenseOptions options;
   options.method = args.method;
   options.remove_outliers = !args.keep_outliers;
+  options.patchmatch = args.patchmatch;
   options.level = args.level == -2 ? 1 : args.level;
   options.num_threads = args.threads;
   options.import.view_stride = args.stride;
@@ -200,6 +203,8 @@ int main(int argc, char** argv) {
       return 0;
     } else if (arg == "--keep-outliers") {
       args.keep_outliers = true;
+    } else if (arg == "--no-fill") {
+      args.patchmatch.fill_min_support = 0;
     } else if (arg == "--method" && has_value) {
       auto method = reconar::ParseDenseMethod(argv[++i]);
       if (!method.ok()) return reconar::Usage(method.status().ToString().c_str());

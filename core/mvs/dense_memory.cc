@@ -24,6 +24,15 @@ size_t EstimateDenseBytes(const DenseMemoryInput& input, int level, int cluster_
   return static_cast<size_t>(bytes);
 }
 
+int FinestLevelWithinSize(const std::vector<std::pair<int, int>>& image_sizes, int max_image_size) {
+  if (max_image_size <= 0) return 0;
+  int longest = 0;
+  for (const auto& [width, height] : image_sizes) longest = std::max({longest, width, height});
+  int level = 0;
+  while (level < kMaxDenseLevel && (longest >> level) > max_image_size) ++level;
+  return level;
+}
+
 Result<DenseLevelChoice> ChooseDenseLevel(const DenseMemoryInput& input, int requested_level, size_t budget_bytes,
                                           int min_cluster_size) {
   if (requested_level < -1 || requested_level > kMaxDenseLevel) {
@@ -32,7 +41,8 @@ Result<DenseLevelChoice> ChooseDenseLevel(const DenseMemoryInput& input, int req
   const int images = static_cast<int>(input.image_sizes.size());
   const int wanted = std::max(1, std::min(input.max_cluster_size, images));
   DenseLevelChoice choice;
-  const int first = requested_level < 0 ? 0 : requested_level;
+  const int first =
+      requested_level < 0 ? FinestLevelWithinSize(input.image_sizes, input.max_image_size) : requested_level;
   const int last = requested_level < 0 ? kMaxDenseLevel : requested_level;
   for (int level = first; level <= last; ++level) {
     const size_t bytes = EstimateDenseBytes(input, level, wanted);

@@ -35,7 +35,13 @@ struct DenseMemoryInput {
   double work_bytes_per_pixel = PmvsWorkBytesPerPixel(2);  // the method's, see above
   int num_threads = 1;
   size_t baseline_bytes = 0;  // already held by the caller (model, merged points so far)
+  // The automatic level skips the levels at which the longest image side exceeds this (0: none);
+  // the coarsest level is taken when every level does.
+  int max_image_size = 0;
 };
+
+// The finest level 0..kMaxDenseLevel at which no image's longest side exceeds max_image_size.
+int FinestLevelWithinSize(const std::vector<std::pair<int, int>>& image_sizes, int max_image_size);
 
 // Estimated peak bytes for a cluster of `cluster_size` of the largest images at `level`.
 size_t EstimateDenseBytes(const DenseMemoryInput& input, int level, int cluster_size);
@@ -47,9 +53,10 @@ struct DenseLevelChoice {
   bool reduced_cluster_size = false;
 };
 
-// requested_level -1: the finest level whose estimate fits the budget at the requested cluster
-// size; otherwise that level. When even that does not fit, the cluster size shrinks (not below
-// min_cluster_size). ResourceExhausted, with the numbers, when nothing fits.
+// requested_level -1: the finest level from FinestLevelWithinSize(input) whose estimate fits the
+// budget at the requested cluster size; otherwise that level. When even that does not fit, the
+// cluster size shrinks (not below min_cluster_size). ResourceExhausted, with the numbers, when
+// nothing fits.
 Result<DenseLevelChoice> ChooseDenseLevel(const DenseMemoryInput& input, int requested_level, size_t budget_bytes,
                                           int min_cluster_size);
 

@@ -9,8 +9,10 @@
 namespace reconar {
 namespace {
 
+// Cell indices are clamped to +-2^30 (MergeOrientedPoints' cell_of): only absurdly far points
+// share the boundary cells, and their distance tests stay exact.
 struct CellKey {
-  int64_t x, y, z;
+  int32_t x, y, z;
   bool operator==(const CellKey& other) const { return x == other.x && y == other.y && z == other.z; }
 };
 
@@ -27,7 +29,8 @@ class CellChains {
     }
   }
   int32_t Next(int32_t point) const { return next_[static_cast<size_t>(point)]; }
-  // Adds point `point` (the next index, 0, 1, 2, ...) to the cell's chain.
+  void ReservePoints(size_t points) { next_.reserve(points); }
+  // Adds point `point` (the next index, 0, 1, 2, ...; see Skip) to the cell's chain.
   void Add(const CellKey& key, int32_t point) {
     if (2 * (used_ + 1) > heads_.size()) Rehash(2 * heads_.size());
     size_t slot = Hash(key) & mask_;
@@ -39,6 +42,8 @@ class CellChains {
     next_.push_back(heads_[slot]);
     heads_[slot] = point;
   }
+  // The next point (by index) is in no cell.
+  void Skip() { next_.push_back(-1); }
 
  private:
   static size_t Hash(const CellKey& key) {
@@ -110,58 +115,88 @@ OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeRe
     std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2, footprints.end());
     cell = footprints[footprints.size() / 2];
   }
-  const auto cell_of = [cell](float v) { return static_cast<int64_t>(std::floor(v / cell)); };
-  CellChains grid;
-  OrientedPoints merged;
-  size_t dropped = 0;
-  for (const Ref& ref : order) {
+  std::vector<float>().swap(footprints);
+  const auto cell_of = [cell](float v) {
+    constexpr double kLimit = 1 << 30;
+    return static_cast<int32_t>(std::clamp(std::floor(static_cast<double>(v) / cell), -kLimit, kLimit));
+  };
+  const auto position_of = [&parts](const Ref& ref) -> const Eigen::Vector3f& {
+    return parts[ref.part].points.positions[ref.index];
+  };
+  const auto normal_of = [&parts](const Ref& ref) {
     const OrientedPoints& source = parts[ref.part].points;
-    const Eigen::Vector3f& position = source.positions[ref.index];
-    const Eigen::Vector3f normal =
-        ref.index < source.normals.size() ? source.normals[ref.index] : Eigen::Vector3f::Zero();
-    const float footprint =
-        ref.index < parts[ref.part].footprints.size() ? parts[ref.part].footprints[ref.index] : 0.0f;
-    bool duplicate = false;
-    if (footprint > 0.0f && std::isfinite(footprint)) {
-      // The cells the ball of radius `footprint` reaches (2 per axis when it is at most a cell); a
-      // footprint many cells wide is capped to 9 cells per axis (rare outliers).
-      int64_t low[3], high[3];
-      for (int a = 0; a < 3; ++a) {
-        const int64_t centre = cell_of(position[a]);
-        low[a] = std::max(cell_of(position[a] - footprint), centre - 4);
-        high[a] = std::min(cell_of(position[a] + footprint), centre + 4);
-      }
-      const float radius2 = footprint * footprint;
-      for (int64_t z = low[2]; z <= high[2] && !duplicate; ++z) {
-        for (int64_t y = low[1]; y <= high[1] && !duplicate; ++y) {
-          for (int64_t x = low[0]; x <= high[0] && !duplicate; ++x) {
-            for (int32_t k = grid.Head(CellKey{x, y, z}); k >= 0; k = grid.Next(k)) {
-              const size_t kept = static_cast<size_t>(k);
-              if ((merged.positions[kept] - position).squaredNorm() <= radius2 &&
-                  merged.normals[kept].dot(normal) > 0.0f) {
-                duplicate = true;
-                break;
+    return ref.index < source.normals.size() ? source.normals[ref.index] : Eigen::Vector3f::Zero();
+  };
+  const auto footprint_of = [&parts](const Ref& ref) {
+    return ref.index < parts[ref.part].footprints.size() ? parts[ref.part].footprints[ref.index] : 0.0f;
+  };
+  // Which points are kept, first; the output is built afterwards at its exact size, once the cell
+  // table is gone (a merge of millions of points is the dense stage's memory peak). The table
+  // chains the positions in `order` of the kept points.
+  std::vector<uint8_t> kept(order.size(), 0);
+  size_t kept_count = 0;
+  {
+    CellChains grid;
+    grid.ReservePoints(order.size());
+    for (size_t r = 0; r < order.size(); ++r) {
+      const Eigen::Vector3f& position = position_of(order[r]);
+      const Eigen::Vector3f normal = normal_of(order[r]);
+      const float footprint = footprint_of(order[r]);
+      bool duplicate = false;
+      if (footprint > 0.0f && std::isfinite(footprint)) {
+        // The cells the ball of radius `footprint` reaches (2 per axis when it is at most a cell); a
+        // footprint many cells wide is capped to 9 cells per axis (rare outliers).
+        int32_t low[3], high[3];
+        for (int a = 0; a < 3; ++a) {
+          const int32_t centre = cell_of(position[a]);
+          low[a] = std::max(cell_of(position[a] - footprint), centre - 4);
+          high[a] = std::min(cell_of(position[a] + footprint), centre + 4);
+        }
+        const float radius2 = footprint * footprint;
+        for (int32_t z = low[2]; z <= high[2] && !duplicate; ++z) {
+          for (int32_t y = low[1]; y <= high[1] && !duplicate; ++y) {
+            for (int32_t x = low[0]; x <= high[0] && !duplicate; ++x) {
+              for (int32_t k = grid.Head(CellKey{x, y, z}); k >= 0; k = grid.Next(k)) {
+                const Ref& other = order[static_cast<size_t>(k)];
+                if ((position_of(other) - position).squaredNorm() <= radius2 && normal_of(other).dot(normal) > 0.0f) {
+                  duplicate = true;
+                  break;
+                }
               }
             }
           }
         }
       }
+      // Every point enters the table's chain array (so that chain entries are order positions);
+      // only the kept ones are linked into a cell.
+      if (duplicate) {
+        grid.Skip();
+        continue;
+      }
+      grid.Add(CellKey{cell_of(position.x()), cell_of(position.y()), cell_of(position.z())}, static_cast<int32_t>(r));
+      kept[r] = 1;
+      ++kept_count;
     }
-    if (duplicate) {
-      ++dropped;
-      continue;
-    }
-    grid.Add(CellKey{cell_of(position.x()), cell_of(position.y()), cell_of(position.z())},
-             static_cast<int32_t>(merged.positions.size()));
-    merged.positions.push_back(position);
-    merged.normals.push_back(normal);
+  }
+  OrientedPoints merged;
+  merged.positions.reserve(kept_count);
+  merged.normals.reserve(kept_count);
+  merged.colors.reserve(kept_count);
+  merged.scores.reserve(kept_count);
+  if (kept_footprints != nullptr) kept_footprints->reserve(kept_count);
+  for (size_t r = 0; r < order.size(); ++r) {
+    if (!kept[r]) continue;
+    const Ref& ref = order[r];
+    const OrientedPoints& source = parts[ref.part].points;
+    merged.positions.push_back(position_of(ref));
+    merged.normals.push_back(normal_of(ref));
     merged.colors.push_back(ref.index < source.colors.size() ? source.colors[ref.index] : std::array<uint8_t, 3>{0, 0, 0});
     merged.scores.push_back(ref.score);
-    if (kept_footprints != nullptr) kept_footprints->push_back(footprint);
+    if (kept_footprints != nullptr) kept_footprints->push_back(footprint_of(ref));
   }
   if (report != nullptr) {
     report->input_points = order.size();
-    report->duplicates_dropped = dropped;
+    report->duplicates_dropped = order.size() - kept_count;
   }
   return merged;
 }

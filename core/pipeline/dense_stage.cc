@@ -151,6 +151,7 @@ Status DenseStageOptions::Check() const {
     return InvalidArgument("dense: level must be -1 (auto), 0, 1 or 2, got " + std::to_string(level));
   }
   if (memory_budget_bytes == 0) return InvalidArgument("dense: the memory budget must be positive");
+  if (max_image_size < 0) return InvalidArgument("dense: max_image_size must be 0 (none) or positive");
   RECONAR_RETURN_IF_ERROR(clustering.Check());
   RECONAR_RETURN_IF_ERROR(outliers.Check());
   RECONAR_RETURN_IF_ERROR(patchmatch.Check());
@@ -201,6 +202,7 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
       patchmatch ? static_cast<double>(kPatchMatchBytesPerPixel) : PmvsWorkBytesPerPixel(options.mvs.cell_size);
   memory.num_threads = num_threads;
   memory.baseline_bytes = CurrentMemoryUsage().resident_bytes;
+  memory.max_image_size = options.max_image_size;
   // The fewest views a cluster needs for the method to make a point.
   const int min_views = patchmatch ? options.patchmatch.fusion_min_views + 1 : options.mvs.min_visible_views;
   const int min_cluster = std::max(options.clustering.min_views_per_point, min_views);
@@ -211,6 +213,8 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   if (patchmatch) choice = GrowClusterToBudget(memory, choice, options.memory_budget_bytes);
   report.level = choice.level;
   report.level_auto = options.level < 0;
+  if (report.level_auto)
+    report.finest_level_within_size = FinestLevelWithinSize(memory.image_sizes, options.max_image_size);
   report.estimated_bytes = choice.estimated_bytes;
   report.max_cluster_size = std::max(choice.max_cluster_size, options.clustering.min_views_per_point);
   report.cluster_size_reduced = choice.reduced_cluster_size;
@@ -354,6 +358,7 @@ std::string DenseReportJson(const DenseStageReport& report) {
   json.Key("method").String(DenseMethodName(report.method));
   json.Key("level").Int(report.level);
   json.Key("level_chosen_from_memory_budget").Bool(report.level_auto);
+  json.Key("finest_level_within_max_image_size").Int(report.finest_level_within_size);
   json.Key("estimated_cluster_mib").Double(static_cast<double>(report.estimated_bytes) / (1 << 20));
   json.Key("max_cluster_size").Int(report.max_cluster_size);
   json.Key("cluster_size_reduced_for_budget").Bool(report.cluster_size_reduced);

@@ -34,7 +34,12 @@ struct DenseStageOptions {
   // PatchMatch by default (issue 16: on the README's room 0.21 of PMVS's dense time with 3.3 times
   // the points; on the rendered bunny 0.48 mm against PMVS's 1.09 mm; docs/dense.md).
   DenseMethod method = DenseMethod::kPatchMatch;
-  int level = -1;  // -1: the finest level 0..2 whose memory estimate fits the budget; else 0, 1 or 2
+  int level = -1;  // -1: the finest level 0..2 within max_image_size whose memory estimate fits the budget
+  // The automatic level's cap on the longest image side, in pixels (0: none). 2400 is COLMAP's
+  // default ("high" quality of its automatic reconstructor; OpenMVS halves every image by
+  // default): a 3072 x 2048 photo is matched at level 1. On fountain-P11 level 0 took 4.2 times
+  // level 1's dense time (docs/dense.md).
+  int max_image_size = 2400;
   size_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
   ViewClusteringOptions clustering;
   PatchMvsOptions mvs;  // its num_threads 0 takes the stage's
@@ -56,6 +61,7 @@ struct DenseStageReport {
   DenseMethod method = DenseMethod::kPatchMatch;
   int level = 0;
   bool level_auto = false;
+  int finest_level_within_size = 0;  // auto: the finest level within max_image_size (the level is not finer)
   size_t estimated_bytes = 0;     // the memory model's figure for one cluster at that level
   int max_cluster_size = 0;       // as used (below the requested one when the budget demanded it)
   bool cluster_size_reduced = false;

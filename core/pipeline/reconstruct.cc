@@ -354,7 +354,10 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
            {&r.load, &r.clustering, &r.undistort, &r.mvs, &r.merge, &r.outlier_filter, &r.write}) {
         summary->peak_rss_bytes = std::max(summary->peak_rss_bytes, phase->peak_rss_bytes);
       }
-      if (r.level_auto && r.level > 0) summary->note = "level " + std::to_string(r.level) + " for the memory budget";
+      if (r.level_auto && r.level > 0) {
+        summary->note = "level " + std::to_string(r.level) +
+                        (r.level > r.finest_level_within_size ? " for the memory budget" : " for the image size limit");
+      }
       if (r.cluster_size_reduced) {
         summary->note += std::string(summary->note.empty() ? "" : "; ") + "clusters of at most " +
                          std::to_string(r.max_cluster_size) + " images for the memory budget";
@@ -362,12 +365,14 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       return Status::Ok();
     };
     std::string dense_settings = Settings({{"level", dense.level},
+                                           {"max_image_size", dense.max_image_size},
                                            {"max_cluster_size", dense.clustering.max_cluster_size},
                                            {"budget_mib", Mib(budget)},
                                            {"remove_outliers", dense.remove_outliers ? 1.0 : 0.0}});
     // PMVS records no method, so that the projects made before the choice existed stay finished.
     if (dense.method != DenseMethod::kPmvs) {
-      dense_settings += " " + Settings({{"method", static_cast<double>(dense.method)}});
+      dense_settings += " " + Settings({{"method", static_cast<double>(dense.method)},
+                                        {"fill_min_support", dense.patchmatch.fill_min_support}});
     }
     RECONAR_RETURN_IF_ERROR(
         runner.Run("dense", dense_settings, Exists(project.root() + "/dense/report.json"), runner.redone(), run_dense));

@@ -29,6 +29,7 @@ Result<BunnyDenseFigures> RunBunnyDense(const Mesh& bunny, const std::string& pr
   start = Clock::now();
   DenseStageOptions dense = DenseRunOptions(options.method, options.level, options.num_threads);
   dense.remove_outliers = options.remove_outliers;
+  dense.patchmatch = options.patchmatch;
   RECONAR_ASSIGN_OR_RETURN(figures.dense, RunDenseStage(Project(project_dir), dense));
   figures.seconds_dense = SecondsSince(start);
 

@@ -22,6 +22,7 @@ struct BunnyDenseOptions {
   bool remove_outliers = true;  // DenseStageOptions::remove_outliers
   int level = 0;
   int num_threads = 0;
+  PatchMatchOptions patchmatch;  // DenseStageOptions::patchmatch
   PoissonOptions poisson;  // depth 8; trim set by the caller (0 keeps Poisson's closure of the unseen base)
   size_t comparison_samples = 200'000;
 };

@@ -36,6 +36,7 @@ Result<TempleRingDenseFigures> RunTempleRingDense(const std::string& par_path, c
   const auto start = std::chrono::steady_clock::now();
   DenseStageOptions dense = DenseRunOptions(options.method, options.level, options.num_threads);
   dense.remove_outliers = options.remove_outliers;
+  dense.patchmatch = options.patchmatch;
   RECONAR_ASSIGN_OR_RETURN(figures.dense, RunDenseStage(Project(project_dir), dense));
   figures.seconds_dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   RECONAR_ASSIGN_OR_RETURN(const std::vector<Eigen::Vector3f> points, ReadDensePoints(project_dir));

@@ -43,6 +43,7 @@ struct TempleRingDenseOptions {
   bool remove_outliers = true;     // DenseStageOptions::remove_outliers
   int level = 1;                   // 0 full 640 x 480, 1 half
   int num_threads = 0;
+  PatchMatchOptions patchmatch;  // DenseStageOptions::patchmatch
   // Margin around the tight box: ~6 pixel footprints at level 0 (0.5 m / 1520 px = 0.33 mm), so
   // that the points' own error (a few footprints for PMVS on templeRing) keeps them inside.
   double box_margin_m = 0.002;

@@ -95,6 +95,15 @@ Status PatchMatchOptions::Check() const {
     return InvalidArgument(prefix + "coarse_levels must lie in [0, " + std::to_string(kMaxCoarseLevels) + "]");
   }
   if (fine_iterations < 0) return InvalidArgument(prefix + "fine_iterations must be >= 0");
+  if (fill_min_support < 0 || fill_min_support > 8) {
+    return InvalidArgument(prefix + "fill_min_support must lie in [0, 8] (of the 8 directions)");
+  }
+  if (!(fill_max_distance > 0.0 && fill_max_distance <= 1.0) || !(fill_max_relative_depth > 0.0) ||
+      !(fill_max_normal_deg > 0.0 && fill_max_normal_deg < 90.0)) {
+    return InvalidArgument(prefix +
+                           "need fill_max_distance in (0, 1], fill_max_relative_depth > 0 and fill_max_normal_deg "
+                           "in (0, 90)");
+  }
   if (geometric_iterations < 0) return InvalidArgument(prefix + "geometric_iterations must be >= 0");
   if (!(geometric_weight >= 0.0) || !(geometric_max_error_px > 0.0)) {
     return InvalidArgument(prefix + "geometric_weight must be >= 0 and geometric_max_error_px positive");

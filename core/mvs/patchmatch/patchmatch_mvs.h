@@ -61,6 +61,22 @@ struct PatchMatchOptions {
   // window below it (bilaterally weighted) gets no depth: what would match there is noise (black
   // velvet behind a studio object, a white wall's grain).
   double image_noise_std = 2.0;
+  // Added: planes for texture-poor pixels (below that floor: white walls, floors), after the planar
+  // prior of ACMP (Xu & Tao, "Planar Prior Assisted PatchMatch Multi-View Stereo", AAAI 2020),
+  // taken from reliable neighbours instead of a triangulation. After the sweeps of every level, a
+  // texture-poor pixel looks along the 8 directions (up to fill_max_distance of the longer image
+  // side) for the first pixel with texture whose cost is below max_cost; the planes of those
+  // pixels, intersected with its ray, agree when their depths differ by at most
+  // fill_max_relative_depth and their normals by at most fill_max_normal_deg. A plane that at least
+  // fill_min_support of them agree on, two of them in opposite directions, fills the pixel (their
+  // mean, at their mean cost): a plane fills the inside of its own outline and does not reach past
+  // it. Fusion then keeps what the other views' maps confirm. 0 turns it off. (Keeping the coarser
+  // level's plane at a texture-poor pixel instead, as multi-scale methods do, fattened templeRing's
+  // faces into the black velvet beside them: 0.961 of its points in the box against 0.981.)
+  int fill_min_support = 4;
+  double fill_max_distance = 0.25;
+  double fill_max_relative_depth = 0.02;
+  double fill_max_normal_deg = 15.0;
   int iterations = 4;  // red-black sweeps (each sweep: both colours)
   // Added: propagation tests, in each of the four directions, the plane of the cheapest pixel
   // among those 1, 3, ..., 11 pixels away (4 planes); with separate_near_neighbours the adjacent

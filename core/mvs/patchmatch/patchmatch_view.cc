@@ -20,6 +20,18 @@ constexpr int kFarSteps = 5;                   // far neighbours 3, 5, ..., 2 kF
 constexpr float kDepthPerturbation = 0.1f;     // relative depth range of a perturbation in sweep 0, ...
 constexpr float kNormalPerturbation = 0.5f;    // ... and of a normal's (added vector); both halve each sweep
 constexpr int kInitialisationSweep = 1 << 20;  // the random stream of the initial planes
+// The fill of texture-poor pixels (PatchMatchOptions::fill_min_support): its agreement tests, and
+// a plane found for a pixel.
+struct FillThresholds {
+  float max_relative_depth;
+  float min_normal_cos;
+};
+struct PlaneFill {
+  size_t pixel;
+  float depth;
+  Eigen::Vector3f normal;
+  float cost;
+};
 
 // A per-pixel SplitMix64 stream keyed by (view seed, pixel, sweep), so the result does not depend
 // on the thread count.
@@ -57,6 +69,7 @@ struct Scratch {
   std::vector<std::pair<float, int>> ranked;  // (cost, source) of the scored sources
   int scored = 0;                             // entries of `ranked` filled by the last Cost
   std::vector<std::pair<float, int>> winner;  // `ranked` of the best candidate so far
+  std::vector<int> fill_west, fill_east;      // FillTexturePoor's row scans
   int winner_count = 0;
   int count = 0;
   int padded_count = 0;  // count rounded up to kWarpLanes (the padding has weight 0)
@@ -138,7 +151,8 @@ class PatchMatchViewSolver {
         PixelRandom random(input_.seed, i, kInitialisationSweep);
         const float depth = RandomDepth(&random);
         const Eigen::Vector3f normal = RandomNormal(&random, Ray(x, y));
-        Store(i, depth, normal, ReferenceWindow(x, y, s) ? FullCost(i, x, y, depth, normal, false, s) : kNoDepthCost);
+        texture_poor_[i] = !ReferenceWindow(x, y, s);
+        Store(i, depth, normal, texture_poor_[i] ? kNoDepthCost : FullCost(i, x, y, depth, normal, false, s));
       }
     });
   }
@@ -172,7 +186,8 @@ class PatchMatchViewSolver {
           map_.source_masks[i] = coarse_mask;
         }
         float cost = kNoDepthCost;
-        if (ReferenceWindow(x, y, s)) {
+        texture_poor_[i] = !ReferenceWindow(x, y, s);
+        if (!texture_poor_[i]) {
           cost = map_.source_masks[i] == all_sources_ ? FullCost(i, x, y, depth, normal, false, s)
                                                       : Cost(x, y, depth, normal, false, map_.source_masks[i], s);
         }
@@ -184,13 +199,146 @@ class PatchMatchViewSolver {
   // Recomputes every pixel's cost for its current plane.
   void Rescore(bool geometric) {
     map_.source_masks.assign(map_.depth.size(), all_sources_);
+    texture_poor_.resize(map_.depth.size());
     ForRows([&](int y, Scratch* s) {
       for (int x = 0; x < map_.width; ++x) {
         const size_t i = map_.Index(x, y);
-        map_.cost[i] =
-            ReferenceWindow(x, y, s) ? FullCost(i, x, y, map_.depth[i], map_.Normal(i), geometric, s) : kNoDepthCost;
+        // A texture-poor pixel keeps its cost: kNoDepthCost, or that of its filled plane.
+        texture_poor_[i] = !ReferenceWindow(x, y, s);
+        if (!texture_poor_[i]) map_.cost[i] = FullCost(i, x, y, map_.depth[i], map_.Normal(i), geometric, s);
       }
     });
+  }
+
+  // The planes of texture-poor pixels from reliable neighbours (PatchMatchOptions::fill_min_support).
+  // Only planes matched photometrically serve: the filled ones are written after all are found.
+  // The first reliable pixel along each direction comes from scans: rows for east and west, and
+  // from the row above (below) for the three directions up (down), kept per pixel as the number
+  // of steps (0: none within fill_max_distance); 13 bytes per pixel of one view while it runs.
+  void FillTexturePoor() {
+    if (options_.fill_min_support <= 0) return;
+    const int width = map_.width, height = map_.height;
+    const size_t n = map_.depth.size();
+    const float max_cost = static_cast<float>(options_.max_cost);
+    // Reliable: a pixel with texture whose cost is below max_cost.
+    std::vector<uint8_t> reliable(n);
+    bool any_texture_poor = false;
+    for (size_t i = 0; i < n; ++i) {
+      reliable[i] = !texture_poor_[i] && map_.cost[i] < max_cost;
+      any_texture_poor |= texture_poor_[i] != 0;
+    }
+    if (!any_texture_poor) return;
+    // steps[6 i + d]: to the first reliable pixel from pixel i, d = 3 (0 up, 1 down) + dx + 1.
+    const int max_distance =
+        std::clamp(static_cast<int>(options_.fill_max_distance * std::max(width, height)), 1, 65535);
+    std::vector<uint16_t> steps(6 * n, 0);
+    for (int half = 0; half < 2; ++half) {  // 0: up (rows top to bottom), 1: down (bottom to top)
+      const int dy = half == 0 ? -1 : 1;
+      for (int k = 0; k < height; ++k) {
+        const int y = half == 0 ? k : height - 1 - k, py = y + dy;
+        if (py < 0 || py >= height) continue;
+        for (int x = 0; x < width; ++x) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int d = 3 * half + dx + 1, px = x + dx;
+            if (px < 0 || px >= width) continue;
+            const size_t q = map_.Index(px, py);
+            uint16_t step = 0;
+            if (reliable[q]) {
+              step = 1;
+            } else if (steps[6 * q + d] != 0 && steps[6 * q + d] < max_distance) {
+              step = static_cast<uint16_t>(steps[6 * q + d] + 1);
+            }
+            steps[6 * map_.Index(x, y) + static_cast<size_t>(d)] = step;
+          }
+        }
+      }
+    }
+    std::vector<std::vector<PlaneFill>> fills(static_cast<size_t>(height));
+    const FillThresholds thresholds{static_cast<float>(options_.fill_max_relative_depth),
+                                    static_cast<float>(std::cos(options_.fill_max_normal_deg * M_PI / 180.0))};
+    ForRows([&](int y, Scratch* s) {
+      // Along the row: the nearest reliable pixel to the west and to the east of each pixel.
+      std::vector<int>& west = s->fill_west;
+      std::vector<int>& east = s->fill_east;
+      west.assign(static_cast<size_t>(width), -1);
+      east.assign(static_cast<size_t>(width), -1);
+      for (int x = 1, last = -1; x < width; ++x) {
+        if (reliable[map_.Index(x - 1, y)]) last = x - 1;
+        west[static_cast<size_t>(x)] = last >= 0 && x - last <= max_distance ? last : -1;
+      }
+      for (int x = width - 2, last = -1; x >= 0; --x) {
+        if (reliable[map_.Index(x + 1, y)]) last = x + 1;
+        east[static_cast<size_t>(x)] = last >= 0 && last - x <= max_distance ? last : -1;
+      }
+      for (int x = 0; x < width; ++x) {
+        const size_t i = map_.Index(x, y);
+        if (!texture_poor_[i]) continue;
+        // Directions in a circle, so that d and d + 4 are opposite: E, SE, S, SW, W, NW, N, NE.
+        int qx[8], qy[8];
+        qx[0] = east[static_cast<size_t>(x)], qy[0] = y;
+        qx[4] = west[static_cast<size_t>(x)], qy[4] = y;
+        static constexpr int kCircle[6] = {5, 6, 7, 3, 2, 1};  // steps index (up: dx -1, 0, 1; down) -> circle
+        for (int d = 0; d < 6; ++d) {
+          const int step = steps[6 * i + static_cast<size_t>(d)];
+          const int c = kCircle[d];
+          qx[c] = step == 0 ? -1 : x + step * (d % 3 - 1);
+          qy[c] = y + step * (d < 3 ? -1 : 1);
+        }
+        FillPixel(x, y, qx, qy, thresholds, &fills[static_cast<size_t>(y)]);
+      }
+    });
+    for (const std::vector<PlaneFill>& row : fills) {
+      for (const PlaneFill& f : row) Store(f.pixel, f.depth, f.normal, f.cost);
+    }
+  }
+
+  // The fill of texture-poor pixel (x, y) from the reliable pixels (qx[d], qy[d]) in the 8
+  // directions of the circle (qx[d] < 0: none), appended to `fills` when enough agree.
+  void FillPixel(int x, int y, const int qx[8], const int qy[8], const FillThresholds& thresholds,
+                 std::vector<PlaneFill>* fills) const {
+    const float max_relative_depth = thresholds.max_relative_depth, min_normal_cos = thresholds.min_normal_cos;
+    const Eigen::Vector3f ray = Ray(x, y);
+    float depth[8], cost[8];
+    Eigen::Vector3f normal[8];
+    bool found[8] = {};
+    for (int d = 0; d < 8; ++d) {
+      if (qx[d] < 0) continue;
+      const size_t q = map_.Index(qx[d], qy[d]);
+      depth[d] = PropagatedDepth(qx[d], qy[d], ray);
+      normal[d] = map_.Normal(q);
+      cost[d] = map_.cost[q];
+      found[d] = depth[d] > 0.0f;
+    }
+    int best_count = 0, best_mask = 0;
+    for (int d = 0; d < 8; ++d) {
+      if (!found[d]) continue;
+      int mask = 0, count = 0;
+      for (int e = 0; e < 8; ++e) {
+        if (found[e] && std::abs(depth[e] - depth[d]) <= max_relative_depth * depth[d] &&
+            normal[e].dot(normal[d]) >= min_normal_cos) {
+          mask |= 1 << e;
+          ++count;
+        }
+      }
+      const bool opposite = (mask & (mask >> 4) & 0xF) != 0;  // agreeing planes on both sides
+      if (opposite && count > best_count) {
+        best_count = count;
+        best_mask = mask;
+      }
+    }
+    if (best_count < options_.fill_min_support) return;
+    float depth_sum = 0.0f, cost_sum = 0.0f;
+    Eigen::Vector3f normal_sum = Eigen::Vector3f::Zero();
+    for (int d = 0; d < 8; ++d) {
+      if (!(best_mask >> d & 1)) continue;
+      depth_sum += depth[d];
+      cost_sum += cost[d];
+      normal_sum += normal[d];
+    }
+    const float fill_depth = depth_sum / static_cast<float>(best_count);
+    const Eigen::Vector3f fill_normal = normal_sum.normalized();
+    if (!(fill_depth >= input_.depth_min && fill_depth <= input_.depth_max) || !(fill_normal.dot(ray) < 0.0f)) return;
+    fills->push_back({map_.Index(x, y), fill_depth, fill_normal, cost_sum / static_cast<float>(best_count)});
   }
 
   // Red pixels ((x + y) even), then black ones: a pixel reads only pixels of the other colour.
@@ -211,6 +359,7 @@ class PatchMatchViewSolver {
 
   void Reset() {
     map_.Reset(view_.width(), view_.height());
+    texture_poor_.assign(map_.depth.size(), 0);
     map_.source_masks.assign(map_.depth.size(), all_sources_);
   }
 
@@ -427,10 +576,8 @@ class PatchMatchViewSolver {
 
   void UpdatePixel(int x, int y, int sweep, bool geometric, Scratch* s) {
     const size_t i = map_.Index(x, y);
-    if (!ReferenceWindow(x, y, s)) {
-      map_.cost[i] = kNoDepthCost;
-      return;
-    }
+    if (texture_poor_[i]) return;  // no plane, or a filled one
+    ReferenceWindow(x, y, s);
     const Eigen::Vector3f ray = Ray(x, y);
     float best_depth = map_.depth[i], best_cost = map_.cost[i];
     Eigen::Vector3f best_normal = map_.Normal(i);
@@ -517,6 +664,7 @@ class PatchMatchViewSolver {
   int subset_size_ = 1;
   uint32_t all_sources_ = 0;
   std::vector<Scratch> scratch_;
+  std::vector<uint8_t> texture_poor_;  // per pixel: the reference window is below the texture floor
   WarpSumsFn warp_sums_ = ActiveWarpSumsKernel().sums;
 };
 
@@ -527,6 +675,7 @@ void RunPhotometricPatchMatch(const PatchMatchViewInput& input, const PatchMatch
   PatchMatchViewSolver solver(input, options, pool, map);
   solver.Initialise();
   for (int sweep = 0; sweep < options.iterations; ++sweep) solver.Sweep(sweep, false);
+  solver.FillTexturePoor();
 }
 
 void RunPatchMatchFromCoarse(const PatchMatchViewInput& input, const DepthMap& coarse_map, const DenseView& coarse_view,
@@ -534,6 +683,7 @@ void RunPatchMatchFromCoarse(const PatchMatchViewInput& input, const DepthMap& c
   PatchMatchViewSolver solver(input, options, pool, map);
   solver.InitialiseFromCoarse(coarse_map, coarse_view);
   for (int k = 0; k < options.fine_iterations; ++k) solver.Sweep(options.iterations + k, false);
+  solver.FillTexturePoor();
 }
 
 void RunGeometricPatchMatch(const PatchMatchViewInput& input, const PatchMatchOptions& options, ThreadPool* pool,

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/mvs/dense_memory.h"
+#include "core/mvs/undistort.h"
 
 namespace reconar {
 namespace {
@@ -107,6 +108,25 @@ TEST(DenseMemory, FinestLevelThatFitsThenSmallerClusters) {
   EXPECT_LT(choice->max_cluster_size, 20);
   EXPECT_EQ(ChooseDenseLevel(input, -1, 1 << 20, 3).status().code(), StatusCode::kResourceExhausted);
   EXPECT_EQ(ChooseDenseLevel(input, 3, level0, 3).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(DenseMemory, TheAutomaticLevelKeepsTheLongestSideWithinTheLimit) {
+  const std::vector<std::pair<int, int>> fountain(11, {3072, 2048});
+  EXPECT_EQ(FinestLevelWithinSize(fountain, 0), 0);
+  EXPECT_EQ(FinestLevelWithinSize(fountain, 3072), 0);
+  EXPECT_EQ(FinestLevelWithinSize(fountain, 2400), 1);
+  EXPECT_EQ(FinestLevelWithinSize(fountain, 1000), 2);
+  EXPECT_EQ(FinestLevelWithinSize(fountain, 100), kMaxDenseLevel);       // the coarsest when none fits
+  EXPECT_EQ(FinestLevelWithinSize({{640, 480}, {480, 3000}}, 2400), 1);  // portrait photos count their height
+  DenseMemoryInput input = ThirtyPhotos();
+  input.max_image_size = 2400;
+  const size_t plenty = EstimateDenseBytes(input, 0, 30) * 2;
+  auto choice = ChooseDenseLevel(input, -1, plenty, 3);
+  ASSERT_TRUE(choice.ok());
+  EXPECT_EQ(choice->level, 1);
+  choice = ChooseDenseLevel(input, 0, plenty, 3);  // a given level is kept
+  ASSERT_TRUE(choice.ok());
+  EXPECT_EQ(choice->level, 0);
 }
 
 TEST(DenseMemory, ClustersGrowToWhatTheBudgetHolds) {

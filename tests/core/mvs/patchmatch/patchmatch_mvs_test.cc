@@ -77,6 +77,8 @@ struct Evaluation {
   double median_normal_degrees = 0.0;
   double completeness = 0.0;  // of the eligible cells (see Evaluate)
   size_t eligible_cells = 0;
+  double panel_completeness = 0.0;  // of the eligible cells in blank panels
+  size_t panel_cells = 0;
 };
 
 // Completeness: a 2 x 2 pixel cell of a view is eligible when the surface point at its centre
@@ -110,7 +112,7 @@ Evaluation Evaluate(const TexturedBoxScene& scene, const TexturedBoxSceneOptions
   e.median_normal_degrees = Quantile(angles, 0.5);
 
   const int cell = 2, r = options.window_radius;
-  size_t covered = 0;
+  size_t covered = 0, panel_covered = 0;
   for (const DenseView* view : views) {
     const int cols = view->width() / cell, rows = view->height() / cell;
     std::vector<double> nearest(static_cast<size_t>(cols) * rows, std::numeric_limits<double>::infinity());
@@ -154,11 +156,17 @@ Evaluation Evaluate(const TexturedBoxScene& scene, const TexturedBoxSceneOptions
         }
         if (others < options.fusion_min_views) continue;
         ++e.eligible_cells;
-        if (nearest[static_cast<size_t>(cy) * cols + cx] <= view->Depth(hit.point) + 2.0 * e.footprint) ++covered;
+        const bool panel = scene.InBlankPanel(hit.face, hit.point);
+        e.panel_cells += panel;
+        if (nearest[static_cast<size_t>(cy) * cols + cx] <= view->Depth(hit.point) + 2.0 * e.footprint) {
+          ++covered;
+          panel_covered += panel;
+        }
       }
     }
   }
   e.completeness = e.eligible_cells ? static_cast<double>(covered) / e.eligible_cells : 0.0;
+  e.panel_completeness = e.panel_cells ? static_cast<double>(panel_covered) / e.panel_cells : 0.0;
   return e;
 }
 
@@ -318,6 +326,10 @@ TEST(PatchMatchMvsTest, RejectsBadOptionsAndViews) {
   expect_bad_option([](PatchMatchOptions* o) { o->coarse_levels = 5; });
   expect_bad_option([](PatchMatchOptions* o) { o->fusion_pixel_step = 0; });
   expect_bad_option([](PatchMatchOptions* o) { o->fine_iterations = -1; });
+  expect_bad_option([](PatchMatchOptions* o) { o->fill_min_support = 9; });
+  expect_bad_option([](PatchMatchOptions* o) { o->fill_max_distance = 0.0; });
+  expect_bad_option([](PatchMatchOptions* o) { o->fill_max_normal_deg = 90.0; });
+  expect_bad_option([](PatchMatchOptions* o) { o->fill_max_relative_depth = std::nan(""); });
 
   const PatchMatchOptions options;
   std::vector<const DenseView*> with_null = views;
@@ -359,6 +371,44 @@ TEST(PatchMatchMvsTest, HostileInputIsHandled) {
     for (size_t i = 0; i < result.value().size(); ++i) ASSERT_TRUE(result.value().positions[i].allFinite());
   } else {
     EXPECT_EQ(result.status().code(), StatusCode::kFailedPrecondition) << result.status().ToString();
+  }
+}
+
+// The box's sides are plain grey inside a textured frame (texture-poor panels, like white walls
+// between door frames): their pixels have no texture to match, so their planes come from the frame
+// (PatchMatchOptions::fill_min_support). The plain background beside the
+// ground is never enclosed by one plane, and must stay empty: every point lies on the surface
+// within the textured box's accuracy bound.
+TEST(PatchMatchMvsTest, TexturePoorPanelsTakeThePlaneOfTheirFrame) {
+  TexturedBoxSceneOptions scene_options = SceneOptions(240, 180);
+  scene_options.blank_panel_inset = 0.1;
+  scene_options.num_cameras = 24;  // 15 degrees apart: 3 or 4 of the first 6 see each of two sides within 60 degrees
+  const TexturedBoxScene scene(scene_options);
+  const std::vector<const DenseView*> views = FirstViews(scene, 6);
+  const std::vector<Eigen::Vector3d> sparse = SparsePoints(scene, views, 300);
+  PatchMatchOptions without;
+  without.fill_min_support = 0;
+  for (const PatchMatchOptions& options : {PatchMatchOptions(), without}) {
+    Result<OrientedPoints> result = RunPatchMatchMvs(views, sparse, options);
+    ASSERT_TRUE(result.ok()) << result.status().ToString();
+    const Evaluation e = Evaluate(scene, scene_options, views, options, *result);
+    const double bound_scale = e.footprint / e.sin_angle;
+    std::vector<double> distances;
+    for (const Eigen::Vector3f& x : result->positions) distances.push_back(scene.DistanceToSurface(x.cast<double>()));
+    const double farthest = *std::max_element(distances.begin(), distances.end());
+    std::printf(
+        "fill %d: %zu points; completeness %.3f of %zu cells, in panels %.3f of %zu; "
+        "distance 90%% %.3f px, farthest %.2f px\n",
+        options.fill_min_support, result->size(), e.completeness, e.eligible_cells, e.panel_completeness, e.panel_cells,
+        e.distance_90 / bound_scale, farthest / bound_scale);
+    ASSERT_GT(e.panel_cells, 500u);
+    EXPECT_LT(e.distance_90, 0.5 * bound_scale);
+    if (options.fill_min_support > 0) {
+      EXPECT_GT(e.panel_completeness, 0.8);
+      EXPECT_LT(farthest, 4.0 * bound_scale);
+    } else {
+      EXPECT_LT(e.panel_completeness, 0.5);  // the panels are texture-poor indeed
+    }
   }
 }
 

@@ -72,7 +72,8 @@ TexturedBoxScene::TexturedBoxScene(const TexturedBoxSceneOptions& options) : opt
         if (hit.hit) {
           const Face& f = faces_[hit.face];
           const Eigen::Vector3d local = hit.point - f.origin;
-          value = Texture(hit.face, local.dot(f.u), local.dot(f.v));
+          value =
+              InBlankPanel(hit.face, hit.point) ? kBlankPanelValue : Texture(hit.face, local.dot(f.u), local.dot(f.v));
         }
         const uint8_t g8 = static_cast<uint8_t>(std::clamp(std::lround(value * 255.0), 0L, 255L));
         view.gray.row(y)[x] = g8;
@@ -95,6 +96,14 @@ double TexturedBoxScene::Texture(int face, double a, double b) const {
   const double fine = ValueNoise(seed, a / options_.texel, b / options_.texel);
   const double coarse = ValueNoise(Hash(seed), a / (4.0 * options_.texel), b / (4.0 * options_.texel));
   return 0.1 + 0.8 * (0.6 * fine + 0.4 * coarse);
+}
+
+bool TexturedBoxScene::InBlankPanel(int face, const Eigen::Vector3d& x) const {
+  const double inset = options_.blank_panel_inset;
+  if (!(inset > 0.0) || face < 2 || face >= static_cast<int>(faces_.size())) return false;  // the box's sides
+  const Face& f = faces_[static_cast<size_t>(face)];
+  const double a = (x - f.origin).dot(f.u), b = (x - f.origin).dot(f.v);
+  return a > inset && a < f.extent_u - inset && b > inset && b < f.extent_v - inset;
 }
 
 SceneHit TexturedBoxScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const {

@@ -23,8 +23,13 @@ struct TexturedBoxSceneOptions {
   double box_height = 0.6;
   double ground_half_size = 2.5;   // ground square [-g, g]^2 at z = 0
   double texel = 0.02;             // lattice spacing of the fine noise octave (world units)
+  // > 0: the box's four sides are plain grey (kBlankPanelValue) inside a textured frame this wide:
+  // texture-poor panels, like white walls between door frames.
+  double blank_panel_inset = 0.0;
   uint64_t seed = 1;
 };
+
+constexpr double kBlankPanelValue = 0.55;
 
 struct SceneHit {
   bool hit = false;
@@ -44,6 +49,8 @@ class TexturedBoxScene {
   SceneHit Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
   // Distance from x to the nearest face, and that face's outward normal.
   double DistanceToSurface(const Eigen::Vector3d& x, Eigen::Vector3d* normal = nullptr) const;
+  // True when surface point x of `face` lies in a blank panel (TexturedBoxSceneOptions::blank_panel_inset).
+  bool InBlankPanel(int face, const Eigen::Vector3d& x) const;
   // True when `view` sees surface point x (x is the first hit along the ray to it).
   bool Sees(const DenseView& view, const Eigen::Vector3d& x) const;
 
