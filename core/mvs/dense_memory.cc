@@ -41,8 +41,9 @@ Result<DenseLevelChoice> ChooseDenseLevel(const DenseMemoryInput& input, int req
   const int images = static_cast<int>(input.image_sizes.size());
   const int wanted = std::max(1, std::min(input.max_cluster_size, images));
   DenseLevelChoice choice;
-  const int first =
-      requested_level < 0 ? FinestLevelWithinSize(input.image_sizes, input.max_image_size) : requested_level;
+  if (requested_level < 0)
+    choice.finest_level_within_size = FinestLevelWithinSize(input.image_sizes, input.max_image_size);
+  const int first = requested_level < 0 ? choice.finest_level_within_size : requested_level;
   const int last = requested_level < 0 ? kMaxDenseLevel : requested_level;
   for (int level = first; level <= last; ++level) {
     const size_t bytes = EstimateDenseBytes(input, level, wanted);

@@ -51,6 +51,7 @@ struct DenseLevelChoice {
   int max_cluster_size = 0;  // possibly below the requested one so that the estimate fits
   size_t estimated_bytes = 0;
   bool reduced_cluster_size = false;
+  int finest_level_within_size = 0;  // requested_level -1: FinestLevelWithinSize(input), where the search began
 };
 
 // requested_level -1: the finest level from FinestLevelWithinSize(input) whose estimate fits the

@@ -213,8 +213,7 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   if (patchmatch) choice = GrowClusterToBudget(memory, choice, options.memory_budget_bytes);
   report.level = choice.level;
   report.level_auto = options.level < 0;
-  if (report.level_auto)
-    report.finest_level_within_size = FinestLevelWithinSize(memory.image_sizes, options.max_image_size);
+  report.finest_level_within_size = choice.finest_level_within_size;
   report.estimated_bytes = choice.estimated_bytes;
   report.max_cluster_size = std::max(choice.max_cluster_size, options.clustering.min_views_per_point);
   report.cluster_size_reduced = choice.reduced_cluster_size;

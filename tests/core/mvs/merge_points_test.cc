@@ -124,6 +124,7 @@ TEST(DenseMemory, TheAutomaticLevelKeepsTheLongestSideWithinTheLimit) {
   auto choice = ChooseDenseLevel(input, -1, plenty, 3);
   ASSERT_TRUE(choice.ok());
   EXPECT_EQ(choice->level, 1);
+  EXPECT_EQ(choice->finest_level_within_size, 1);
   choice = ChooseDenseLevel(input, 0, plenty, 3);  // a given level is kept
   ASSERT_TRUE(choice.ok());
   EXPECT_EQ(choice->level, 0);
