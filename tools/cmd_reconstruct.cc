@@ -39,7 +39,12 @@ constexpr char kHelp[] =
     "                        written, for rendering on a handheld (default 500000; 0: keep all)\n"
     "  --formats LIST        mesh formats among ply,obj,glb,wrl (default all four)\n"
     "  --no-preview          do not render preview.png\n"
-    "  --contrast-threshold T, --max-features N, --first-octave O, --sift-memory-mib M   as `reconar features`\n"
+    "  --contrast-threshold T, --max-features N, --first-octave O, --sift-memory-mib M,\n"
+    "  --texture-poor-features N, --texture-poor-contrast C   as `reconar features`\n"
+    "  --texture-poor         for objects with little texture (a plaster figure, white walls): photos\n"
+    "                        under 1000 features extracted again at a lower contrast threshold;\n"
+    "                        images registered from 12 inliers when their two-view matches agree,\n"
+    "                        or from a registered neighbour's two-view geometry and 5 points\n"
     "  --force               redo every stage\n"
     "  --json                print report.json on stdout\n";
 

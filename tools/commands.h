@@ -26,6 +26,7 @@ int RunReconstructCommand(int argc, char** argv, int first, const char* help, bo
 #include "core/features/sift/sift.h"
 #include "core/mesh/mesh.h"
 #include "core/pipeline/dense_stage.h"
+#include "core/pipeline/feature_stage.h"
 #include "core/pipeline/match_stage.h"
 #include "tools/args.h"
 
@@ -34,8 +35,12 @@ namespace reconar::tools {
 // --first-octave, --max-features, --contrast-threshold and --sift-memory-mib (MiB) shared by
 // features, match, sfm and reconstruct.
 Result<SiftOptions> SiftOptionsFromArgs(const Args& args);
-inline const std::set<std::string> kSiftValuedOptions = {"first-octave", "max-features", "sift-memory-mib",
-                                                           "contrast-threshold"};
+inline const std::set<std::string> kSiftValuedOptions = {"first-octave",          "max-features",
+                                                         "sift-memory-mib",       "contrast-threshold",
+                                                         "texture-poor-features", "texture-poor-contrast"};
+// The feature stage's options: the SIFT ones above, --texture-poor-features N (default
+// texture_poor_features; 0: off) and --texture-poor-contrast C.
+Result<FeatureStageOptions> FeatureStageOptionsFromArgs(const Args& args, int texture_poor_features = 0);
 
 // --ratio, --checks, --min-inliers, --f-threshold and --threads over the values `options` holds.
 Status ReadMatchArgs(const Args& args, MatchStageOptions* options);

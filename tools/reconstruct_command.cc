@@ -15,7 +15,8 @@
 namespace reconar::tools {
 namespace {
 
-const std::set<std::string> kFlags = {"no-tags-in-ba", "no-preview", "force", "json", "fixed-distortion", "no-fill"};
+const std::set<std::string> kFlags = {"no-tags-in-ba",    "no-preview", "force",       "json",
+                                      "fixed-distortion", "no-fill",    "texture-poor"};
 
 std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
@@ -94,7 +95,9 @@ Status ReadDenseAndMeshArgs(const Args& args, ReconstructOptions* options) {
 
 Result<ReconstructOptions> OptionsFromArgs(const Args& args) {
   ReconstructOptions options;
-  RECONAR_ASSIGN_OR_RETURN(options.features.sift, SiftOptionsFromArgs(args));
+  if (args.Has("texture-poor")) UseTexturePoorSettings(&options);
+  RECONAR_ASSIGN_OR_RETURN(options.features,
+                           FeatureStageOptionsFromArgs(args, options.features.texture_poor_min_features));
   RECONAR_RETURN_IF_ERROR(ReadMatchArgs(args, &options.matching));
   RECONAR_RETURN_IF_ERROR(ReadMapperArgs(args, &options.sfm.mapper));
   RECONAR_ASSIGN_OR_RETURN(options.tag_size_m, args.GetDouble("tag-size", 0.0, 0.0, 100.0));

@@ -1,6 +1,7 @@
 #include "core/pipeline/feature_stage.h"
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -80,7 +81,8 @@ Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image
 
     WorkerExtractors& mine = extractors[worker];
     if (!mine.configured) mine.configured = std::make_unique<SiftExtractor>(options.sift);
-    auto result = mine.configured->Extract(gray.view());
+    SiftExtractor* used = mine.configured.get();
+    auto result = used->Extract(gray.view());
     if (!result.ok() && result.status().code() == StatusCode::kResourceExhausted && options.sift.first_octave < 0) {
       if (!mine.fallback) {
         SiftOptions fallback = options.sift;
@@ -88,12 +90,30 @@ Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image
         mine.fallback = std::make_unique<SiftExtractor>(fallback);
       }
       summary.warnings.push_back("first octave 0 used: " + result.status().message());
-      result = mine.fallback->Extract(gray.view());
+      used = mine.fallback.get();
+      result = used->Extract(gray.view());
     }
     if (!result.ok()) {
       skipped[i] = path + ": " + result.status().message();
       if (progress) progress->Advance();
       return;
+    }
+    summary.contrast_threshold = used->options().contrast_threshold;
+    const size_t first_count = result->keypoints.size();
+    while (static_cast<int>(result->keypoints.size()) < options.texture_poor_min_features &&
+           summary.contrast_threshold / 2.0 >= options.texture_poor_min_contrast_threshold) {
+      summary.contrast_threshold /= 2.0;
+      used->set_contrast_threshold(summary.contrast_threshold);
+      auto again = used->Extract(gray.view());
+      used->set_contrast_threshold(options.sift.contrast_threshold);
+      if (!again.ok()) break;
+      result = std::move(again);
+    }
+    if (summary.contrast_threshold < options.sift.contrast_threshold) {
+      char note[160];
+      std::snprintf(note, sizeof(note), "texture-poor: %zu features at contrast threshold %g, %zu at %g", first_count,
+                    options.sift.contrast_threshold, result->keypoints.size(), summary.contrast_threshold);
+      summary.warnings.push_back(note);
     }
     summary.num_features = static_cast<int>(result->keypoints.size());
     if (project != nullptr) {

@@ -258,14 +258,24 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       summary->note = feature_note;
       RECONAR_ASSIGN_OR_RETURN(const FeatureStageReport r, RunFeatureStage(image_paths, &project, features));
       for (const std::string& skipped : r.skipped) std::fprintf(stderr, "warning: skipped %s\n", skipped.c_str());
+      int texture_poor = 0;
+      for (const ImageFeatureSummary& image : r.extracted)
+        texture_poor += image.contrast_threshold < sift.contrast_threshold;
+      if (texture_poor > 0) {
+        summary->note += (summary->note.empty() ? "" : "; ") + std::to_string(texture_poor) +
+                         " texture-poor photo(s) extracted again at a lower contrast threshold";
+      }
       return Status::Ok();
     };
-    RECONAR_RETURN_IF_ERROR(runner.Run("features",
-                                       Settings({{"first_octave", sift.first_octave},
-                                                 {"max_features", sift.max_features},
-                                                 {"contrast_threshold", sift.contrast_threshold},
-                                                 {"arena_mib", Mib(sift.arena_bytes)}}),
-                                       FeaturesUpToDate(project, image_paths), false, run_features));
+    RECONAR_RETURN_IF_ERROR(
+        runner.Run("features",
+                   Settings({{"first_octave", sift.first_octave},
+                             {"max_features", sift.max_features},
+                             {"contrast_threshold", sift.contrast_threshold},
+                             {"arena_mib", Mib(sift.arena_bytes)},
+                             {"texture_poor_min_features", static_cast<double>(features.texture_poor_min_features)},
+                             {"texture_poor_min_contrast", features.texture_poor_min_contrast_threshold}}),
+                   FeaturesUpToDate(project, image_paths), false, run_features));
 
     MatchStageOptions matching = options.matching;
     matching.num_threads = threads;
@@ -309,6 +319,13 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     const auto run_mapping = [&](StageSummary* summary) -> Status {
       RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
       if (with_tags && !r.tags.metric) summary->note = "no metric registration: " + r.tags.reason;
+      if (r.mapper.models.size() > 1) {
+        std::string sizes;
+        for (size_t k = 1; k < r.mapper.models.size(); ++k)
+          sizes += (k > 1 ? ", " : "") + std::to_string(r.mapper.models[k].images.size());
+        summary->note += std::string(summary->note.empty() ? "" : "; ") + std::to_string(r.mapper.models.size()) +
+                         " models: the largest in sparse/, the others (" + sizes + " images) in sparse/model2...";
+      }
       if (!with_tags) {
         RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagsJsonPath()));
         RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagLayoutPath()));
@@ -319,12 +336,15 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       json.EndObject();
       return WriteFileAtomically(project.SparseDir() + "/report.json", json.str() + "\n");
     };
-    std::string mapping_settings = Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
-                                             {"max_error", mapper.max_reprojection_error_px},
-                                             {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
-                                             {"tag_size", options.tag_size_m},
-                                             {"world_tag", sfm.tags.registration.world_tag},
-                                             {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}});
+    std::string mapping_settings =
+        Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
+                  {"min_verified_inliers", static_cast<double>(mapper.registration_min_verified_inliers)},
+                  {"min_baseline_points", static_cast<double>(mapper.registration_min_baseline_points)},
+                  {"max_error", mapper.max_reprojection_error_px},
+                  {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
+                  {"tag_size", options.tag_size_m},
+                  {"world_tag", sfm.tags.registration.world_tag},
+                  {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}});
     // Tag projects map differently since images register by their known tags and the world tag is
     // fitted as a square (version 2): their recorded mapping is not reused. Others are unchanged.
     if (with_tags) mapping_settings += " " + Settings({{"tag_mapping", 2.0}});
@@ -441,6 +461,12 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     }
   }
   return report;
+}
+
+void UseTexturePoorSettings(ReconstructOptions* options) {
+  options->features.texture_poor_min_features = 1000;
+  options->sfm.mapper.registration_min_verified_inliers = 12;
+  options->sfm.mapper.registration_min_baseline_points = 5;
 }
 
 }  // namespace reconar

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <memory>
 
@@ -146,7 +147,8 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     if (done > shown) progress->Advance(done - shown);
     shown = std::max(shown, done);
   };
-  auto reconstruction = RunIncrementalMapper(images, pairs, options.mapper, &report.mapper, on_progress);
+  std::vector<Reconstruction> other_models;
+  auto reconstruction = RunIncrementalMapper(images, pairs, options.mapper, &report.mapper, on_progress, &other_models);
   if (progress) progress->Finish();
   if (!reconstruction.ok()) return reconstruction.status();
   if (options.tags.enabled) {
@@ -177,6 +179,19 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     }
     RECONAR_RETURN_IF_ERROR(WriteFileAtomically(project.TagsJsonPath(), TagRegistrationJson(report.tags, tag_family, size)));
   }
+  // The other models, each in sparse/model<K>/ (K as in the report's "models", the main one 1).
+  for (int k = 2;; ++k) {
+    const std::string dir = sparse + "/model" + std::to_string(k);
+    if (static_cast<size_t>(k) <= other_models.size() + 1) {
+      RECONAR_RETURN_IF_ERROR(CreateDirectories(dir));
+      RECONAR_RETURN_IF_ERROR(WriteColmapTextModel(other_models[static_cast<size_t>(k - 2)], dir));
+    } else {
+      std::error_code error;
+      if (!std::filesystem::exists(dir, error)) break;
+      std::filesystem::remove_all(dir, error);
+      if (error) return IoError(dir + ": cannot remove a stale model: " + error.message());
+    }
+  }
   // points3D.txt last: its presence marks a finished model (see the sfm command's reuse check).
   RECONAR_RETURN_IF_ERROR(WriteColmapTextModel(*reconstruction, sparse));
   report.seconds_write = SecondsSince(start);
@@ -196,6 +211,7 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("focal_35mm_equivalent_mm").Double(sfm.focal_35mm_equivalent);
   json->Key("initial_pair").String(m.initial_pair);
   json->Key("initial_pair_relaxations").Int(m.init_relaxations);
+  json->Key("registered_from_neighbour").Int(m.num_registered_from_neighbour);
   json->Key("principal_point_refined").Bool(m.principal_point_refined);
   json->Key("distortion_refined").Bool(m.distortion_refined);
   json->Key("aspect_refined").Bool(m.aspect_refined);
@@ -207,6 +223,18 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("global_bundle_adjustments").Int(m.num_global_ba);
   json->Key("failed_bundle_adjustments").Int(m.num_failed_ba);
   if (m.num_failed_ba > 0) json->Key("first_bundle_adjustment_failure").String(m.first_ba_failure);
+  json->Key("models").BeginArray();
+  for (size_t k = 0; k < m.models.size(); ++k) {
+    json->BeginObject();
+    json->Key("directory").String(k == 0 ? "sparse" : "sparse/model" + std::to_string(k + 1));
+    json->Key("registered").Int(static_cast<long long>(m.models[k].images.size()));
+    json->Key("points").Int(m.models[k].num_points);
+    json->Key("initial_pair").String(m.models[k].initial_pair);
+    json->Key("images").BeginArray();
+    for (const std::string& name : m.models[k].images) json->String(name);
+    json->EndArray().EndObject();
+  }
+  json->EndArray();
   json->Key("unregistered").BeginArray();
   for (const MapperReport::Unregistered& u : m.unregistered) {
     json->BeginObject().Key("image").String(u.name).Key("reason").String(u.reason).EndObject();

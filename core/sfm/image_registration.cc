@@ -4,6 +4,7 @@
 
 #include "core/geometry/absolute_pose.h"
 #include "core/sfm/tag_image_registration.h"
+#include "core/sfm/two_view_check.h"
 
 namespace reconar {
 
@@ -42,6 +43,29 @@ void AcceptRegistration(MapperModel* model, int image, const Rigid3& cam_from_wo
   model->failure[static_cast<size_t>(image)].clear();
 }
 
+namespace {
+
+// Empty when the pose has registration_min_inliers inliers, or fewer but verified as
+// MapperOptions says; otherwise why it is refused.
+std::string VerifyFewInliers(const MapperModel& model, int image, size_t num_correspondences,
+                             const AbsolutePoseResult& pose, double focal, const MapperOptions& options) {
+  if (pose.num_inliers >= options.registration_min_inliers) return "";
+  const std::string few = "the best pose has " + std::to_string(pose.num_inliers) + " inliers (" +
+                          std::to_string(options.registration_min_inliers) + " register without further checks)";
+  if (2 * static_cast<size_t>(pose.num_inliers) < num_correspondences) return few + " and they are under half";
+  const std::vector<TwoViewMatch> two_view = GatherTwoViewMatches(model, image);
+  const int consistent =
+      CountEpipolarConsistent(model, two_view, pose.cam_from_world, focal, options.registration_max_error_px);
+  if (static_cast<int>(two_view.size()) < options.registration_min_verified_inliers ||
+      consistent < options.registration_min_two_view_fraction * static_cast<double>(two_view.size())) {
+    return few + " and " + std::to_string(consistent) + " of its " + std::to_string(two_view.size()) +
+           " two-view matches to registered images lie on their epipolar lines";
+  }
+  return "";
+}
+
+}  // namespace
+
 bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, int image, const MapperOptions& options,
                    bool* focal_changed) {
   *focal_changed = false;
@@ -68,15 +92,22 @@ bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, i
   const bool focal_confirmed = model->CameraUsers(camera_id) >= 3 || !options.refine_focal;
   AbsolutePoseOptions pose_options;
   pose_options.max_error_px = options.registration_max_error_px * (focal_confirmed ? 1.0 : 2.0);
-  pose_options.min_inliers = options.registration_min_inliers;
+  pose_options.min_inliers = options.registration_min_verified_inliers;
   pose_options.refine_focal = !focal_confirmed;
   auto result = EstimateAbsolutePose(pixels, world, pose_camera, pose_options);
   if (result.ok() && !result->success() && !focal_confirmed) {
     result = EstimateAbsolutePoseUnknownFocal(pixels, world, pose_camera, pose_options);
   }
-  if (!result.ok() || !result->success()) {
-    std::string reason = "pose from " + std::to_string(pixels.size()) +
-                         " 2D-3D correspondences failed: " + (result.ok() ? result->reason : result.status().message());
+  std::string verification;
+  if (result.ok() && result->success()) {
+    verification = VerifyFewInliers(*model, image, pixels.size(), *result,
+                                    result->focal > 0.0 ? result->focal : camera.focal, options);
+  }
+  if (!result.ok() || !result->success() || !verification.empty()) {
+    std::string reason = "pose from " + std::to_string(pixels.size()) + " 2D-3D correspondences failed: " +
+                         (!verification.empty() ? verification
+                          : result.ok()         ? result->reason
+                                                : result.status().message());
     if (!images[static_cast<size_t>(image)].tags.empty()) {
       std::string tag_reason;
       if (RegisterImageByTags(model, images, image, options, &tag_reason)) return true;

@@ -3,10 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/geometry/essential_five_point.h"
-#include "core/geometry/ransac.h"
-#include "core/geometry/relative_pose.h"
 #include "core/sfm/mapper_adjustment.h"
+#include "core/sfm/pair_pose.h"
 #include "core/sfm/point_filter.h"
 #include "core/sfm/track_triangulation.h"
 
@@ -58,35 +56,14 @@ Result<std::string> TryInitialPair(MapperModel* model, const std::vector<MapperI
                                    MapperReport* report) {
   Reconstruction& rec = model->rec;
   const int a = pair.matches.image_a, b = pair.matches.image_b;
-  const SfmCamera& ca = rec.cameras[static_cast<size_t>(rec.images[static_cast<size_t>(a)].camera_id)];
-  const SfmCamera& cb = rec.cameras[static_cast<size_t>(rec.images[static_cast<size_t>(b)].camera_id)];
-  std::vector<Correspondence> samples;
-  samples.reserve(pair.matches.matches.size());
-  for (const FeatureMatch& m : pair.matches.matches) {
-    const Eigen::Vector2d& xa = rec.images[static_cast<size_t>(a)].keypoints[static_cast<size_t>(m.index_a)];
-    const Eigen::Vector2d& xb = rec.images[static_cast<size_t>(b)].keypoints[static_cast<size_t>(m.index_b)];
-    samples.push_back({Eigen::Vector2d((xa.x() - ca.cx) / ca.focal, (xa.y() - ca.cy) / ca.focal),
-                       Eigen::Vector2d((xb.x() - cb.cx) / cb.focal, (xb.y() - cb.cy) / cb.focal)});
-  }
-  RansacOptions ransac;
-  ransac.max_residual = options.max_reprojection_error_px / std::sqrt(ca.focal * cb.focal);
-  const auto essential = Ransac<EssentialFivePoint>::Run(samples.data(), static_cast<int>(samples.size()), ransac);
   const std::string pair_name = images[static_cast<size_t>(a)].name + " + " + images[static_cast<size_t>(b)].name;
-  if (!essential.ok() || essential->status != RansacStatus::kSuccess) {
-    return pair_name + ": no essential matrix";
-  }
-  std::vector<Correspondence> inliers;
-  for (size_t i = 0; i < samples.size(); ++i) {
-    if (essential->inlier_mask[i]) inliers.push_back(samples[i]);
-  }
-  const auto pose = RelativePoseFromEssential(essential->model, inliers.data(), static_cast<int>(inliers.size()));
+  const auto pose = EstimatePairPose(*model, pair, options);
   if (!pose.ok()) return pair_name + ": " + pose.status().message();
 
   SfmImage& ia = rec.images[static_cast<size_t>(a)];
   SfmImage& ib = rec.images[static_cast<size_t>(b)];
   ia.cam_from_world = Rigid3();
-  ib.cam_from_world.rotation = pose->R;
-  ib.cam_from_world.translation = pose->t;
+  ib.cam_from_world = pose->b_from_a;
   ia.registered = ib.registered = true;
   TriangulateImage(model, b, options);
   std::string reason = CheckInitialModel(*model, pair_name, bounds);

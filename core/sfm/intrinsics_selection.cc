@@ -28,6 +28,30 @@ void Restore(const Snapshot& snapshot, Reconstruction* rec) {
   for (size_t p = 0; p < rec->points.size(); ++p) rec->points[p].position = snapshot.points[p];
 }
 
+// A principal point beyond this fraction of the image's size from its centre is no camera's: with a
+// long lens on part of a ring, a shift of the principal point trades against a common tilt of the
+// cameras (dinoSparseRing's first seven views put it 570 px below a 480 px image, 10 degrees off).
+constexpr double kMaxPrincipalPointOffset = 0.25;
+// Radial coefficients beyond this are bogus (COLMAP's max_extra_param): with a long lens, k1 and k2
+// barely move the image and trade against the focal (templeSparseRing: k2 = 2.8 and the focal 4.5 %
+// long; dinoSparseRing: k2 = 338).
+constexpr double kMaxRadialCoefficient = 1.0;
+
+// The candidate's cameras are plausible in what it refines (the principal point only when it is
+// the data's choice: MapperOptions::PrincipalPoint::kAuto).
+bool PlausibleCameras(const Reconstruction& rec, const IntrinsicsChoice& choice, bool principal_point_optional) {
+  for (const SfmCamera& camera : rec.cameras) {
+    if (choice.principal_point && principal_point_optional &&
+        (std::fabs(camera.cx - 0.5 * (camera.width - 1)) > kMaxPrincipalPointOffset * camera.width ||
+         std::fabs(camera.cy - 0.5 * (camera.height - 1)) > kMaxPrincipalPointOffset * camera.height))
+      return false;
+    if (choice.distortion &&
+        (std::fabs(camera.k1) > kMaxRadialCoefficient || std::fabs(camera.k2) > kMaxRadialCoefficient))
+      return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 Result<IntrinsicsChoice> SelectIntrinsicsModel(MapperModel* model, const std::vector<MapperImage>& images,
@@ -47,7 +71,8 @@ Result<IntrinsicsChoice> SelectIntrinsicsModel(MapperModel* model, const std::ve
     const Result<double> cost = BundleAdjust(model, images, model->RegisteredImages(), adjustment, options, report);
     RECONAR_RETURN_IF_ERROR(CountFailedAdjustment(cost.status(), report));
     *result = Save(model->rec);
-    return cost.ok() ? cost.value() : std::numeric_limits<double>::infinity();
+    const bool plausible = PlausibleCameras(model->rec, choice, options.principal_point == PP::kAuto);
+    return cost.ok() && plausible ? cost.value() : std::numeric_limits<double>::infinity();
   };
   IntrinsicsChoice richest;
   richest.principal_point = options.principal_point != PP::kFixed;
@@ -67,7 +92,9 @@ Result<IntrinsicsChoice> SelectIntrinsicsModel(MapperModel* model, const std::ve
     for (const SfmPoint& point : model->rec.points) {
       residuals += point.deleted ? 0.0 : 2.0 * static_cast<double>(point.track.size());
     }
-    const double s2 = std::max(2.0 * richest_cost / std::max(residuals, 1.0), 1e-12);
+    // The noise level from the richest model, or from the plainest when the richest is refused.
+    const double reference_cost = std::isfinite(richest_cost) ? richest_cost : chosen_cost;
+    const double s2 = std::max(2.0 * reference_cost / std::max(residuals, 1.0), 1e-12);
     const double cameras = static_cast<double>(model->rec.cameras.size());
     const auto bic = [&](const IntrinsicsChoice& c, double cost) {
       const double parameters = cameras * (2.0 * c.principal_point + 2.0 * c.distortion + 1.0 * c.aspect);

@@ -56,9 +56,22 @@ struct MapperOptions {
   // floors (COLMAP's mapper relaxes the same way): texture-poor rooms have few matches per pair.
   int init_min_points_floor = 25;
   double init_min_angle_floor_deg = 1.0;
-  // Registration: P3P LO-RANSAC with this pixel threshold; a pose needs this many inliers.
+  // Registration: P3P LO-RANSAC with this pixel threshold; a pose with this many inliers registers.
   double registration_max_error_px = 4.0;
   int registration_min_inliers = 30;
+  // A pose with fewer inliers, down to registration_min_verified_inliers, registers when they are
+  // at least half of the image's 2D-3D correspondences and the pose puts at least
+  // registration_min_two_view_fraction of the image's matches to registered images on tracks
+  // without a point on their epipolar lines (of at least registration_min_verified_inliers such
+  // matches), after every candidate has been tried under the plain rule. Texture-poor objects and
+  // sparse rings rarely give 30 points in three views; 12 is `--texture-poor`'s
+  // (UseTexturePoorSettings), the default keeps the plain rule.
+  int registration_min_verified_inliers = 30;
+  double registration_min_two_view_fraction = 0.5;
+  // Registration from a registered neighbour's two-view geometry (neighbour_registration.h) when
+  // the absolute pose fails: this many model points must agree on the baseline's length; 0 (the
+  // default) turns it off, `--texture-poor` (UseTexturePoorSettings) sets 5.
+  int registration_min_baseline_points = 0;
   // Registration by tags (images with MapperImage::tags only, tag_image_registration.h): a pose
   // that puts every corner of every tag the model holds within registration_max_error_px
   // registers with fewer inliers when that is at least two such tags, or one and this many other
@@ -113,6 +126,9 @@ struct MapperOptions {
   enum class CameraSharing { kAuto, kPerImage, kSingle };
   CameraSharing camera_sharing = CameraSharing::kAuto;
   int num_threads = 0;  // <= 0: one per core
+  // When registration stops with images left that have verified matches among themselves, a new
+  // model is started from them, up to this many models in all; the largest is returned.
+  int max_models = 8;
 
   Status Check() const;
 };
@@ -129,7 +145,16 @@ struct MapperReport {
   int num_inconsistent_tracks = 0;
   std::string initial_pair;  // "a.jpg + b.jpg"
   int init_relaxations = 0;  // how often the initial-pair bounds were halved before one was found
+  int num_registered_from_neighbour = 0;  // images registered from a neighbour's two-view geometry
   std::vector<Unregistered> unregistered;
+  // Every model built, the returned (largest) one first: its images and point count. An image in
+  // another model is listed as unregistered with the reason "in model K".
+  struct Model {
+    std::vector<std::string> images;
+    int num_points = 0;
+    std::string initial_pair;
+  };
+  std::vector<Model> models;
   int num_local_ba = 0;
   int num_global_ba = 0;
   // Adjustments that failed numerically (the model was left as it was before each) and the
@@ -148,13 +173,15 @@ struct MapperReport {
 // Called after each registration with (registered, total).
 using MapperProgress = std::function<void(int, int)>;
 
-// Builds a model from the images and their verified pairwise matches. InvalidArgument for bad
+// Builds a model from the images and their verified pairwise matches, then further models from
+// the images left (MapperOptions::max_models), and returns the largest; the others, with every
+// image (unregistered where not theirs), go to *other_models when given. InvalidArgument for bad
 // options or inconsistent input (a match indexing a missing keypoint), or a bundle adjustment
-// refusing its problem (a programming error); FailedPrecondition, with
-// the reason, when no initial pair can be found (e.g. unrelated photos or too few matches).
+// refusing its problem (a programming error); FailedPrecondition, with the reason, when no
+// initial pair can be found (e.g. unrelated photos or too few matches).
 Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& images,
-                                            const std::vector<MapperPair>& pairs,
-                                            const MapperOptions& options, MapperReport* report,
-                                            const MapperProgress& progress = nullptr);
+                                            const std::vector<MapperPair>& pairs, const MapperOptions& options,
+                                            MapperReport* report, const MapperProgress& progress = nullptr,
+                                            std::vector<Reconstruction>* other_models = nullptr);
 
 }  // namespace reconar

@@ -21,6 +21,7 @@ struct MapperModel {
   std::vector<bool> camera_from_exif;  // per camera: the prior came from EXIF
   std::vector<std::string> failure;    // per image: why it is not registered (yet)
   std::vector<int> tried_with;         // per image: visible points at the last failed attempt
+  std::vector<int> neighbour_tried_with;  // the same for registration from a neighbour
 
   // A model over `tracks` with no point yet: every track untriangulated.
   void SetTracks(TrackSet track_set);

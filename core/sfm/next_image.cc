@@ -40,9 +40,9 @@ std::vector<NextImageCandidate> NextImageCandidates(MapperModel* model, const st
       }
     }
     if (visible == 0) continue;
-    if (visible < options.registration_min_inliers) {
+    if (visible < options.registration_min_verified_inliers) {
       model->failure[i] = "sees only " + std::to_string(visible) + " reconstructed points (need " +
-                          std::to_string(options.registration_min_inliers) + ")";
+                          std::to_string(options.registration_min_verified_inliers) + ")";
       continue;
     }
     if (visible <= model->tried_with[i]) continue;  // failed before and nothing new is visible

@@ -8,6 +8,7 @@
 #include "core/geometry/absolute_pose.h"
 #include "core/sfm/image_registration.h"
 #include "core/sfm/tag_observations.h"
+#include "core/sfm/two_view_check.h"
 
 namespace reconar {
 namespace {
@@ -103,17 +104,9 @@ struct Correspondences {
   std::vector<int> keypoint;  // the image's keypoint
   std::vector<int> point;     // its model point, -1 for a derived corner
   int num_corners = 0;
-  // Matches of the image's other keypoints to registered images on tracks without a point yet:
-  // (normalised point here, normalised point there, that image), for the epipolar check.
-  struct TwoView {
-    Eigen::Vector2d here, there;
-    int image;
-  };
-  std::vector<TwoView> two_view;
+  // The image's other keypoints' matches to registered images on tracks without a point yet.
+  std::vector<TwoViewMatch> two_view;
 };
-
-// At most this many two-view matches are checked.
-constexpr size_t kMaxTwoViewMatches = 2000;
 
 Correspondences Gather(const MapperModel& model, const std::vector<MapperImage>& images, int image,
                        const std::vector<KnownTag>& known) {
@@ -140,22 +133,7 @@ Correspondences Gather(const MapperModel& model, const std::vector<MapperImage>&
     c.keypoint.push_back(static_cast<int>(kp));
     c.point.push_back(model.point_of_track[static_cast<size_t>(t)]);
   }
-  const SfmCamera& camera =
-      model.rec.cameras[static_cast<size_t>(model.rec.images[static_cast<size_t>(image)].camera_id)];
-  for (size_t kp = 0; kp < track_of.size() && kp < in.keypoints.size(); ++kp) {
-    const int t = track_of[kp];
-    if (corner[kp] || t < 0 || model.point_of_track[static_cast<size_t>(t)] >= 0) continue;
-    Eigen::Vector2d here;
-    if (!camera.Undistort(in.keypoints[kp], &here)) continue;
-    for (const TrackElement& e : model.tracks.tracks[static_cast<size_t>(t)]) {
-      const SfmImage& other = model.rec.images[static_cast<size_t>(e.image_id)];
-      if (e.image_id == image || !other.registered || c.two_view.size() >= kMaxTwoViewMatches) continue;
-      Eigen::Vector2d there;
-      if (model.rec.cameras[static_cast<size_t>(other.camera_id)].Undistort(
-              other.keypoints[static_cast<size_t>(e.keypoint_id)], &there))
-        c.two_view.push_back({here, there, e.image_id});
-    }
-  }
+  c.two_view = GatherTwoViewMatches(model, image, &corner);
   return c;
 }
 
@@ -181,21 +159,8 @@ Verdict Judge(const MapperModel& model, const Correspondences& c, const RadialCa
     if (static_cast<int>(i) < c.num_corners) corner_squares += squared;
   }
   if (c.num_corners > 0) v.corner_rms_px = std::sqrt(corner_squares / c.num_corners);
-  for (const Correspondences::TwoView& m : c.two_view) {
-    // Sampson distance (pixels at the focal) under E = [t]x R of here_from_there.
-    const Rigid3& there_pose = model.rec.images[static_cast<size_t>(m.image)].cam_from_world;
-    const Eigen::Matrix3d R = cam_from_world.rotation * there_pose.rotation.transpose();
-    const Eigen::Vector3d t = cam_from_world.translation - R * there_pose.translation;
-    Eigen::Matrix3d tx;
-    tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
-    const Eigen::Matrix3d E = tx * R;
-    const Eigen::Vector3d x1 = m.there.homogeneous(), x2 = m.here.homogeneous();
-    const Eigen::Vector3d Ex1 = E * x1, Etx2 = E.transpose() * x2;
-    const double denominator = Ex1.head<2>().squaredNorm() + Etx2.head<2>().squaredNorm();
-    const double numerator = x2.dot(Ex1);
-    if (!(denominator > 0.0) || numerator * numerator <= bound / (camera.focal * camera.focal) * denominator)
-      ++v.two_view_consistent;
-  }
+  v.two_view_consistent =
+      CountEpipolarConsistent(model, c.two_view, cam_from_world, camera.focal, options.registration_max_error_px);
   std::vector<int> per_tag(static_cast<size_t>(c.num_corners / 4), 0);
   for (int i : v.inliers) {
     if (i < c.num_corners) {

@@ -60,7 +60,8 @@ Result<GroundTruthByName> ReadStrechaGroundTruth(const std::string& dir);
 // x ~ K [R | t] X. The file has no image size: width and height stay 0.
 // In file order. CorruptData "path:line: reason" for a malformed line, a count that disagrees with
 // the lines, a K that is not upper triangular with positive focal lengths and k33 = 1, or an R
-// that is not a rotation (|R^T R - I| > 1e-6, det < 0); Unsupported for a skewed K (k12 != 0).
+// that is not a rotation (|R^T R - I| > 1e-5, det < 0; within that, R is replaced by the nearest
+// rotation); Unsupported for a skewed K (k12 != 0).
 struct NamedGroundTruthCamera {
   std::string name;  // "templeR0001.png"
   GroundTruthCamera camera;

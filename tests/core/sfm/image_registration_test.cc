@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <vector>
 
@@ -11,16 +12,8 @@
 namespace reconar {
 namespace {
 
-testing::Scene RingScene() {
-  testing::SceneOptions o;
-  o.num_cameras = 8;
-  o.num_points = 1000;
-  o.noise_px = 0.4;
-  return testing::MakeScene(o);
-}
-
 TEST(ImageRegistrationTest, RecoversTheTruePoseAndAddsTheInlierObservations) {
-  const testing::Scene scene = RingScene();
+  const testing::Scene scene = testing::RegistrationRing();
   MapperModel model = testing::TrueModel(scene);
   const int image = 3;
   testing::Unregister(&model, image);
@@ -52,7 +45,7 @@ TEST(ImageRegistrationTest, RecoversTheTruePoseAndAddsTheInlierObservations) {
 }
 
 TEST(ImageRegistrationTest, FailureGivesTheReasonAndLeavesTheImageUnregistered) {
-  const testing::Scene scene = RingScene();
+  const testing::Scene scene = testing::RegistrationRing();
   MapperModel model = testing::TrueModel(scene);
   testing::Unregister(&model, 5);
   MapperOptions options;
@@ -65,11 +58,47 @@ TEST(ImageRegistrationTest, FailureGivesTheReasonAndLeavesTheImageUnregistered) 
   for (int id : model.rec.images[5].point3d_ids) EXPECT_EQ(id, -1);
 }
 
+// 15 correspondences are under the 30 that register unchecked, but all fit and the pose puts the
+// image's many two-view matches on their epipolar lines.
+TEST(ImageRegistrationTest, FewPointsRegisterWhenTheTwoViewMatchesAgree) {
+  const testing::Scene scene = testing::RegistrationRing();
+  MapperModel model = testing::TrueModelWithFewPointsSeenBy(scene, 3, 15);
+  bool focal_changed = true;
+  ASSERT_TRUE(RegisterImage(&model, scene.images, 3, testing::TexturePoorMapperOptions(), &focal_changed))
+      << model.failure[3];
+  const SfmImage& img = model.rec.images[3];
+  EXPECT_LT(RotationAngle(img.cam_from_world.rotation, scene.poses[3].rotation) * 180.0 / M_PI, 0.3);
+  EXPECT_LT((img.Center() - CameraCenterInWorld(scene.poses[3])).norm(), 0.1);  // ring radius 10
+}
+
+// The same 15 keypoints moved to where a camera tilted by 5 degrees would see their points: they
+// fit that wrong pose exactly, but the image's other matches do not lie on its epipolar lines.
+// (Tilted, not turned: the ring's baselines are horizontal, and a turn about the vertical moves
+// points along their epipolar lines, which no two-view check can see.)
+TEST(ImageRegistrationTest, FewPointsAgainstTheTwoViewMatchesAreRefused) {
+  const testing::Scene scene = testing::RegistrationRing();
+  MapperModel model = testing::TrueModelWithFewPointsSeenBy(scene, 3, 15);
+  Rigid3 wrong = scene.poses[3];
+  wrong.rotation = Eigen::AngleAxisd(5.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix() * wrong.rotation;
+  SfmImage& img = model.rec.images[3];
+  const std::vector<int>& track_of = model.tracks.track_of[3];
+  for (size_t kp = 0; kp < track_of.size(); ++kp) {
+    const int t = track_of[kp];
+    const int point = t < 0 ? -1 : model.point_of_track[static_cast<size_t>(t)];
+    if (point >= 0)
+      img.keypoints[kp] = scene.camera.Project(wrong * model.rec.points[static_cast<size_t>(point)].position);
+  }
+  bool focal_changed = true;
+  EXPECT_FALSE(RegisterImage(&model, scene.images, 3, testing::TexturePoorMapperOptions(), &focal_changed));
+  EXPECT_FALSE(model.rec.images[3].registered);
+  EXPECT_NE(model.failure[3].find("on their epipolar lines"), std::string::npos) << model.failure[3];
+}
+
 // Image 2 gets its own camera with an EXIF focal `factor` x the true one; no registered image
 // uses that camera yet, so the registration estimates the focal (paper eq. 5 keeps the EXIF
 // focal when it lies within 0.7-1.4 x the estimate).
 double FocalAfterRegistration(double factor) {
-  const testing::Scene scene = RingScene();
+  const testing::Scene scene = testing::RegistrationRing();
   std::vector<MapperImage> images = scene.images;
   images[2].focal_from_exif = true;
   images[2].focal_prior = factor * scene.camera.focal;
@@ -93,7 +122,7 @@ TEST(ImageRegistrationTest, UnconfirmedFocalIsEstimatedAndADistrustedExifFocalRe
 }
 
 TEST(ImageRegistrationTest, GuessCameraAveragesRegisteredCamerasOfTheSameSize) {
-  const testing::Scene scene = RingScene();
+  const testing::Scene scene = testing::RegistrationRing();
   MapperModel model = testing::TrueModel(scene);
   SfmCamera fresh = scene.camera;
   fresh.focal = 2000.0;

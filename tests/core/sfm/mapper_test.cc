@@ -5,13 +5,14 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <functional>
-#include <cmath>
-#include <random>
 #include <map>
+#include <random>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "tests/core/sfm/synthetic_scene.h"
@@ -446,6 +447,60 @@ TEST(IncrementalMapperTest, ImagesThatCannotBeRegisteredAreListedWithAReason) {
     EXPECT_FALSE(u.reason.empty()) << u.name;
   }
   EXPECT_EQ(names, (std::set<std::string>{"lonely.jpg", "weak.jpg"}));
+}
+
+// Two unrelated rings in one set: the larger is returned, the smaller becomes model 2 with every
+// one of its images, and neither takes an image of the other.
+TEST(IncrementalMapperTest, UnrelatedSetsBecomeSeparateModelsTheLargestFirst) {
+  SceneOptions small_options = SmallScene();
+  small_options.num_cameras = 6;
+  small_options.seed = 11;
+  const Scene large = MakeScene(SmallScene());
+  const Scene small = MakeScene(small_options);
+  std::vector<MapperImage> images = small.images;  // the smaller set first: its model starts first
+  for (MapperImage& image : images) image.name = "small_" + image.name;
+  std::vector<MapperPair> pairs = small.pairs;
+  const int offset = static_cast<int>(images.size());
+  images.insert(images.end(), large.images.begin(), large.images.end());
+  for (MapperPair pair : large.pairs) {
+    pair.matches.image_a += offset;
+    pair.matches.image_b += offset;
+    pairs.push_back(pair);
+  }
+  MapperReport report;
+  std::vector<Reconstruction> others;
+  Result<Reconstruction> result = RunIncrementalMapper(images, pairs, SingleThreaded(), &report, nullptr, &others);
+  ASSERT_TRUE(result.ok()) << result.status().ToString();
+  ExpectModelConsistent(*result, report, images.size());
+  ASSERT_EQ(report.models.size(), 2u);
+  ASSERT_EQ(others.size(), 1u);
+  EXPECT_EQ(report.models[0].images.size(), large.images.size());
+  EXPECT_EQ(report.models[1].images.size(), small.images.size());
+  EXPECT_EQ(report.models[0].num_points, result->NumPoints());
+  EXPECT_EQ(report.models[1].num_points, others[0].NumPoints());
+  for (size_t i = 0; i < images.size(); ++i) {
+    const bool in_large = static_cast<int>(i) >= offset;
+    EXPECT_EQ(result->images[i].registered, in_large) << images[i].name;
+    EXPECT_EQ(others[0].images[i].registered, !in_large) << images[i].name;
+  }
+  for (const auto& u : report.unregistered) {
+    EXPECT_EQ(u.name.rfind("small_", 0), 0u) << u.name;
+    EXPECT_NE(u.reason.find("in model 2"), std::string::npos) << u.name << ": " << u.reason;
+  }
+  // Each model is right on its own.
+  for (const auto& [model, scene, first] :
+       {std::tuple<const Reconstruction*, const Scene*, int>{&*result, &large, offset}, {&others[0], &small, 0}}) {
+    std::vector<testing::CameraPose> estimated, truth;
+    for (size_t i = 0; i < scene->images.size(); ++i) {
+      const SfmImage& image = model->images[i + static_cast<size_t>(first)];
+      estimated.push_back({image.cam_from_world.rotation, image.Center()});
+      truth.push_back({scene->poses[i].rotation, CameraCenterInWorld(scene->poses[i])});
+    }
+    const auto errors = testing::CameraCenterErrors(estimated, truth);
+    ASSERT_TRUE(errors.ok());
+    EXPECT_LT(errors->rotation_max_deg, 0.5);
+    EXPECT_LT(errors->centre_max, 0.01 * 10.0);  // ring radius 10
+  }
 }
 
 }  // namespace

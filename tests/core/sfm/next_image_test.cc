@@ -32,10 +32,11 @@ MapperModel HandMadeModel() {
   return model;
 }
 
-// The candidates with registration_min_inliers = 2.
+// The candidates when 2 points suffice to try.
 std::vector<NextImageCandidate> CandidatesOf(MapperModel* model) {
   MapperOptions options;
   options.registration_min_inliers = 2;
+  options.registration_min_verified_inliers = 2;
   return NextImageCandidates(model, {}, options);
 }
 

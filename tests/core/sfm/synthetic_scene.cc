@@ -257,4 +257,38 @@ int TruePointOf(const Scene& scene, const SfmPoint& point) {
   return scene.point_of_keypoint[static_cast<size_t>(e.image_id)][static_cast<size_t>(e.keypoint_id)];
 }
 
+MapperOptions TexturePoorMapperOptions() {
+  MapperOptions options;
+  options.registration_min_verified_inliers = 12;
+  options.registration_min_baseline_points = 5;
+  return options;
+}
+
+Scene RegistrationRing() {
+  SceneOptions o;
+  o.num_cameras = 8;
+  o.num_points = 1000;
+  o.noise_px = 0.4;
+  return MakeScene(o);
+}
+
+MapperModel TrueModelWithFewPointsSeenBy(const Scene& scene, int image, int keep) {
+  MapperModel model = TrueModel(scene);
+  Unregister(&model, image);
+  int kept = 0;
+  const std::vector<int>& track_of = model.tracks.track_of[static_cast<size_t>(image)];
+  for (size_t kp = 0; kp < track_of.size(); ++kp) {
+    const int t = track_of[kp];
+    const int point = t < 0 ? -1 : model.point_of_track[static_cast<size_t>(t)];
+    if (point < 0) continue;
+    if (kept < keep && scene.point_of_keypoint[static_cast<size_t>(image)][kp] >= 0) {
+      ++kept;
+    } else {
+      model.DeletePoint(point);
+    }
+  }
+  EXPECT_EQ(model.CountVisiblePoints(image), keep);
+  return model;
+}
+
 }  // namespace reconar::testing

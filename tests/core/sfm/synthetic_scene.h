@@ -76,6 +76,18 @@ MapperModel TrueModel(const Scene& scene);
 // Removes `image` from the model as if it had not been registered: no pose, no observation.
 void Unregister(MapperModel* model, int image);
 
+// The mapper options of `--texture-poor` (UseTexturePoorSettings): registration from 12 verified
+// inliers and from a neighbour's two-view geometry.
+MapperOptions TexturePoorMapperOptions();
+
+// The registration tests' scene: 8 cameras on the ring, 1000 points, 0.4 px noise.
+Scene RegistrationRing();
+
+// The true model with `image` unregistered and only the first `keep` of its true points left; the
+// other tracks through it lose their points (their matches become two-view matches). Expects
+// (gtest) that it sees exactly `keep` points.
+MapperModel TrueModelWithFewPointsSeenBy(const Scene& scene, int image, int keep);
+
 // Expects (gtest) the two models equal to the bit: cameras, poses, observations, points.
 void ExpectIdenticalModels(const Reconstruction& a, const Reconstruction& b);
 
