@@ -149,8 +149,7 @@ class Mapper {
   Result<bool> RegisterNextImage() {
     const std::vector<NextImageCandidate> candidates = NextImageCandidates(&model_, images_, opt_);
     // Every candidate under the plain rule (registration_min_inliers, or its tags) before any under
-    // the verified one for fewer inliers: a weak pose taken early shapes the model around it (the
-    // 24 odd views of templeRing came out a third less accurate when the order was by count only).
+    // the verified one for fewer inliers: a weak pose taken early would shape the model around it.
     // A failure under the plain rule is remembered apart (plain_tried_with_), so that the image
     // still gets its try under the verified one.
     const bool two_rules = opt_.registration_min_verified_inliers < opt_.registration_min_inliers;
