@@ -326,6 +326,14 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
         summary->note += std::string(summary->note.empty() ? "" : "; ") + std::to_string(r.mapper.models.size()) +
                          " models: the largest in sparse/, the others (" + sizes + " images) in sparse/model2...";
       }
+      const int registered = r.mapper.models.empty() ? 0 : static_cast<int>(r.mapper.models[0].images.size());
+      const int photos = registered + static_cast<int>(r.mapper.unregistered.size());
+      if (2 * registered < photos && mapper.registration_min_verified_inliers >= mapper.registration_min_inliers) {
+        summary->note += std::string(summary->note.empty() ? "" : "; ") + "only " + std::to_string(registered) +
+                         " of " + std::to_string(photos) +
+                         " photos registered: for a scene with little texture, --texture-poor registers photos from "
+                         "fewer points";
+      }
       if (!with_tags) {
         RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagsJsonPath()));
         RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagLayoutPath()));
@@ -340,6 +348,9 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
         Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
                   {"min_verified_inliers", static_cast<double>(mapper.registration_min_verified_inliers)},
                   {"min_baseline_points", static_cast<double>(mapper.registration_min_baseline_points)},
+                  {"max_models", static_cast<double>(mapper.max_models)},
+                  {"min_model_images", static_cast<double>(mapper.min_model_images)},
+                  {"max_starts", static_cast<double>(mapper.init_max_starts)},
                   {"max_error", mapper.max_reprojection_error_px},
                   {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
                   {"tag_size", options.tag_size_m},

@@ -211,6 +211,8 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("focal_35mm_equivalent_mm").Double(sfm.focal_35mm_equivalent);
   json->Key("initial_pair").String(m.initial_pair);
   json->Key("initial_pair_relaxations").Int(m.init_relaxations);
+  json->Key("initial_pairs_scored").Int(m.init_pairs_scored);
+  json->Key("initial_starts").Int(m.init_starts);
   json->Key("registered_from_neighbour").Int(m.num_registered_from_neighbour);
   json->Key("principal_point_refined").Bool(m.principal_point_refined);
   json->Key("distortion_refined").Bool(m.distortion_refined);

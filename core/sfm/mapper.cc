@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <utility>
 
 #include "core/base/elapsed.h"
@@ -30,13 +31,20 @@ constexpr char kNotConnected[] = "not connected to the reconstructed images";
 class Mapper {
  public:
   Mapper(const std::vector<MapperImage>& images, const std::vector<MapperPair>& pairs, const MapperOptions& options,
-         MapperReport* report)
-      : images_(images), pairs_(pairs), opt_(options), report_(report) {}
+         MapperReport* report, const std::set<std::pair<int, int>>& excluded_starts, InitialPairScores* scores)
+      : images_(images),
+        pairs_(pairs),
+        opt_(options),
+        report_(report),
+        excluded_starts_(excluded_starts),
+        initial_pair_scores_(scores) {}
 
   Status Run(const MapperProgress& progress) {
     const auto start = Clock::now();
     RECONAR_RETURN_IF_ERROR(Setup());
-    RECONAR_RETURN_IF_ERROR(InitializeFromBestPair(&model_, images_, pairs_, opt_, report_));
+    RECONAR_RETURN_IF_ERROR(InitializeFromBestPair(
+        &model_, images_, pairs_, opt_, report_, excluded_starts_,
+        excluded_starts_.empty() ? InitialPairOrder::kMatchCount : InitialPairOrder::kGeometry, initial_pair_scores_));
     if (progress) progress(model_.rec.NumRegisteredImages(), static_cast<int>(images_.size()));
     int last_global = model_.rec.NumRegisteredImages();
     while (true) {
@@ -234,6 +242,8 @@ class Mapper {
   const std::vector<MapperPair>& pairs_;
   const MapperOptions& opt_;
   MapperReport* report_;
+  const std::set<std::pair<int, int>>& excluded_starts_;
+  InitialPairScores* initial_pair_scores_;
   MapperModel model_;
   std::vector<int> plain_tried_with_;  // per image: visible points at its last failure under the plain rule
 };
@@ -244,6 +254,7 @@ Status MapperOptions::Check() const {
   if (init_min_points < 8) return InvalidArgument("MapperOptions: init_min_points < 8");
   if (!(init_min_median_angle_deg >= 0.0)) return InvalidArgument("MapperOptions: init_min_median_angle_deg < 0");
   if (init_max_pairs_tried < 1) return InvalidArgument("MapperOptions: init_max_pairs_tried < 1");
+  if (init_max_pairs_scored < 1) return InvalidArgument("MapperOptions: init_max_pairs_scored < 1");
   if (init_min_points_floor < 8 || init_min_points_floor > init_min_points) {
     return InvalidArgument("MapperOptions: init_min_points_floor must be in [8, init_min_points]");
   }
@@ -257,6 +268,8 @@ Status MapperOptions::Check() const {
   if (!(registration_min_two_view_fraction >= 0.0 && registration_min_two_view_fraction <= 1.0))
     return InvalidArgument("MapperOptions: registration_min_two_view_fraction must be in [0, 1]");
   if (max_models < 1) return InvalidArgument("MapperOptions: max_models < 1");
+  if (min_model_images < 2) return InvalidArgument("MapperOptions: min_model_images < 2");
+  if (init_max_starts < 1) return InvalidArgument("MapperOptions: init_max_starts < 1");
   if (registration_min_baseline_points < 0)
     return InvalidArgument("MapperOptions: registration_min_baseline_points < 0");
   if (registration_min_tag_point_inliers < 0)
@@ -276,6 +289,71 @@ Status MapperOptions::Check() const {
   return Status::Ok();
 }
 
+namespace {
+
+// The images joined to `image` by chains of verified pairs among `pairs`, itself included (a pair
+// naming a missing image is the mapper's Setup's to refuse).
+int ComponentSize(size_t num_images, const std::vector<MapperPair>& pairs, int image) {
+  std::vector<std::vector<int>> neighbours(num_images);
+  for (const MapperPair& pair : pairs) {
+    const int a = pair.matches.image_a, b = pair.matches.image_b;
+    if (a < 0 || b < 0 || static_cast<size_t>(a) >= num_images || static_cast<size_t>(b) >= num_images) continue;
+    neighbours[static_cast<size_t>(a)].push_back(b);
+    neighbours[static_cast<size_t>(b)].push_back(a);
+  }
+  std::vector<char> seen(num_images, 0);
+  std::vector<int> stack = {image};
+  seen[static_cast<size_t>(image)] = 1;
+  int size = 0;
+  while (!stack.empty()) {
+    const int current = stack.back();
+    stack.pop_back();
+    ++size;
+    for (const int next : neighbours[static_cast<size_t>(current)]) {
+      if (!seen[static_cast<size_t>(next)]) seen[static_cast<size_t>(next)] = 1, stack.push_back(next);
+    }
+  }
+  return size;
+}
+
+// One model over `pairs`, started again from the next initial pair while it is a failed start
+// (MapperOptions::min_model_images, against the images its initial pair connects to); the
+// largest start is kept. False, with the reason in report->failed_start, when no start could be
+// made; errors other than that pass through.
+Result<bool> RunWithRestarts(const std::vector<MapperImage>& images, const std::vector<MapperPair>& pairs,
+                             const MapperOptions& options, const MapperProgress& progress, Reconstruction* model,
+                             MapperReport* report) {
+  std::set<std::pair<int, int>> excluded;
+  InitialPairScores scores;
+  bool any = false;
+  for (int start = 1; start <= options.init_max_starts; ++start) {
+    MapperReport attempt_report;
+    Mapper mapper(images, pairs, options, &attempt_report, excluded, &scores);
+    const Status status = mapper.Run(progress);
+    if (!status.ok()) {
+      if (status.code() != StatusCode::kFailedPrecondition) return status;
+      if (!any) {
+        *report = std::move(attempt_report);
+        report->failed_start = status.message();
+      }
+      break;
+    }
+    Reconstruction attempt = mapper.TakeResult();
+    excluded.insert({attempt_report.initial_image_a, attempt_report.initial_image_b});
+    if (!any || attempt.NumRegisteredImages() > model->NumRegisteredImages()) {
+      *model = std::move(attempt);
+      *report = std::move(attempt_report);
+      any = true;
+    }
+    report->init_starts = start;
+    const int component = ComponentSize(images.size(), pairs, report->initial_image_a);
+    if (model->NumRegisteredImages() >= std::min(options.min_model_images, (component + 1) / 2)) break;
+  }
+  return any;
+}
+
+}  // namespace
+
 Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& images,
                                             const std::vector<MapperPair>& pairs, const MapperOptions& options,
                                             MapperReport* report, const MapperProgress& progress,
@@ -294,16 +372,17 @@ Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& imag
   std::vector<MapperPair> remaining = pairs;
   while (models.empty() || (static_cast<int>(models.size()) < options.max_models && !remaining.empty())) {
     MapperReport model_report;
-    Mapper mapper(images, remaining, options, &model_report);
-    const Status status = mapper.Run(models.empty() ? progress : nullptr);
-    if (!status.ok()) {
+    Reconstruction model;
+    RECONAR_ASSIGN_OR_RETURN(
+        const bool started,
+        RunWithRestarts(images, remaining, options, models.empty() ? progress : nullptr, &model, &model_report));
+    if (!started) {
       if (models.empty()) {
         *report = model_report;
-        return status;
+        return FailedPrecondition(model_report.failed_start);
       }
       break;
     }
-    Reconstruction model = mapper.TakeResult();
     if (!models.empty() && model.NumRegisteredImages() < 3) break;
     for (size_t i = 0; i < model.images.size(); ++i) {
       if (model.images[i].registered) model_of[i] = static_cast<int>(models.size());
@@ -343,7 +422,7 @@ Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& imag
       if (std::find(in.begin(), in.end(), u.name) == in.end()) continue;
       in_model = true;
       u.reason = "in model " + std::to_string(k + 1) + " (" + std::to_string(in.size()) +
-                 " images; too few matches to this model's images to join it)";
+                 " images); not in this one: " + u.reason;
     }
     if (in_model) continue;
     // In no model: the first reason from a run that tried the image, else the first run's.

@@ -48,10 +48,12 @@ struct MapperPair {
 
 struct MapperOptions {
   // Initial pair: at least this many tracks triangulated, with median triangulation angle at
-  // least init_min_median_angle_deg.
+  // least init_min_median_angle_deg. Up to init_max_pairs_scored pairs get a quick two-view
+  // score (initial_pair.h) and up to init_max_pairs_tried of them a full try, per round.
   int init_min_points = 100;
   double init_min_median_angle_deg = 4.0;
   int init_max_pairs_tried = 20;
+  int init_max_pairs_scored = 500;
   // When no pair meets those bounds, both are halved and the pairs tried again, down to these
   // floors (COLMAP's mapper relaxes the same way): texture-poor rooms have few matches per pair.
   int init_min_points_floor = 25;
@@ -129,6 +131,11 @@ struct MapperOptions {
   // When registration stops with images left that have verified matches among themselves, a new
   // model is started from them, up to this many models in all; the largest is returned.
   int max_models = 8;
+  // A model that stops at fewer than min(min_model_images, half the images its initial pair is
+  // joined to by chains of verified pairs) is a failed start (like COLMAP's min_model_size): it is built again from the
+  // next initial pair, up to init_max_starts starts in all, and the largest start is kept.
+  int min_model_images = 10;
+  int init_max_starts = 4;
 
   Status Check() const;
 };
@@ -144,7 +151,11 @@ struct MapperReport {
   int num_tracks = 0;
   int num_inconsistent_tracks = 0;
   std::string initial_pair;  // "a.jpg + b.jpg"
+  int initial_image_a = -1, initial_image_b = -1;
+  int init_starts = 1;       // how often the model was started (a failed start is built again)
+  std::string failed_start;  // why no start could be made, when none could
   int init_relaxations = 0;  // how often the initial-pair bounds were halved before one was found
+  int init_pairs_scored = 0;              // pairs given a quick two-view score before the initial pair was found
   int num_registered_from_neighbour = 0;  // images registered from a neighbour's two-view geometry
   std::vector<Unregistered> unregistered;
   // Every model built, the returned (largest) one first: its images and point count. An image in

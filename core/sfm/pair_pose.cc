@@ -8,7 +8,8 @@
 
 namespace reconar {
 
-Result<PairPose> EstimatePairPose(const MapperModel& model, const MapperPair& pair, const MapperOptions& options) {
+Result<PairPose> EstimatePairPose(const MapperModel& model, const MapperPair& pair, const MapperOptions& options,
+                                  PairPoseSearch search) {
   const Reconstruction& rec = model.rec;
   const int a = pair.matches.image_a, b = pair.matches.image_b;
   const SfmImage& ia = rec.images[static_cast<size_t>(a)];
@@ -29,6 +30,10 @@ Result<PairPose> EstimatePairPose(const MapperModel& model, const MapperPair& pa
   }
   RansacOptions ransac;
   ransac.max_residual = options.max_reprojection_error_px / std::sqrt(ca.focal * cb.focal);
+  if (search == PairPoseSearch::kQuick) {
+    ransac.local_optimisation = false;
+    ransac.max_iterations = kQuickPairPoseIterations;
+  }
   const auto essential = Ransac<EssentialFivePoint>::Run(samples.data(), static_cast<int>(samples.size()), ransac);
   if (!essential.ok() || essential->status != RansacStatus::kSuccess) {
     return FailedPrecondition("no essential matrix");

@@ -19,8 +19,14 @@ struct PairPose {
   int num_inliers = 0;
 };
 
+// kQuick skips RANSAC's local optimisation and stops at kQuickPairPoseIterations: enough to rank
+// pairs whose matches are already verified (initial_pair.cc), not to start a model from.
+enum class PairPoseSearch { kThorough, kQuick };
+constexpr int kQuickPairPoseIterations = 200;
+
 // FailedPrecondition with the reason when RANSAC finds no essential matrix or no decomposition
 // puts the matches in front of both cameras.
-Result<PairPose> EstimatePairPose(const MapperModel& model, const MapperPair& pair, const MapperOptions& options);
+Result<PairPose> EstimatePairPose(const MapperModel& model, const MapperPair& pair, const MapperOptions& options,
+                                  PairPoseSearch search = PairPoseSearch::kThorough);
 
 }  // namespace reconar

@@ -6,7 +6,8 @@
 // <= 3.58 mm (issue 5). templeSparseRing at least 12 of 16 and dinoSparseRing at least 8 of 16,
 // mean centre error <= 1 % of the ring's radius, mean rotation error <= 1 degree, every camera
 // within 2 degrees, and a reason for every view left out (issue 17; the dino with --texture-poor,
-// and the temple with it all 16).
+// and the temple with it all 16). A walk forward down a rendered corridor (tests/support/
+// corridor_walk.h; its poses are exact): every view in one model, on the rings' bars.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -18,6 +19,7 @@
 
 #include "core/base/json_reader.h"
 #include "core/sfm/model_io.h"
+#include "tests/support/corridor_walk.h"
 #include "tests/support/ground_truth.h"
 #include "tests/support/run_command.h"
 #include "tests/support/sfm_evaluation.h"
@@ -214,6 +216,22 @@ TEST(SfmCli, DinoSparseRingRegistersAtLeastEightOfSixteen) {
              8);
 }
 
+// With the defaults the dino gives few views; those it gives are right, and the tool points to
+// --texture-poor.
+TEST(SfmCli, DinoSparseRingWithTheDefaultsIsRightAndPointsToTexturePoor) {
+  const fs::path project = FreshDir("dino_default");
+  const std::string data = testing::SharedDataPath("middlebury_dinoSparseRing");
+  const CommandRun run = RunReconar("sfm " + data + " " + project.string() + " --threads 2");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const RingScore score = ScoreRing(project / "sparse", data + "/dinoSR_par.txt");
+  EXPECT_GE(score.registered, 3);
+  EXPECT_LE(score.errors.rotation_max_deg, 2.0);
+  if (2 * score.registered < 16) {
+    EXPECT_NE(run.output.find("--texture-poor"), std::string::npos) << run.output;
+  }
+  fs::remove_all(project);
+}
+
 // Both rings in one folder: two models, each right, and no view of one object in the other's.
 TEST(SfmCli, TwoUnrelatedRingsMixedBecomeTwoModels) {
   const fs::path project = FreshDir("two_rings");
@@ -235,6 +253,51 @@ TEST(SfmCli, TwoUnrelatedRingsMixedBecomeTwoModels) {
   const RingScore second = ScoreRing(project / "out" / "sparse" / "model2", dino + "/dinoSR_par.txt");
   ExpectRingAccurate(second, 8);
   fs::remove_all(project);
+}
+
+// ---- A walk forward down a corridor (the paper's case): rendered views with exact poses ----
+
+// A walk of `walk.frames` views rendered down the corridor through `reconar sfm` with the defaults:
+// one model holding every view, each camera in its place (the rings' bars, with the walk's length
+// for the radius).
+void ExpectCorridorWalk(const std::string& name, const testing::CorridorWalkOptions& walk) {
+  const fs::path project = FreshDir(name);
+  const fs::path photos = project / "photos";
+  fs::create_directories(photos);
+  const auto truth = testing::RenderCorridorWalk(photos.string(), walk);
+  ASSERT_TRUE(truth.ok()) << truth.status().ToString();
+  const CommandRun run = RunReconar("sfm " + photos.string() + " " + (project / "out").string() + " --threads 2");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const Score score = ScoreModel(project / "out" / "sparse", truth);
+  const double walk_length = walk.step_m * (walk.frames - 1);
+  std::printf(
+      "%s: %d of %d registered, mean centre error %.3f %% of the %.1f m walk (max %.3f %%), "
+      "rotation mean %.3f deg (max %.3f)\n",
+      name.c_str(), score.registered, walk.frames, 100.0 * score.errors.centre_mean / walk_length, walk_length,
+      100.0 * score.errors.centre_max / walk_length, score.errors.rotation_mean_deg, score.errors.rotation_max_deg);
+  EXPECT_EQ(score.registered, walk.frames) << run.output;
+  EXPECT_LE(score.errors.centre_mean, 0.01 * walk_length);
+  EXPECT_LE(score.errors.rotation_mean_deg, 1.0);
+  EXPECT_LE(score.errors.rotation_max_deg, 2.0);
+  EXPECT_FALSE(fs::exists(project / "out" / "sparse" / "model2"));
+  fs::remove_all(project);
+}
+
+// 29 views 0.4 m apart, like a walk down a street with a phone (the issue's 29 photos).
+TEST(SfmCli, ForwardWalkDownACorridorKeepsTheChain) {
+  testing::CorridorWalkOptions walk;
+  walk.frames = 29;
+  walk.step_m = 0.4;
+  ExpectCorridorWalk("corridor_walk", walk);
+}
+
+// 60 views 0.1 m apart, as a burst or a capture session gives them: the best-matched pairs are
+// neighbours without baseline, and the initial pair must come from further down the list.
+TEST(SfmCli, DenseForwardWalkStartsFromAPairWithBaseline) {
+  testing::CorridorWalkOptions walk;
+  walk.frames = 60;
+  walk.step_m = 0.1;
+  ExpectCorridorWalk("corridor_dense", walk);
 }
 
 }  // namespace

@@ -94,6 +94,58 @@ TEST(InitialPairTest, BoundsAreRelaxedDownToTheFloors) {
   EXPECT_NE(failed.message().find("relaxed to 8000 points"), std::string::npos) << failed.message();
 }
 
+// Eight views within 0.03 of each other (28 pairs without baseline, more than the 20 full tries)
+// and a ninth 40 degrees around: the search goes on down the match-count order to the wide pairs.
+TEST(InitialPairTest, SearchesPastThePairsWithoutBaseline) {
+  testing::SceneOptions o;
+  o.num_points = 800;
+  o.wrong_fraction = 0.0;
+  o.distortion = false;
+  for (int i = 0; i < 8; ++i) o.centres.push_back(Eigen::Vector3d(10.0, 0.004 * i, 1.0));
+  const double a = 40.0 * M_PI / 180.0;
+  o.centres.push_back(Eigen::Vector3d(10.0 * std::cos(a), 10.0 * std::sin(a), 2.0));
+  const testing::Scene scene = testing::MakeScene(o);
+  MapperOptions options = testing::SingleThreaded();
+  ASSERT_LT(options.init_max_pairs_tried, 28);
+  MapperModel model = Unstarted(scene);
+  MapperReport report;
+  const Status status = InitializeFromBestPair(&model, scene.images, scene.pairs, options, &report);
+  ASSERT_TRUE(status.ok()) << status.ToString();
+  EXPECT_EQ(report.init_relaxations, 0);
+  EXPECT_TRUE(model.rec.images[8].registered) << report.initial_pair;
+  EXPECT_GT(report.init_pairs_scored, 28);
+}
+
+// A model whose points no third view sees enough of (here: the rule asks for more points than the
+// scene has) is a dead end; with nothing better it is still the result, not "no model".
+TEST(InitialPairTest, ADeadEndPairIsTheLastResort) {
+  const testing::Scene scene = ThreeViews();
+  MapperOptions options = testing::SingleThreaded();
+  options.registration_min_inliers = options.registration_min_verified_inliers = 100000;
+  MapperModel model = Unstarted(scene);
+  MapperReport report;
+  const Status status = InitializeFromBestPair(&model, scene.images, scene.pairs, options, &report);
+  ASSERT_TRUE(status.ok()) << status.ToString();
+  EXPECT_EQ(model.rec.NumRegisteredImages(), 2);
+  EXPECT_NE(report.initial_pair.find("view2.jpg"), std::string::npos) << report.initial_pair;
+  EXPECT_NE(CheckExtendable(model, "p", options).find("no other image sees 100000"), std::string::npos);
+}
+
+TEST(InitialPairTest, CheckExtendableAsksForAThirdViewThatSeesEnough) {
+  const testing::Scene scene = ThreeViews();
+  MapperModel model = testing::TrueModel(scene);
+  testing::Unregister(&model, 1);
+  const int seen = model.CountVisiblePoints(1);
+  MapperOptions options = testing::SingleThreaded();
+  options.registration_min_inliers = options.registration_min_verified_inliers = seen;
+  EXPECT_EQ(CheckExtendable(model, "p", options), "");
+  options.registration_min_inliers = options.registration_min_verified_inliers = seen + 1;
+  EXPECT_NE(CheckExtendable(model, "p", options).find("at most " + std::to_string(seen)), std::string::npos);
+  // The looser of the two rules counts.
+  options.registration_min_verified_inliers = seen;
+  EXPECT_EQ(CheckExtendable(model, "p", options), "");
+}
+
 TEST(InitialPairTest, CheckInitialModelNamesTheUnmetBound) {
   const testing::Scene scene = ThreeViews();
   MapperModel model = testing::TrueModel(scene);

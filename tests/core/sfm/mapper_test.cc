@@ -474,6 +474,9 @@ TEST(IncrementalMapperTest, UnrelatedSetsBecomeSeparateModelsTheLargestFirst) {
   ExpectModelConsistent(*result, report, images.size());
   ASSERT_EQ(report.models.size(), 2u);
   ASSERT_EQ(others.size(), 1u);
+  // Each model holds every image its initial pair is joined to: neither is a failed start
+  // (MapperOptions::min_model_images), however small next to the whole set.
+  EXPECT_EQ(report.init_starts, 1);
   EXPECT_EQ(report.models[0].images.size(), large.images.size());
   EXPECT_EQ(report.models[1].images.size(), small.images.size());
   EXPECT_EQ(report.models[0].num_points, result->NumPoints());
