@@ -67,9 +67,11 @@ Status InitializeFromBestPair(MapperModel* model, const std::vector<MapperImage>
                               const std::vector<MapperPair>& pairs, const MapperOptions& options, MapperReport* report,
                               const std::set<std::pair<int, int>>& excluded, InitialPairOrder order_by,
                               InitialPairScores* scores) {
-  if (scores != nullptr && scores->scored.size() != pairs.size()) {
-    scores->angles.assign(pairs.size(), {});
-    scores->scored.assign(pairs.size(), 0);
+  InitialPairScores local_scores;
+  InitialPairScores& quick = scores != nullptr ? *scores : local_scores;
+  if (quick.scored.size() != pairs.size()) {
+    quick.angles.assign(pairs.size(), {});
+    quick.scored.assign(pairs.size(), 0);
   }
   std::vector<int> order;
   for (size_t p = 0; p < pairs.size(); ++p) {
@@ -90,7 +92,8 @@ Status InitializeFromBestPair(MapperModel* model, const std::vector<MapperImage>
   // pairs further down. A model no third image can join is kept only as the last resort.
   const size_t max_scored = std::min(order.size(), static_cast<size_t>(options.init_max_pairs_scored));
   constexpr size_t kBatch = 32;
-  std::vector<std::vector<double>> angles;  // per scored pair, in `order`
+  size_t num_scored = 0;  // the first pairs of `order` that have their quick score
+  auto angles_of = [&](size_t k) -> const std::vector<double>& { return quick.angles[static_cast<size_t>(order[k])]; };
   struct DeadEnd {
     int pair = -1;
     InitialPairBounds bounds;
@@ -103,19 +106,14 @@ Status InitializeFromBestPair(MapperModel* model, const std::vector<MapperImage>
     report->initial_image_a = pair.matches.image_a;
     report->initial_image_b = pair.matches.image_b;
     report->init_relaxations = round;
-    report->init_pairs_scored = static_cast<int>(angles.size());
+    report->init_pairs_scored = static_cast<int>(num_scored);
   };
   std::string skipped;  // why the best-matched pair skipped in the last round could not meet the bounds
   auto score_up_to = [&](size_t end) {
-    while (angles.size() < end) {
-      const size_t p = static_cast<size_t>(order[angles.size()]);
-      if (scores == nullptr) {
-        angles.push_back(QuickTriangulationAngles(*model, pairs[p], options));
-        continue;
-      }
-      if (!scores->scored[p]) scores->angles[p] = QuickTriangulationAngles(*model, pairs[p], options);
-      scores->scored[p] = 1;
-      angles.push_back(scores->angles[p]);
+    for (; num_scored < end; ++num_scored) {
+      const size_t p = static_cast<size_t>(order[num_scored]);
+      if (!quick.scored[p]) quick.angles[p] = QuickTriangulationAngles(*model, pairs[p], options);
+      quick.scored[p] = 1;
     }
   };
   for (int round = 0;; ++round) {
@@ -127,7 +125,7 @@ Status InitializeFromBestPair(MapperModel* model, const std::vector<MapperImage>
       score_up_to(max_scored);
       std::vector<int> well(max_scored);
       for (size_t k = 0; k < max_scored; ++k) {
-        const auto& a = angles[k];
+        const std::vector<double>& a = angles_of(k);
         well[k] =
             static_cast<int>(a.end() - std::lower_bound(a.begin(), a.end(), bounds.min_median_angle_deg * kDegree));
         sequence.push_back(k);
@@ -136,11 +134,9 @@ Status InitializeFromBestPair(MapperModel* model, const std::vector<MapperImage>
     }
     for (size_t step = 0; step < max_scored && tries < options.init_max_pairs_tried; ++step) {
       const size_t k = sequence.empty() ? step : sequence[step];
-      if (k == angles.size()) {
-        score_up_to(std::min(max_scored, k + kBatch));
-      }
-      if (!CouldMeet(angles[k], bounds)) {
-        if (skipped.empty()) skipped = QuickReason(images, pairs[static_cast<size_t>(order[k])], angles[k]);
+      if (k == num_scored) score_up_to(std::min(max_scored, k + kBatch));
+      if (!CouldMeet(angles_of(k), bounds)) {
+        if (skipped.empty()) skipped = QuickReason(images, pairs[static_cast<size_t>(order[k])], angles_of(k));
         continue;
       }
       ++tries;
@@ -170,7 +166,7 @@ Status InitializeFromBestPair(MapperModel* model, const std::vector<MapperImage>
     }
   }
   if (last_reason.empty()) last_reason = skipped;
-  return FailedPrecondition("no initial pair found among the " + std::to_string(angles.size()) +
+  return FailedPrecondition("no initial pair found among the " + std::to_string(num_scored) +
                             " best-matched pairs, even with the bounds relaxed to " +
                             std::to_string(bounds.min_points) + " points and " +
                             std::to_string(bounds.min_median_angle_deg) + " deg; last: " + last_reason);
