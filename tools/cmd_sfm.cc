@@ -27,6 +27,8 @@ constexpr char kHelp[] =
     "                        under 1000 features extracted again at a lower contrast threshold;\n"
     "                        images registered from 12 inliers when their two-view matches agree,\n"
     "                        or from a registered neighbour's two-view geometry and 5 points\n"
+    "  --merge-models        merge a further model into the largest when a similarity aligns the\n"
+    "                        points they share (a 7-DoF alignment, then one adjustment of both)\n"
     "  --max-error PX        reprojection error bound for triangulation and filtering (default 4)\n"
     "  --ratio R             Lowe ratio (default 0.8 here)\n"
     "  --min-inliers N       inliers a pair needs (default 30 here)\n"

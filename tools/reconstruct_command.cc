@@ -15,8 +15,8 @@
 namespace reconar::tools {
 namespace {
 
-const std::set<std::string> kFlags = {"no-tags-in-ba",    "no-preview", "force",       "json",
-                                      "fixed-distortion", "no-fill",    "texture-poor"};
+const std::set<std::string> kFlags = {"no-tags-in-ba",    "no-preview", "force",        "json",
+                                      "fixed-distortion", "no-fill",    "texture-poor", "merge-models"};
 
 std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
@@ -54,6 +54,7 @@ Status ReadMapperArgs(const Args& args, MapperOptions* mapper) {
     return InvalidArgument("--principal-point must be fixed, auto or refine, got '" + pp + "'");
   }
   if (args.Has("fixed-distortion")) mapper->refine_distortion = false;
+  if (args.Has("merge-models")) mapper->merge_models = true;
   RECONAR_ASSIGN_OR_RETURN(mapper->max_reprojection_error_px,
                            args.GetDouble("max-error", mapper->max_reprojection_error_px, 0.1, 100.0));
   mapper->registration_max_error_px =

@@ -326,6 +326,10 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
         summary->note += std::string(summary->note.empty() ? "" : "; ") + std::to_string(r.mapper.models.size()) +
                          " models: the largest in sparse/, the others (" + sizes + " images) in sparse/model2...";
       }
+      if (!r.mapper.merges.empty()) {
+        summary->note += std::string(summary->note.empty() ? "" : "; ") + std::to_string(r.mapper.merges.size()) +
+                         (r.mapper.merges.size() == 1 ? " model" : " models") + " merged into the largest";
+      }
       const int registered = r.mapper.models.empty() ? 0 : static_cast<int>(r.mapper.models[0].images.size());
       const int photos = registered + static_cast<int>(r.mapper.unregistered.size());
       if (2 * registered < photos && mapper.registration_min_verified_inliers >= mapper.registration_min_inliers) {
@@ -351,6 +355,7 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
                   {"max_models", static_cast<double>(mapper.max_models)},
                   {"min_model_images", static_cast<double>(mapper.min_model_images)},
                   {"max_starts", static_cast<double>(mapper.init_max_starts)},
+                  {"merge_models", mapper.merge_models ? 1.0 : 0.0},
                   {"max_error", mapper.max_reprojection_error_px},
                   {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
                   {"tag_size", options.tag_size_m},

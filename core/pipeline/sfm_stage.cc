@@ -232,9 +232,16 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
     json->Key("registered").Int(static_cast<long long>(m.models[k].images.size()));
     json->Key("points").Int(m.models[k].num_points);
     json->Key("initial_pair").String(m.models[k].initial_pair);
+    if (!m.models[k].not_merged.empty()) json->Key("not_merged").String(m.models[k].not_merged);
     json->Key("images").BeginArray();
     for (const std::string& name : m.models[k].images) json->String(name);
     json->EndArray().EndObject();
+  }
+  json->EndArray();
+  json->Key("merged").BeginArray();
+  for (const MapperReport::Merge& merge : m.merges) {
+    json->BeginObject().Key("initial_pair").String(merge.initial_pair).Key("images").Int(merge.num_images);
+    json->Key("shared_points").Int(merge.num_shared_points).Key("inliers").Int(merge.num_inliers).EndObject();
   }
   json->EndArray();
   json->Key("unregistered").BeginArray();

@@ -12,6 +12,7 @@
 #include "core/sfm/intrinsics_selection.h"
 #include "core/sfm/mapper_adjustment.h"
 #include "core/sfm/mapper_model.h"
+#include "core/sfm/model_merge.h"
 #include "core/sfm/neighbour_registration.h"
 #include "core/sfm/next_image.h"
 #include "core/sfm/point_filter.h"
@@ -39,12 +40,20 @@ class Mapper {
         excluded_starts_(excluded_starts),
         initial_pair_scores_(scores) {}
 
-  Status Run(const MapperProgress& progress) {
+  // From the best initial pair, or, with `seed`, from its registered images' poses and their
+  // cameras (a merge of models, model_merge.h): the seed's points are triangulated again from the
+  // tracks of every pair.
+  Status Run(const MapperProgress& progress, const Reconstruction* seed = nullptr) {
     const auto start = Clock::now();
     RECONAR_RETURN_IF_ERROR(Setup());
-    RECONAR_RETURN_IF_ERROR(InitializeFromBestPair(
-        &model_, images_, pairs_, opt_, report_, excluded_starts_,
-        excluded_starts_.empty() ? InitialPairOrder::kMatchCount : InitialPairOrder::kGeometry, initial_pair_scores_));
+    if (seed != nullptr) {
+      RECONAR_RETURN_IF_ERROR(StartFromSeed(*seed));
+    } else {
+      RECONAR_RETURN_IF_ERROR(
+          InitializeFromBestPair(&model_, images_, pairs_, opt_, report_, excluded_starts_,
+                                 excluded_starts_.empty() ? InitialPairOrder::kMatchCount : InitialPairOrder::kGeometry,
+                                 initial_pair_scores_));
+    }
     if (progress) progress(model_.rec.NumRegisteredImages(), static_cast<int>(images_.size()));
     int last_global = model_.rec.NumRegisteredImages();
     while (true) {
@@ -117,6 +126,21 @@ class Mapper {
     report_->num_tracks = static_cast<int>(model_.tracks.tracks.size());
     report_->num_inconsistent_tracks = model_.tracks.num_inconsistent;
     return Status::Ok();
+  }
+
+  Status StartFromSeed(const Reconstruction& seed) {
+    Reconstruction& rec = model_.rec;
+    if (seed.images.size() != rec.images.size() || seed.cameras.size() != rec.cameras.size())
+      return InvalidArgument("mapper: a seed model of other images");
+    for (size_t c = 0; c < rec.cameras.size(); ++c) rec.cameras[c] = seed.cameras[c];
+    for (size_t i = 0; i < rec.images.size(); ++i) {
+      if (!seed.images[i].registered) continue;
+      rec.images[i].registered = true;
+      rec.images[i].cam_from_world = seed.images[i].cam_from_world;
+      model_.failure[i].clear();
+    }
+    for (const int image : model_.RegisteredImages()) TriangulateImage(&model_, image, opt_);
+    return GlobalRefinement(GrowthAdjustment(opt_.global_ba_iterations));
   }
 
   // The camera of image i under the sharing rule, created when no earlier image shares it.
@@ -270,6 +294,7 @@ Status MapperOptions::Check() const {
   if (max_models < 1) return InvalidArgument("MapperOptions: max_models < 1");
   if (min_model_images < 2) return InvalidArgument("MapperOptions: min_model_images < 2");
   if (init_max_starts < 1) return InvalidArgument("MapperOptions: init_max_starts < 1");
+  if (merge_min_shared_points < 3) return InvalidArgument("MapperOptions: merge_min_shared_points < 3");
   if (registration_min_baseline_points < 0)
     return InvalidArgument("MapperOptions: registration_min_baseline_points < 0");
   if (registration_min_tag_point_inliers < 0)
@@ -352,6 +377,69 @@ Result<bool> RunWithRestarts(const std::vector<MapperImage>& images, const std::
   return any;
 }
 
+// Merges into the largest model every other model that aligns with it (model_merge.h), largest
+// first, each union grown again over every pair and adjusted as one; a merged model leaves
+// `models`. A model that does not align keeps why in its report (MapperReport::not_merged).
+Status MergeIntoLargest(const std::vector<MapperImage>& images, const std::vector<MapperPair>& pairs,
+                        const MapperOptions& options, std::vector<Reconstruction>* models,
+                        std::vector<MapperReport>* reports) {
+  ModelMergeOptions merge_options;
+  merge_options.max_error_px = options.max_reprojection_error_px;
+  merge_options.min_inliers = options.merge_min_shared_points;
+  const std::set<std::pair<int, int>> no_excluded_starts;
+  bool merged = true;
+  while (merged && models->size() > 1) {
+    merged = false;
+    std::vector<size_t> order(models->size());
+    for (size_t m = 0; m < order.size(); ++m) order[m] = m;
+    std::stable_sort(order.begin(), order.end(), [models](size_t a, size_t b) {
+      return (*models)[a].NumRegisteredImages() > (*models)[b].NumRegisteredImages();
+    });
+    const size_t main = order[0];
+    for (size_t k = 1; k < order.size() && !merged; ++k) {
+      const size_t other = order[k];
+      MapperReport& other_report = (*reports)[other];
+      const Result<ModelAlignment> alignment = AlignModels((*models)[main], (*models)[other], pairs, merge_options);
+      if (!alignment.ok()) {
+        other_report.not_merged = alignment.status().message();
+        continue;
+      }
+      const Reconstruction seed = CombineRegisteredImages((*models)[main], (*models)[other], alignment->to_from_from);
+      MapperReport merged_report;
+      Mapper mapper(images, pairs, options, &merged_report, no_excluded_starts, nullptr);
+      const Status status = mapper.Run(nullptr, &seed);
+      if (!status.ok()) {
+        if (status.code() != StatusCode::kFailedPrecondition) return status;
+        other_report.not_merged = "the merged model failed: " + status.message();
+        continue;
+      }
+      const MapperReport& main_report = (*reports)[main];
+      merged_report.initial_pair = main_report.initial_pair;
+      merged_report.initial_image_a = main_report.initial_image_a;
+      merged_report.initial_image_b = main_report.initial_image_b;
+      merged_report.init_starts = main_report.init_starts;
+      merged_report.init_relaxations = main_report.init_relaxations;
+      merged_report.init_pairs_scored = main_report.init_pairs_scored;
+      merged_report.merges = main_report.merges;
+      merged_report.merges.push_back({other_report.initial_pair, (*models)[other].NumRegisteredImages(),
+                                      alignment->num_shared_points, alignment->num_inliers});
+      merged_report.seconds_total += main_report.seconds_total;
+      merged_report.seconds_ba += main_report.seconds_ba;
+      merged_report.num_local_ba += main_report.num_local_ba;
+      merged_report.num_global_ba += main_report.num_global_ba;
+      if (merged_report.first_ba_failure.empty()) merged_report.first_ba_failure = main_report.first_ba_failure;
+      merged_report.num_failed_ba += main_report.num_failed_ba;
+      merged_report.num_registered_from_neighbour += main_report.num_registered_from_neighbour;
+      (*models)[main] = mapper.TakeResult();
+      (*reports)[main] = std::move(merged_report);
+      models->erase(models->begin() + static_cast<std::ptrdiff_t>(other));
+      reports->erase(reports->begin() + static_cast<std::ptrdiff_t>(other));
+      merged = true;
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& images,
@@ -397,6 +485,7 @@ Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& imag
     }
     remaining = std::move(left);
   }
+  if (options.merge_models) RECONAR_RETURN_IF_ERROR(MergeIntoLargest(images, pairs, options, &models, &reports));
   // The main model is the largest; the others follow from the largest down.
   std::vector<size_t> order(models.size());
   for (size_t m = 0; m < order.size(); ++m) order[m] = m;
@@ -413,6 +502,7 @@ Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& imag
     }
     summary.num_points = reports[m].num_points;
     summary.initial_pair = reports[m].initial_pair;
+    summary.not_merged = reports[m].not_merged;
     report->models.push_back(std::move(summary));
   }
   for (MapperReport::Unregistered& u : report->unregistered) {

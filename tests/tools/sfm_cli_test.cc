@@ -255,6 +255,32 @@ TEST(SfmCli, TwoUnrelatedRingsMixedBecomeTwoModels) {
   fs::remove_all(project);
 }
 
+// templeRing's 24 odd views: 21 in the main model and 3 in a second one with the defaults; with
+// --merge-models the second is aligned to the first by the points they share and both are
+// adjusted as one, and every view is in one model, each camera within the rings' bars.
+TEST(SfmCli, TempleRingOddViewsMergeIntoOneModel) {
+  const fs::path project = FreshDir("templering_odd_merged");
+  const std::string data = testing::SharedDataPath("middlebury_templeRing");
+  const auto truth = testing::ReadMiddleburyParInOrder(data + "/templeR_par.txt");
+  ASSERT_TRUE(truth.ok()) << truth.status().ToString();
+  std::vector<std::string> odd;
+  for (size_t i = 0; i < truth->size(); i += 2) odd.push_back((*truth)[i].name);
+  ASSERT_EQ(odd.size(), 24u);
+  const std::string photos = testing::LinkFiles((project / "odd").string(), data, odd);
+  const CommandRun run = RunReconar("sfm " + photos + " " + (project / "out").string() + " --threads 2 --merge-models");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const RingScore score = ScoreRing(project / "out" / "sparse", data + "/templeR_par.txt");
+  ExpectRingAccurate(score, 24);
+  EXPECT_FALSE(fs::exists(project / "out" / "sparse" / "model2")) << run.output;
+  auto report = ReadJsonFile((project / "out" / "sparse" / "report.json").string());
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  const JsonValue* merged = report->Find("merged");
+  ASSERT_NE(merged, nullptr);
+  ASSERT_EQ(merged->size(), 1u);
+  EXPECT_GE((*merged)[0].Find("inliers")->number(), 12.0);
+  fs::remove_all(project);
+}
+
 // ---- A walk forward down a corridor (the paper's case): rendered views with exact poses ----
 
 // A walk of `walk.frames` views rendered down the corridor through `reconar sfm` with the defaults:
