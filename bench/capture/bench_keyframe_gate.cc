@@ -1,0 +1,159 @@
+// The capture's keyframe gate per frame, one thread: median ms per frame at 640x480 and 1280x720 on
+// a rotating-camera sweep over fountain-P11's photo (tests/tracker/rotation_video.h), and on the AR
+// video's 93 real 640x480 frames. With OpenCV found, the same work done with OpenCV runs beside it in
+// the same process, alternating runs: INTER_AREA resize to the analysis width, Laplacian variance,
+// mean and clipped share, goodFeaturesToTrack on keyframes, calcOpticalFlowPyrLK forward and back
+// (window 11, 3 levels, as ours). Reported as ratios: these machines are noisy.
+//   bench_keyframe_gate [repeats=5]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "bench/common/bench_images.h"
+#include "core/io/image_io.h"
+#include "tests/support/ar_video.h"
+#include "tests/tracker/rotation_video.h"
+#include "tracker/keyframe_gate.h"
+
+#ifdef RECONAR_BENCH_WITH_OPENCV
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#endif
+
+namespace {
+
+using reconar::Image;
+using Clock = std::chrono::steady_clock;
+
+struct Run {
+  double median_ms = 0.0;
+  int keyframes = 0;
+};
+
+Run RunOurs(const std::vector<Image<uint8_t>>& frames) {
+  reconar::KeyframeGate gate;
+  reconar::GateFrameReport report;
+  std::vector<double> ms;
+  for (const Image<uint8_t>& frame : frames) {
+    const Clock::time_point start = Clock::now();
+    const reconar::Status status = gate.Process(frame.view(), &report);
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    if (!status.ok()) {
+      std::fprintf(stderr, "gate: %s\n", status.ToString().c_str());
+      std::exit(1);
+    }
+  }
+  return {reconar::bench::Median(ms), gate.keyframes()};
+}
+
+#ifdef RECONAR_BENCH_WITH_OPENCV
+Run RunOpenCv(const std::vector<Image<uint8_t>>& frames) {
+  std::vector<double> ms;
+  cv::Mat small, previous, laplacian;
+  std::vector<cv::Point2f> keyframe_points, points, forward, backward;
+  std::vector<uchar> status, back_status;
+  std::vector<float> error;
+  int keyframes = 0;
+  size_t keyframe_count = 0;
+  for (const Image<uint8_t>& frame : frames) {
+    const Clock::time_point start = Clock::now();
+    const cv::Mat input(frame.height(), frame.width(), CV_8UC1, const_cast<uint8_t*>(frame.data()));
+    const int factor = (frame.width() + 319) / 320;
+    cv::resize(input, small, cv::Size(frame.width() / factor, frame.height() / factor), 0, 0, cv::INTER_AREA);
+    cv::Laplacian(small, laplacian, CV_32F);
+    cv::Scalar mean, deviation;
+    cv::meanStdDev(laplacian, mean, deviation);
+    const double level = cv::mean(small)[0];
+    const int clipped = cv::countNonZero(small <= 4) + cv::countNonZero(small >= 251);
+    bool keyframe = keyframe_count == 0;
+    if (!keyframe) {
+      cv::calcOpticalFlowPyrLK(previous, small, points, forward, status, error, cv::Size(11, 11), 2);
+      cv::calcOpticalFlowPyrLK(small, previous, forward, backward, back_status, error, cv::Size(11, 11), 2);
+      std::vector<cv::Point2f> kept, kept_keyframe;
+      std::vector<float> moved;
+      for (size_t i = 0; i < points.size(); ++i) {
+        if (!status[i] || !back_status[i] || cv::norm(backward[i] - points[i]) > 1.0) continue;
+        kept.push_back(forward[i]);
+        kept_keyframe.push_back(keyframe_points[i]);
+        moved.push_back(static_cast<float>(cv::norm(forward[i] - keyframe_points[i])));
+      }
+      points = kept;
+      keyframe_points = kept_keyframe;
+      double motion = 0.0;
+      if (!moved.empty()) {
+        std::nth_element(moved.begin(), moved.begin() + static_cast<long>(moved.size() / 2), moved.end());
+        motion = moved[moved.size() / 2];
+      }
+      keyframe = motion >= 0.12 * small.cols || points.size() < 0.6 * keyframe_count;
+    }
+    if (keyframe) {
+      cv::goodFeaturesToTrack(small, points, 80, 0.01, 0.6 * small.cols / 10);
+      keyframe_points = points;
+      keyframe_count = points.size();
+      ++keyframes;
+    }
+    small.copyTo(previous);
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    if (deviation[0] < 0 || level < 0 || clipped < 0) std::exit(1);
+  }
+  return {reconar::bench::Median(ms), keyframes};
+}
+#endif
+
+void Measure(const char* name, const std::vector<Image<uint8_t>>& frames, int repeats) {
+  std::vector<double> ours, theirs;
+  int our_keyframes = 0, their_keyframes = 0;
+  for (int r = 0; r < repeats; ++r) {
+    const Run a = RunOurs(frames);
+    ours.push_back(a.median_ms);
+    our_keyframes = a.keyframes;
+#ifdef RECONAR_BENCH_WITH_OPENCV
+    const Run b = RunOpenCv(frames);
+    theirs.push_back(b.median_ms);
+    their_keyframes = b.keyframes;
+#endif
+  }
+  std::printf("%-34s %3zu frames  reconar %.2f ms/frame (%d keyframes)", name, frames.size(),
+              reconar::bench::Median(ours), our_keyframes);
+  if (!theirs.empty()) {
+    std::printf("  OpenCV %.2f ms/frame (%d keyframes)  ratio %.2f", reconar::bench::Median(theirs), their_keyframes,
+                reconar::bench::Median(ours) / reconar::bench::Median(theirs));
+  }
+  std::printf("\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+  const std::string photo = std::string(RECONAR_SHARED_DATA_DIR) + "/strecha_fountain-P11/images/0005.jpg";
+  for (const auto& [width, height] : {std::pair<int, int>{640, 480}, std::pair<int, int>{1280, 720}}) {
+    auto scene = reconar::testing::MakeRotationScene(photo, 1280 / width, width, height);
+    if (!scene.ok()) {
+      std::fprintf(stderr, "%s\n", scene.status().ToString().c_str());
+      return 1;
+    }
+    std::vector<Image<uint8_t>> frames;
+    for (int i = 0; i < 90; ++i) {
+      frames.push_back(reconar::testing::RenderRotatedView(
+          *scene, reconar::testing::YawPitchRoll(-13.0 + 0.3 * i, 2.0 * std::sin(0.1 * i), 0.0)));
+    }
+    const std::string name = "rotating sweep " + std::to_string(width) + "x" + std::to_string(height);
+    Measure(name.c_str(), frames, repeats);
+  }
+  std::vector<Image<uint8_t>> video;
+  for (const reconar::testing::ArVideoFrame& frame : reconar::testing::ReadArVideoFrames()) {
+    auto decoded = reconar::ReadImage(reconar::testing::ArVideoDir() + "/frames/" + frame.name);
+    if (!decoded.ok()) {
+      std::fprintf(stderr, "%s\n", decoded.status().ToString().c_str());
+      return 1;
+    }
+    video.push_back(reconar::ToGray8(decoded->rgb));
+  }
+  Measure("AR video 640x480 (real frames)", video, repeats);
+  return 0;
+}

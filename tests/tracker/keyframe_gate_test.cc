@@ -1,0 +1,177 @@
+// The capture's keyframe gate (tracker/keyframe_gate.h) on a real-looking video with known motion:
+// fountain-P11's photo seen by a camera turning about its centre (rotation_video.h), with motion
+// blur and darkness put on frames we choose, so which frames are blurred or dark is known.
+#include "tracker/keyframe_gate.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <set>
+#include <vector>
+
+#include "tests/tracker/rotation_video.h"
+
+namespace reconar {
+namespace {
+
+// The photo box-filtered by `downscale`: 4 makes frames that show most of it, 2 a narrower view
+// that can jump within it.
+testing::RotationScene Scene(int downscale = 4) {
+  auto scene = testing::MakeRotationScene(
+      std::string(RECONAR_SHARED_DATA_DIR) + "/strecha_fountain-P11/images/0005.jpg", downscale, 640, 480);
+  EXPECT_TRUE(scene.ok()) << scene.status().ToString();
+  return std::move(*scene);
+}
+
+// A sweep of `count` frames turning by `step_deg` of yaw per frame, starting at start_deg.
+std::vector<Image<uint8_t>> Sweep(const testing::RotationScene& scene, int count, double start_deg, double step_deg) {
+  std::vector<Image<uint8_t>> frames;
+  for (int i = 0; i < count; ++i) {
+    frames.push_back(testing::RenderRotatedView(scene, testing::YawPitchRoll(start_deg + step_deg * i, 0.0, 0.0)));
+  }
+  return frames;
+}
+
+// Horizontal motion blur: the mean of `length` pixels along each row.
+Image<uint8_t> MotionBlurred(const Image<uint8_t>& frame, int length) {
+  Image<uint8_t> out(frame.width(), frame.height());
+  for (int y = 0; y < frame.height(); ++y) {
+    for (int x = 0; x < frame.width(); ++x) {
+      int sum = 0;
+      for (int k = 0; k < length; ++k) sum += frame.row(y)[std::clamp(x + k - length / 2, 0, frame.width() - 1)];
+      out.row(y)[x] = static_cast<uint8_t>(sum / length);
+    }
+  }
+  return out;
+}
+
+Image<uint8_t> Darkened(const Image<uint8_t>& frame, double gain) {
+  Image<uint8_t> out(frame.width(), frame.height());
+  for (int y = 0; y < frame.height(); ++y)
+    for (int x = 0; x < frame.width(); ++x) out.row(y)[x] = static_cast<uint8_t>(frame.row(y)[x] * gain);
+  return out;
+}
+
+std::vector<GateFrameReport> RunGate(const std::vector<Image<uint8_t>>& frames,
+                                     const KeyframeGateOptions& options = KeyframeGateOptions()) {
+  KeyframeGate gate(options);
+  std::vector<GateFrameReport> reports(frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) EXPECT_TRUE(gate.Process(frames[i].view(), &reports[i]).ok());
+  return reports;
+}
+
+TEST(KeyframeGateTest, AStillCameraGivesOneKeyframe) {
+  const testing::RotationScene scene = Scene();
+  const std::vector<Image<uint8_t>> frames(20, testing::RenderRotatedView(scene, testing::YawPitchRoll(0, 0, 0)));
+  const std::vector<GateFrameReport> reports = RunGate(frames);
+  EXPECT_EQ(reports[0].verdict, GateVerdict::kKeyframe);
+  for (size_t i = 1; i < reports.size(); ++i) {
+    EXPECT_EQ(reports[i].verdict, GateVerdict::kTooClose) << i;
+    EXPECT_NEAR(reports[i].motion, 0.0, 1e-3);
+    EXPECT_GT(reports[i].overlap, 0.95);
+  }
+  EXPECT_GE(reports[1].corners, 40);
+}
+
+// Turning steadily: keyframes follow each other as the view moves, each after the motion or the
+// overlap asked for, and the motion measured agrees with the true turn.
+TEST(KeyframeGateTest, KeyframesFollowTheMotion) {
+  const testing::RotationScene scene = Scene();
+  const double step_deg = 0.4;
+  const std::vector<Image<uint8_t>> frames = Sweep(scene, 60, -12.0, step_deg);
+  const KeyframeGateOptions options;
+  const std::vector<GateFrameReport> reports = RunGate(frames, options);
+  // A yaw of d degrees moves the centre of the view by about focal * tan(d) pixels.
+  const double px_per_frame = scene.frame_camera.fx * std::tan(step_deg * M_PI / 180.0);
+  int keyframes = 0, last = 0;
+  for (size_t i = 0; i < reports.size(); ++i) {
+    EXPECT_NE(reports[i].verdict, GateVerdict::kLost) << i;
+    EXPECT_NE(reports[i].verdict, GateVerdict::kBlurred) << i;
+    if (i > 0) {
+      EXPECT_NEAR(reports[i].frame_motion * 640.0, px_per_frame, 0.25 * px_per_frame) << i;
+    }
+    if (reports[i].verdict != GateVerdict::kKeyframe) continue;
+    ++keyframes;
+    if (i > 0) {
+      EXPECT_TRUE(reports[i].motion >= options.keyframe_motion || reports[i].overlap < options.keyframe_overlap) << i;
+      EXPECT_NEAR(reports[i].motion * 640.0, px_per_frame * static_cast<double>(i - last),
+                  0.2 * px_per_frame * (i - last))
+          << i;
+    }
+    last = static_cast<int>(i);
+  }
+  std::printf("%d keyframes of %zu frames, %.1f px per frame\n", keyframes, frames.size(), px_per_frame);
+  EXPECT_GE(keyframes, 4);
+  EXPECT_LE(keyframes, 20);
+}
+
+// Frames with motion blur never become keyframes, however the sweep falls.
+TEST(KeyframeGateTest, BlurredFramesAreNeverKeyframes) {
+  const testing::RotationScene scene = Scene();
+  std::vector<Image<uint8_t>> frames = Sweep(scene, 80, -16.0, 0.4);
+  std::set<size_t> blurred;
+  for (size_t i = 6; i < frames.size(); i += 3) {
+    frames[i] = MotionBlurred(frames[i], 9);
+    blurred.insert(i);
+  }
+  const std::vector<GateFrameReport> reports = RunGate(frames);
+  int keyframes = 0, sharp_passed_over = 0;
+  for (size_t i = 0; i < reports.size(); ++i) {
+    if (blurred.count(i)) {
+      EXPECT_NE(reports[i].verdict, GateVerdict::kKeyframe) << i;
+      EXPECT_EQ(reports[i].verdict, GateVerdict::kBlurred) << i << " sharpness " << reports[i].sharpness;
+    } else {
+      keyframes += reports[i].verdict == GateVerdict::kKeyframe;
+      sharp_passed_over += reports[i].verdict == GateVerdict::kBlurred;
+    }
+  }
+  std::printf("%zu blurred frames, none taken; %d keyframes; %d sharp frames judged blurred\n", blurred.size(),
+              keyframes, sharp_passed_over);
+  EXPECT_EQ(sharp_passed_over, 0);
+  EXPECT_GE(keyframes, 4);
+}
+
+TEST(KeyframeGateTest, DarkFramesAreNotTakenAndSaySo) {
+  const testing::RotationScene scene = Scene();
+  std::vector<Image<uint8_t>> frames = Sweep(scene, 40, -8.0, 0.4);
+  for (size_t i = 10; i < 30; ++i) frames[i] = Darkened(frames[i], 0.15);
+  const std::vector<GateFrameReport> reports = RunGate(frames);
+  for (size_t i = 10; i < 30; ++i) {
+    EXPECT_EQ(reports[i].verdict, GateVerdict::kBadExposure) << i << " mean " << reports[i].mean_level;
+    EXPECT_STREQ(reports[i].advice, "too dark");
+  }
+}
+
+// A jump away loses the keyframe; coming back finds its corners again without a new keyframe.
+TEST(KeyframeGateTest, LostAfterAJumpAndFoundAgainOnComingBack) {
+  const testing::RotationScene scene = Scene(2);
+  std::vector<Image<uint8_t>> frames;
+  for (int i = 0; i < 5; ++i) frames.push_back(testing::RenderRotatedView(scene, testing::YawPitchRoll(0.0, 0, 0)));
+  for (int i = 0; i < 5; ++i) frames.push_back(testing::RenderRotatedView(scene, testing::YawPitchRoll(14.0, 0, 0)));
+  for (int i = 0; i < 5; ++i) frames.push_back(testing::RenderRotatedView(scene, testing::YawPitchRoll(0.3, 0, 0)));
+  const std::vector<GateFrameReport> reports = RunGate(frames);
+  EXPECT_EQ(reports[5].verdict, GateVerdict::kLost);
+  EXPECT_STREQ(reports[5].advice, "go back: lost");
+  EXPECT_TRUE(reports[10].recovered);
+  for (size_t i = 10; i < 15; ++i) {
+    EXPECT_EQ(reports[i].verdict, GateVerdict::kTooClose) << i;
+    EXPECT_GT(reports[i].overlap, 0.6) << i;
+  }
+}
+
+TEST(KeyframeGateTest, AFrameOfAnotherSizeIsRefused) {
+  KeyframeGate gate;
+  Image<uint8_t> a(320, 240), b(640, 480);
+  GateFrameReport report;
+  ASSERT_TRUE(gate.Process(a.view(), &report).ok());
+  const Status status = gate.Process(b.view(), &report);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("640x480 after frames of 320x240"), std::string::npos) << status.message();
+  KeyframeGateOptions bad;
+  bad.keyframe_overlap = 0.1;
+  KeyframeGate refusing(bad);
+  EXPECT_FALSE(refusing.Process(a.view(), &report).ok());
+}
+
+}  // namespace
+}  // namespace reconar

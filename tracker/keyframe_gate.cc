@@ -1,0 +1,291 @@
+#include "tracker/keyframe_gate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace reconar {
+namespace {
+
+constexpr int kShadowLevel = 4;
+constexpr int kHighlightLevel = 251;
+constexpr int kPyramidLevels = 3;
+constexpr float kMaxForwardBackwardPx = 1.0f;  // analysis pixels
+
+// The median of values[0, count) (reorders them).
+template <typename T>
+T MedianInPlace(T* values, int count) {
+  T* middle = values + count / 2;
+  std::nth_element(values, middle, values + count);
+  return *middle;
+}
+
+}  // namespace
+
+const char* GateVerdictName(GateVerdict verdict) {
+  switch (verdict) {
+    case GateVerdict::kKeyframe:
+      return "keyframe";
+    case GateVerdict::kBlurred:
+      return "blurred";
+    case GateVerdict::kBadExposure:
+      return "bad exposure";
+    case GateVerdict::kTooClose:
+      return "too close to the last keyframe";
+    case GateVerdict::kLost:
+      return "lost";
+  }
+  return "?";
+}
+
+Status KeyframeGateOptions::Check() const {
+  if (analysis_width < 64) return InvalidArgument("KeyframeGateOptions: analysis_width < 64");
+  if (!(sharpness_ratio > 0.0 && sharpness_ratio <= 1.0))
+    return InvalidArgument("KeyframeGateOptions: sharpness_ratio must be in (0, 1]");
+  if (sharpness_window < 1 || sharpness_window > 64)
+    return InvalidArgument("KeyframeGateOptions: sharpness_window must be in [1, 64]");
+  if (min_history < 1 || min_history > sharpness_window)
+    return InvalidArgument("KeyframeGateOptions: min_history must be in [1, sharpness_window]");
+  if (!(max_clipped_fraction > 0.0 && max_clipped_fraction <= 1.0))
+    return InvalidArgument("KeyframeGateOptions: max_clipped_fraction must be in (0, 1]");
+  if (!(min_mean_level >= 0.0 && max_mean_level > min_mean_level && max_mean_level <= 255.0))
+    return InvalidArgument("KeyframeGateOptions: need 0 <= min_mean_level < max_mean_level <= 255");
+  if (!(keyframe_motion > 0.0)) return InvalidArgument("KeyframeGateOptions: keyframe_motion <= 0");
+  if (!(lost_overlap >= 0.0 && keyframe_overlap > lost_overlap && keyframe_overlap <= 1.0))
+    return InvalidArgument("KeyframeGateOptions: need 0 <= lost_overlap < keyframe_overlap <= 1");
+  if (!(max_frame_motion > 0.0)) return InvalidArgument("KeyframeGateOptions: max_frame_motion <= 0");
+  if (grid_columns < 2 || grid_rows < 2 || grid_columns * grid_rows > 256)
+    return InvalidArgument("KeyframeGateOptions: the grid needs 2 x 2 to 256 cells");
+  if (lost_frames_to_restart < 1) return InvalidArgument("KeyframeGateOptions: lost_frames_to_restart < 1");
+  return Status::Ok();
+}
+
+KeyframeGate::KeyframeGate(const KeyframeGateOptions& options) : options_(options) {
+  flow_options_.window_radius = 5;
+  flow_options_.num_levels = kPyramidLevels;
+}
+
+void KeyframeGate::Downscale(ImageView<const uint8_t> gray) {
+  const int f = factor_;
+  const int area = f * f;
+  for (int y = 0; y < small_.height(); ++y) {
+    uint8_t* out = small_.row(y);
+    for (int x = 0; x < small_.width(); ++x) {
+      int sum = 0;
+      for (int dy = 0; dy < f; ++dy) {
+        const uint8_t* in = gray.row(y * f + dy) + x * f;
+        for (int dx = 0; dx < f; ++dx) sum += in[dx];
+      }
+      out[x] = static_cast<uint8_t>((sum + area / 2) / area);
+    }
+  }
+}
+
+void KeyframeGate::MeasureImage(GateFrameReport* report) const {
+  const int w = small_.width(), h = small_.height();
+  long long clipped = 0, level_sum = 0;
+  double laplacian_sum = 0.0, laplacian_squares = 0.0;
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* row = small_.row(y);
+    for (int x = 0; x < w; ++x) {
+      level_sum += row[x];
+      clipped += (row[x] <= kShadowLevel || row[x] >= kHighlightLevel) ? 1 : 0;
+    }
+    if (y == 0 || y == h - 1) continue;
+    const uint8_t* up = small_.row(y - 1);
+    const uint8_t* down = small_.row(y + 1);
+    for (int x = 1; x < w - 1; ++x) {
+      const double laplacian = up[x] + down[x] + row[x - 1] + row[x + 1] - 4.0 * row[x];
+      laplacian_sum += laplacian;
+      laplacian_squares += laplacian * laplacian;
+    }
+  }
+  const double pixels = static_cast<double>(w) * h;
+  const double interior = static_cast<double>(w - 2) * (h - 2);
+  report->mean_level = level_sum / pixels;
+  report->clipped_fraction = clipped / pixels;
+  const double mean = laplacian_sum / interior;
+  report->sharpness = laplacian_squares / interior - mean * mean;
+}
+
+double KeyframeGate::SharpnessReference() const {
+  if (history_count_ < options_.min_history) return sharpness_max_;
+  std::array<double, 64> sorted = sharpness_history_;
+  return MedianInPlace(sorted.data(), history_count_);
+}
+
+void KeyframeGate::RememberSharpness(double sharpness) {
+  sharpness_history_[static_cast<size_t>(history_next_)] = sharpness;
+  history_next_ = (history_next_ + 1) % options_.sharpness_window;
+  history_count_ = std::min(history_count_ + 1, options_.sharpness_window);
+  sharpness_max_ = std::max(sharpness_max_, sharpness);
+}
+
+// Corners of the newest frame: per grid cell the pixel with the largest smaller eigenvalue of the
+// 3x3 structure tensor (Shi & Tomasi, "Good Features to Track", CVPR 1994), when it is textured
+// enough for the flow.
+void KeyframeGate::TakeKeyframe() {
+  const int w = small_.width(), h = small_.height();
+  const int margin = flow_options_.window_radius + 2;
+  num_corners_ = 0;
+  for (int gy = 0; gy < options_.grid_rows; ++gy) {
+    for (int gx = 0; gx < options_.grid_columns; ++gx) {
+      const int x0 = std::max(margin, gx * w / options_.grid_columns);
+      const int x1 = std::min(w - margin, (gx + 1) * w / options_.grid_columns);
+      const int y0 = std::max(margin, gy * h / options_.grid_rows);
+      const int y1 = std::min(h - margin, (gy + 1) * h / options_.grid_rows);
+      float best = static_cast<float>(flow_options_.min_eigenvalue) * 4.0f;
+      int best_x = -1, best_y = -1;
+      for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+          double gxx = 0.0, gyy = 0.0, gxy = 0.0;
+          for (int dy = -1; dy <= 1; ++dy) {
+            const uint8_t* row = small_.row(y + dy);
+            const uint8_t* up = small_.row(y + dy - 1);
+            const uint8_t* down = small_.row(y + dy + 1);
+            for (int dx = -1; dx <= 1; ++dx) {
+              const double ix = 0.5 * (row[x + dx + 1] - row[x + dx - 1]);
+              const double iy = 0.5 * (down[x + dx] - up[x + dx]);
+              gxx += ix * ix, gyy += iy * iy, gxy += ix * iy;
+            }
+          }
+          gxx /= 9.0, gyy /= 9.0, gxy /= 9.0;
+          const float smaller =
+              static_cast<float>(0.5 * (gxx + gyy) - std::sqrt(0.25 * (gxx - gyy) * (gxx - gyy) + gxy * gxy));
+          if (smaller > best) best = smaller, best_x = x, best_y = y;
+        }
+      }
+      if (best_x < 0) continue;
+      const Eigen::Vector2f corner(static_cast<float>(best_x), static_cast<float>(best_y));
+      keyframe_corners_[static_cast<size_t>(num_corners_)] = corner;
+      corners_[static_cast<size_t>(num_corners_)] = corner;
+      alive_[static_cast<size_t>(num_corners_)] = true;
+      ++num_corners_;
+    }
+  }
+  keyframe_pyramid_ = pyramids_[current_];
+  have_keyframe_ = true;
+  ++keyframes_;
+  lost_frames_ = 0;
+}
+
+// flow_ for the corners at `from` (in `previous`) into `next`; a result whose flow back does not
+// return within kMaxForwardBackwardPx is marked lost (kLargeError).
+Status KeyframeGate::ConsistentFlow(const ImagePyramid& previous, const ImagePyramid& next,
+                                    const Eigen::Vector2f* from) {
+  RECONAR_RETURN_IF_ERROR(TrackPoints(previous, next, flow_options_, from, nullptr, num_corners_, flow_.data()));
+  for (int i = 0; i < num_corners_; ++i) forward_[static_cast<size_t>(i)] = flow_[static_cast<size_t>(i)].point;
+  RECONAR_RETURN_IF_ERROR(
+      TrackPoints(next, previous, flow_options_, forward_.data(), from, num_corners_, backward_flow_.data()));
+  for (int i = 0; i < num_corners_; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    if (flow_[k].status != FlowStatus::kTracked) continue;
+    if (backward_flow_[k].status != FlowStatus::kTracked ||
+        (backward_flow_[k].point - from[i]).norm() > kMaxForwardBackwardPx)
+      flow_[k].status = FlowStatus::kLargeError;
+  }
+  return Status::Ok();
+}
+
+// Follows the keyframe's corners from the previous frame into the newest one.
+Status KeyframeGate::FollowCorners(GateFrameReport* report) {
+  const ImagePyramid& previous = pyramids_[1 - current_];
+  const ImagePyramid& next = pyramids_[current_];
+  RECONAR_RETURN_IF_ERROR(ConsistentFlow(previous, next, corners_.data()));
+  int alive = 0, moved = 0;
+  for (int i = 0; i < num_corners_; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    if (!alive_[k]) continue;
+    if (flow_[k].status != FlowStatus::kTracked) {
+      alive_[k] = false;
+      continue;
+    }
+    scratch_[static_cast<size_t>(moved++)] = (flow_[k].point - corners_[k]).norm();
+    corners_[k] = flow_[k].point;
+    followed_[static_cast<size_t>(alive++)] = corners_[k] - keyframe_corners_[k];
+  }
+  // Lost: the view may have come back to the keyframe's, so look for its corners from there.
+  if (alive < options_.lost_overlap * num_corners_) {
+    RECONAR_RETURN_IF_ERROR(ConsistentFlow(keyframe_pyramid_, next, keyframe_corners_.data()));
+    int found = 0;
+    for (int i = 0; i < num_corners_; ++i) found += flow_[static_cast<size_t>(i)].status == FlowStatus::kTracked;
+    if (found > alive) {
+      alive = moved = 0;
+      report->recovered = true;
+      for (int i = 0; i < num_corners_; ++i) {
+        const size_t k = static_cast<size_t>(i);
+        alive_[k] = flow_[k].status == FlowStatus::kTracked;
+        if (!alive_[k]) continue;
+        corners_[k] = flow_[k].point;
+        followed_[static_cast<size_t>(alive++)] = corners_[k] - keyframe_corners_[k];
+      }
+    }
+  }
+  const float width = static_cast<float>(small_.width());
+  report->corners = num_corners_;
+  report->overlap = num_corners_ > 0 ? static_cast<double>(alive) / num_corners_ : 0.0;
+  report->frame_motion = moved > 0 ? MedianInPlace(scratch_.data(), moved) / width : 0.0;
+  for (int i = 0; i < alive; ++i) scratch_[static_cast<size_t>(i)] = followed_[static_cast<size_t>(i)].norm();
+  report->motion = alive > 0 ? MedianInPlace(scratch_.data(), alive) / width : 0.0;
+  return Status::Ok();
+}
+
+Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* report) {
+  *report = GateFrameReport();
+  if (gray.data == nullptr || gray.width <= 0 || gray.height <= 0)
+    return InvalidArgument("keyframe gate: an empty frame");
+  if (frame_width_ == 0) {
+    RECONAR_RETURN_IF_ERROR(options_.Check());
+    frame_width_ = gray.width, frame_height_ = gray.height;
+    factor_ = std::max(1, (gray.width + options_.analysis_width - 1) / options_.analysis_width);
+    small_ = Image<uint8_t>(gray.width / factor_, gray.height / factor_);
+    if (small_.width() < 32 || small_.height() < 32)
+      return InvalidArgument("keyframe gate: frames under 32 pixels after downscaling");
+  } else if (gray.width != frame_width_ || gray.height != frame_height_) {
+    return InvalidArgument("keyframe gate: a frame of " + std::to_string(gray.width) + "x" +
+                           std::to_string(gray.height) + " after frames of " + std::to_string(frame_width_) + "x" +
+                           std::to_string(frame_height_));
+  }
+  Downscale(gray);
+  current_ = 1 - current_;
+  RECONAR_RETURN_IF_ERROR(pyramids_[current_].Build(small_.view(), kPyramidLevels));
+  MeasureImage(report);
+  if (have_keyframe_) RECONAR_RETURN_IF_ERROR(FollowCorners(report));
+
+  const bool exposed = report->clipped_fraction <= options_.max_clipped_fraction &&
+                       report->mean_level >= options_.min_mean_level && report->mean_level <= options_.max_mean_level;
+  report->sharpness_threshold = options_.sharpness_ratio * SharpnessReference();
+  if (exposed) RememberSharpness(report->sharpness);
+  const bool fast = report->frame_motion > options_.max_frame_motion;
+  if (!exposed) {
+    report->verdict = GateVerdict::kBadExposure;
+    report->advice = report->mean_level < options_.min_mean_level   ? "too dark"
+                     : report->mean_level > options_.max_mean_level ? "too bright"
+                                                                    : "light too harsh: clipped shadows or highlights";
+  } else if (report->sharpness < report->sharpness_threshold) {
+    report->verdict = GateVerdict::kBlurred;
+    report->advice = fast ? "too fast" : "hold steady: blurred";
+  } else if (!have_keyframe_) {
+    report->verdict = GateVerdict::kKeyframe;
+    report->advice = "move sideways";
+  } else if (report->overlap < options_.lost_overlap) {
+    report->verdict = GateVerdict::kLost;
+    report->advice = "go back: lost";
+    if (++lost_frames_ >= options_.lost_frames_to_restart) {
+      report->verdict = GateVerdict::kKeyframe;
+      report->restarted = true;
+      report->advice = "started again: go back to join the earlier views";
+    }
+  } else if (report->motion >= options_.keyframe_motion || report->overlap < options_.keyframe_overlap) {
+    report->verdict = GateVerdict::kKeyframe;
+    report->advice = fast ? "too fast" : "move sideways";
+  } else {
+    report->verdict = GateVerdict::kTooClose;
+    report->advice = fast ? "too fast" : "move sideways";
+  }
+  if (report->verdict == GateVerdict::kKeyframe) TakeKeyframe();
+  if (report->verdict != GateVerdict::kLost) lost_frames_ = 0;
+  return Status::Ok();
+}
+
+}  // namespace reconar
