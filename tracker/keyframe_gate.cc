@@ -4,6 +4,9 @@
 #include <cmath>
 #include <string>
 
+#include "core/base/prng.h"
+#include "core/geometry/homography_four_point.h"
+
 namespace reconar {
 namespace {
 
@@ -11,6 +14,8 @@ constexpr int kShadowLevel = 4;
 constexpr int kHighlightLevel = 251;
 constexpr int kPyramidLevels = 3;
 constexpr float kMaxForwardBackwardPx = 1.0f;  // analysis pixels
+constexpr double kHomographyInlierPx = 1.0;    // analysis pixels
+constexpr int kHomographyIterations = 64;
 
 // The median of values[0, count) (reorders them).
 template <typename T>
@@ -50,7 +55,7 @@ Status KeyframeGateOptions::Check() const {
     return InvalidArgument("KeyframeGateOptions: max_clipped_fraction must be in (0, 1]");
   if (!(min_mean_level >= 0.0 && max_mean_level > min_mean_level && max_mean_level <= 255.0))
     return InvalidArgument("KeyframeGateOptions: need 0 <= min_mean_level < max_mean_level <= 255");
-  if (!(keyframe_motion > 0.0)) return InvalidArgument("KeyframeGateOptions: keyframe_motion <= 0");
+  if (!(keyframe_parallax > 0.0)) return InvalidArgument("KeyframeGateOptions: keyframe_parallax <= 0");
   if (!(lost_overlap >= 0.0 && keyframe_overlap > lost_overlap && keyframe_overlap <= 1.0))
     return InvalidArgument("KeyframeGateOptions: need 0 <= lost_overlap < keyframe_overlap <= 1");
   if (!(max_frame_motion > 0.0)) return InvalidArgument("KeyframeGateOptions: max_frame_motion <= 0");
@@ -65,47 +70,58 @@ KeyframeGate::KeyframeGate(const KeyframeGateOptions& options) : options_(option
   flow_options_.num_levels = kPyramidLevels;
 }
 
+// Box filter by factor_: the factor_ input rows of an output row summed into column_sums_ (a loop
+// the compiler vectorises), then each run of factor_ sums added.
 void KeyframeGate::Downscale(ImageView<const uint8_t> gray) {
   const int f = factor_;
   const int area = f * f;
+  const int used_width = small_.width() * f;
+  uint32_t* sums = column_sums_.data();
   for (int y = 0; y < small_.height(); ++y) {
+    const uint8_t* first = gray.row(y * f);
+    for (int x = 0; x < used_width; ++x) sums[x] = first[x];
+    for (int dy = 1; dy < f; ++dy) {
+      const uint8_t* in = gray.row(y * f + dy);
+      for (int x = 0; x < used_width; ++x) sums[x] += in[x];
+    }
     uint8_t* out = small_.row(y);
     for (int x = 0; x < small_.width(); ++x) {
-      int sum = 0;
-      for (int dy = 0; dy < f; ++dy) {
-        const uint8_t* in = gray.row(y * f + dy) + x * f;
-        for (int dx = 0; dx < f; ++dx) sum += in[dx];
-      }
-      out[x] = static_cast<uint8_t>((sum + area / 2) / area);
+      uint32_t sum = 0;
+      for (int dx = 0; dx < f; ++dx) sum += sums[x * f + dx];
+      out[x] = static_cast<uint8_t>((sum + static_cast<uint32_t>(area / 2)) / static_cast<uint32_t>(area));
     }
   }
 }
 
-void KeyframeGate::MeasureImage(GateFrameReport* report) const {
+// Exposure on the analysis image; sharpness on the frame itself, at every other pixel of every
+// other row (the box filter would take away the finest detail that blur removes first).
+void KeyframeGate::MeasureImage(ImageView<const uint8_t> gray, GateFrameReport* report) const {
   const int w = small_.width(), h = small_.height();
   long long clipped = 0, level_sum = 0;
-  double laplacian_sum = 0.0, laplacian_squares = 0.0;
   for (int y = 0; y < h; ++y) {
     const uint8_t* row = small_.row(y);
     for (int x = 0; x < w; ++x) {
       level_sum += row[x];
       clipped += (row[x] <= kShadowLevel || row[x] >= kHighlightLevel) ? 1 : 0;
     }
-    if (y == 0 || y == h - 1) continue;
-    const uint8_t* up = small_.row(y - 1);
-    const uint8_t* down = small_.row(y + 1);
-    for (int x = 1; x < w - 1; ++x) {
-      const double laplacian = up[x] + down[x] + row[x - 1] + row[x + 1] - 4.0 * row[x];
-      laplacian_sum += laplacian;
-      laplacian_squares += laplacian * laplacian;
-    }
   }
   const double pixels = static_cast<double>(w) * h;
-  const double interior = static_cast<double>(w - 2) * (h - 2);
-  report->mean_level = level_sum / pixels;
-  report->clipped_fraction = clipped / pixels;
-  const double mean = laplacian_sum / interior;
-  report->sharpness = laplacian_squares / interior - mean * mean;
+  report->mean_level = static_cast<double>(level_sum) / pixels;
+  report->clipped_fraction = static_cast<double>(clipped) / pixels;
+  long long laplacian_sum = 0, laplacian_squares = 0, count = 0;
+  for (int y = 1; y + 1 < gray.height; y += 2) {
+    const uint8_t* up = gray.row(y - 1);
+    const uint8_t* row = gray.row(y);
+    const uint8_t* down = gray.row(y + 1);
+    for (int x = 1; x + 1 < gray.width; x += 2) {
+      const int laplacian = up[x] + down[x] + row[x - 1] + row[x + 1] - 4 * row[x];
+      laplacian_sum += laplacian;
+      laplacian_squares += laplacian * laplacian;
+      ++count;
+    }
+  }
+  const double mean = count > 0 ? static_cast<double>(laplacian_sum) / count : 0.0;
+  report->sharpness = count > 0 ? static_cast<double>(laplacian_squares) / count - mean * mean : 0.0;
 }
 
 double KeyframeGate::SharpnessReference() const {
@@ -169,6 +185,46 @@ void KeyframeGate::TakeKeyframe() {
   lost_frames_ = 0;
 }
 
+// The median distance (analysis pixels) of the followed corners from where the homography that
+// explains most of them puts them (RANSAC over 4-point samples, seeded: deterministic; refitted on
+// its inliers). 0 with fewer than 8 corners: too few to tell.
+double KeyframeGate::Parallax(int count) {
+  if (count < 8) return 0.0;
+  SplitMix64 rng(0x6b6579ull);
+  std::array<Eigen::Matrix3d, HomographyFourPoint::kMaxModels> models;
+  Eigen::Matrix3d best = Eigen::Matrix3d::Identity();
+  int best_inliers = -1;
+  const double inlier_squared = kHomographyInlierPx * kHomographyInlierPx;
+  for (int iteration = 0; iteration < kHomographyIterations; ++iteration) {
+    std::array<Correspondence, 4> sample;
+    std::array<int, 4> picked = {-1, -1, -1, -1};
+    for (int s = 0; s < 4; ++s) {
+      int index;
+      do {
+        index = static_cast<int>(rng.UniformInt(static_cast<uint32_t>(count)));
+      } while (std::find(picked.begin(), picked.begin() + s, index) != picked.begin() + s);
+      picked[static_cast<size_t>(s)] = index;
+      sample[static_cast<size_t>(s)] = pairs_[static_cast<size_t>(index)];
+    }
+    if (HomographyFourPoint::Estimate(sample.data(), 4, &models) == 0) continue;
+    HomographyFourPoint::Residuals(pairs_.data(), count, models[0], residuals_.data());
+    int inliers = 0;
+    for (int i = 0; i < count; ++i) inliers += residuals_[static_cast<size_t>(i)] <= inlier_squared;
+    if (inliers > best_inliers) best_inliers = inliers, best = models[0];
+  }
+  if (best_inliers < 0) return 0.0;
+  HomographyFourPoint::Residuals(pairs_.data(), count, best, residuals_.data());
+  int inliers = 0;
+  for (int i = 0; i < count; ++i) {
+    if (residuals_[static_cast<size_t>(i)] <= inlier_squared)
+      inlier_pairs_[static_cast<size_t>(inliers++)] = pairs_[static_cast<size_t>(i)];
+  }
+  if (inliers >= 4 && HomographyFourPoint::Estimate(inlier_pairs_.data(), inliers, &models) > 0) best = models[0];
+  HomographyFourPoint::Residuals(pairs_.data(), count, best, residuals_.data());
+  for (int i = 0; i < count; ++i) residuals_[static_cast<size_t>(i)] = std::sqrt(residuals_[static_cast<size_t>(i)]);
+  return MedianInPlace(residuals_.data(), count);
+}
+
 // flow_ for the corners at `from` (in `previous`) into `next`; a result whose flow back does not
 // return within kMaxForwardBackwardPx is marked lost (kLargeError).
 Status KeyframeGate::ConsistentFlow(const ImagePyramid& previous, const ImagePyramid& next,
@@ -202,6 +258,7 @@ Status KeyframeGate::FollowCorners(GateFrameReport* report) {
     }
     scratch_[static_cast<size_t>(moved++)] = (flow_[k].point - corners_[k]).norm();
     corners_[k] = flow_[k].point;
+    pairs_[static_cast<size_t>(alive)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
     followed_[static_cast<size_t>(alive++)] = corners_[k] - keyframe_corners_[k];
   }
   // Lost: the view may have come back to the keyframe's, so look for its corners from there.
@@ -217,6 +274,7 @@ Status KeyframeGate::FollowCorners(GateFrameReport* report) {
         alive_[k] = flow_[k].status == FlowStatus::kTracked;
         if (!alive_[k]) continue;
         corners_[k] = flow_[k].point;
+        pairs_[static_cast<size_t>(alive)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
         followed_[static_cast<size_t>(alive++)] = corners_[k] - keyframe_corners_[k];
       }
     }
@@ -227,6 +285,7 @@ Status KeyframeGate::FollowCorners(GateFrameReport* report) {
   report->frame_motion = moved > 0 ? MedianInPlace(scratch_.data(), moved) / width : 0.0;
   for (int i = 0; i < alive; ++i) scratch_[static_cast<size_t>(i)] = followed_[static_cast<size_t>(i)].norm();
   report->motion = alive > 0 ? MedianInPlace(scratch_.data(), alive) / width : 0.0;
+  report->parallax = Parallax(alive) / width;
   return Status::Ok();
 }
 
@@ -239,6 +298,7 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
     frame_width_ = gray.width, frame_height_ = gray.height;
     factor_ = std::max(1, (gray.width + options_.analysis_width - 1) / options_.analysis_width);
     small_ = Image<uint8_t>(gray.width / factor_, gray.height / factor_);
+    column_sums_.assign(static_cast<size_t>(gray.width), 0);
     if (small_.width() < 32 || small_.height() < 32)
       return InvalidArgument("keyframe gate: frames under 32 pixels after downscaling");
   } else if (gray.width != frame_width_ || gray.height != frame_height_) {
@@ -249,7 +309,7 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
   Downscale(gray);
   current_ = 1 - current_;
   RECONAR_RETURN_IF_ERROR(pyramids_[current_].Build(small_.view(), kPyramidLevels));
-  MeasureImage(report);
+  MeasureImage(gray, report);
   if (have_keyframe_) RECONAR_RETURN_IF_ERROR(FollowCorners(report));
 
   const bool exposed = report->clipped_fraction <= options_.max_clipped_fraction &&
@@ -276,7 +336,7 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
       report->restarted = true;
       report->advice = "started again: go back to join the earlier views";
     }
-  } else if (report->motion >= options_.keyframe_motion || report->overlap < options_.keyframe_overlap) {
+  } else if (report->parallax >= options_.keyframe_parallax || report->overlap < options_.keyframe_overlap) {
     report->verdict = GateVerdict::kKeyframe;
     report->advice = fast ? "too fast" : "move sideways";
   } else {

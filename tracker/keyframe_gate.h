@@ -1,21 +1,26 @@
 #pragma once
 // The capture's keyframe gate (issue 18): at video rate, which frames of a live camera serve the
 // reconstruction, and what the person holding it should do next. Each frame is looked at on a copy
-// box-filtered down to at most KeyframeGateOptions::analysis_width pixels wide:
-//  - sharpness: the variance of its 4-neighbour Laplacian, against the median of the recent frames'
+// box-filtered down to at most KeyframeGateOptions::analysis_width pixels wide, and for sharpness
+// on the frame itself:
+//  - sharpness: the variance of the frame's 4-neighbour Laplacian (at every other pixel of every
+//    other row: the box filter would take away the finest detail, which blur removes first),
+//    against the median of the recent frames'
 //    (the scene sets the scale: a leafy facade and a white wall differ a hundredfold), so a frame
 //    blurred by motion falls out while the scene's own level is accepted;
 //  - exposure: the share of clipped shadows and highlights, and the mean level;
 //  - motion against the last keyframe: corners found in the keyframe (one per grid cell, the
 //    strongest Shi-Tomasi response) followed frame to frame by pyramidal Lucas-Kanade, each kept
 //    only when the flow back from the new frame returns it within a pixel (Kalal, Mikolajczyk &
-//    Matas, "Forward-Backward Error", ICPR 2010: a jump the flow cannot follow fails here). Their
-//    median displacement since the keyframe, the share still followed (the overlap with the
-//    keyframe) and the median displacement since the previous frame (how fast the view moves).
-// A sharp, well-exposed frame becomes a keyframe when the view has moved far enough or the overlap
-// has fallen low enough that the next one would not register (docs/capture.md gives the rules and
-// the reasons for their defaults). Steady state makes no heap allocation: every buffer is sized on
-// the first frame (tests/tracker/keyframe_gate_allocation_test.cc).
+//    Matas, "Forward-Backward Error", ICPR 2010: a jump the flow cannot follow fails here). From
+//    them: the parallax since the keyframe (the median distance of the corners from where the
+//    best homography of the keyframe puts them: a camera turning on the spot, or a plane, gives
+//    none, depth seen from a new place does), the share still followed (the overlap with the
+//    keyframe), and the median displacement since the previous frame (how fast the view moves).
+// A sharp, well-exposed frame becomes a keyframe when it has enough parallax to triangulate
+// from, or when the overlap has fallen so low that the next one would not register
+// (docs/capture.md gives the rules and the reasons for their defaults). Steady state makes no heap allocation: every
+// buffer is sized on the first frame (tests/tracker/keyframe_gate_allocation_test.cc).
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
@@ -24,6 +29,7 @@
 #include "core/base/image.h"
 #include "core/base/status.h"
 #include "core/features/optical_flow.h"
+#include "core/geometry/correspondence.h"
 
 namespace reconar {
 
@@ -39,7 +45,7 @@ struct KeyframeGateOptions {
   double min_mean_level = 35.0;   // darker on average: "too dark"
   double max_mean_level = 225.0;  // brighter: "too bright"
   // Motion, as fractions of the analysis width.
-  double keyframe_motion = 0.12;         // a keyframe once the view moved this far since the last one ...
+  double keyframe_parallax = 0.02;       // a keyframe once the parallax since the last one reaches this ...
   double keyframe_overlap = 0.6;         // ... or fewer than this share of its corners are still followed
   double lost_overlap = 0.25;            // fewer than this: lost (the next keyframe would not register)
   double max_frame_motion = 0.06;        // more per frame: "too fast"
@@ -66,6 +72,7 @@ struct GateFrameReport {
   double clipped_fraction = 0.0;
   double mean_level = 0.0;
   double motion = 0.0;        // median displacement since the last keyframe / analysis width
+  double parallax = 0.0;      // median distance from the keyframe's homography / analysis width
   double frame_motion = 0.0;  // median displacement since the previous frame / analysis width
   double overlap = 1.0;       // share of the keyframe's corners still followed
   int corners = 0;            // corners found in the last keyframe
@@ -87,11 +94,12 @@ class KeyframeGate {
   static constexpr int kMaxCorners = 256;
 
   void Downscale(ImageView<const uint8_t> gray);
-  void MeasureImage(GateFrameReport* report) const;
+  void MeasureImage(ImageView<const uint8_t> gray, GateFrameReport* report) const;
   double SharpnessReference() const;
   void RememberSharpness(double sharpness);
   void TakeKeyframe();
   Status FollowCorners(GateFrameReport* report);
+  double Parallax(int count);
   Status ConsistentFlow(const ImagePyramid& previous, const ImagePyramid& next, const Eigen::Vector2f* from);
 
   KeyframeGateOptions options_;
@@ -112,12 +120,15 @@ class KeyframeGate {
   std::array<FlowResult, kMaxCorners> backward_flow_{};
   std::array<bool, kMaxCorners> alive_{};
   std::array<float, kMaxCorners> scratch_{};
+  std::array<Correspondence, kMaxCorners> pairs_{};  // keyframe corner -> its place now
+  std::array<Correspondence, kMaxCorners> inlier_pairs_{};
+  std::array<double, kMaxCorners> residuals_{};
   int num_corners_ = 0;
   std::array<double, 64> sharpness_history_{};
   std::array<double, 64> sharpness_sorted_{};
   int history_count_ = 0, history_next_ = 0;
   double sharpness_max_ = 0.0;
-  std::vector<float> response_;  // Shi-Tomasi response per analysis pixel
+  std::vector<uint32_t> column_sums_;  // one row of the frame, for the box filter
 };
 
 }  // namespace reconar

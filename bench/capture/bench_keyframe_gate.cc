@@ -3,7 +3,8 @@
 // video's 93 real 640x480 frames. With OpenCV found, the same work done with OpenCV runs beside it in
 // the same process, alternating runs: INTER_AREA resize to the analysis width, Laplacian variance,
 // mean and clipped share, goodFeaturesToTrack on keyframes, calcOpticalFlowPyrLK forward and back
-// (window 11, 3 levels, as ours). Reported as ratios: these machines are noisy.
+// (window 11, 3 levels, as ours), findHomography (RANSAC, 1 px) from the keyframe's corners and the
+// median distance from it (the parallax). Reported as ratios: these machines are noisy.
 //   bench_keyframe_gate [repeats=5]
 #include <algorithm>
 #include <chrono>
@@ -20,6 +21,7 @@
 #include "tracker/keyframe_gate.h"
 
 #ifdef RECONAR_BENCH_WITH_OPENCV
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #endif
@@ -54,7 +56,7 @@ Run RunOurs(const std::vector<Image<uint8_t>>& frames) {
 Run RunOpenCv(const std::vector<Image<uint8_t>>& frames) {
   std::vector<double> ms;
   cv::Mat small, previous, laplacian;
-  std::vector<cv::Point2f> keyframe_points, points, forward, backward;
+  std::vector<cv::Point2f> keyframe_points, points, forward, backward, predicted;
   std::vector<uchar> status, back_status;
   std::vector<float> error;
   int keyframes = 0;
@@ -83,12 +85,19 @@ Run RunOpenCv(const std::vector<Image<uint8_t>>& frames) {
       }
       points = kept;
       keyframe_points = kept_keyframe;
-      double motion = 0.0;
-      if (!moved.empty()) {
-        std::nth_element(moved.begin(), moved.begin() + static_cast<long>(moved.size() / 2), moved.end());
-        motion = moved[moved.size() / 2];
+      double parallax = 0.0;
+      if (points.size() >= 8) {
+        const cv::Mat homography = cv::findHomography(keyframe_points, points, cv::RANSAC, 1.0);
+        if (!homography.empty()) {
+          cv::perspectiveTransform(keyframe_points, predicted, homography);
+          moved.clear();
+          for (size_t i = 0; i < points.size(); ++i)
+            moved.push_back(static_cast<float>(cv::norm(predicted[i] - points[i])));
+          std::nth_element(moved.begin(), moved.begin() + static_cast<long>(moved.size() / 2), moved.end());
+          parallax = moved[moved.size() / 2];
+        }
       }
-      keyframe = motion >= 0.12 * small.cols || points.size() < 0.6 * keyframe_count;
+      keyframe = parallax >= 0.02 * small.cols || points.size() < 0.6 * keyframe_count;
     }
     if (keyframe) {
       cv::goodFeaturesToTrack(small, points, 80, 0.01, 0.6 * small.cols / 10);

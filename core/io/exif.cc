@@ -380,4 +380,112 @@ ExifInfo ReadExifFromJpeg(std::string_view jpeg) {
   return none;
 }
 
+namespace {
+
+// One IFD entry to write: its value bytes (little-endian), inline when at most 4 bytes.
+struct EntryToWrite {
+  uint16_t tag;
+  uint16_t type;
+  uint32_t count;
+  std::string value;
+};
+
+void PutU16(std::string* out, uint16_t v) { out->append({static_cast<char>(v & 0xFF), static_cast<char>(v >> 8)}); }
+void PutU32(std::string* out, uint32_t v) {
+  for (int shift = 0; shift < 32; shift += 8) out->push_back(static_cast<char>((v >> shift) & 0xFF));
+}
+void SetU32(std::string* out, size_t at, uint32_t v) {
+  for (int k = 0; k < 4; ++k) (*out)[at + static_cast<size_t>(k)] = static_cast<char>((v >> (8 * k)) & 0xFF);
+}
+
+EntryToWrite Ascii(uint16_t tag, const std::string& text) {
+  std::string value = text.substr(0, kMaxStringLength - 1);
+  value.push_back('\0');
+  return {tag, kAscii, static_cast<uint32_t>(value.size()), value};
+}
+EntryToWrite Short(uint16_t tag, int v) {
+  std::string value;
+  PutU16(&value, static_cast<uint16_t>(std::clamp(v, 0, 65535)));
+  return {tag, kShort, 1, value};
+}
+EntryToWrite Long(uint16_t tag, uint32_t v) {
+  std::string value;
+  PutU32(&value, v);
+  return {tag, kLong, 1, value};
+}
+// A positive rational with a denominator of 10000 (four decimals).
+EntryToWrite Rational(uint16_t tag, double v) {
+  std::string value;
+  PutU32(&value, static_cast<uint32_t>(std::lround(std::clamp(v, 0.0, 4e5) * 10000.0)));
+  PutU32(&value, 10000);
+  return {tag, kRational, 1, value};
+}
+
+// Appends an IFD (entries sorted by tag, as TIFF requires) at the end of `tiff`, then the values
+// that do not fit inline; returns the offset of the "next IFD" field (0 written).
+size_t AppendIfd(std::string* tiff, std::vector<EntryToWrite> entries) {
+  std::sort(entries.begin(), entries.end(), [](const EntryToWrite& a, const EntryToWrite& b) { return a.tag < b.tag; });
+  const size_t start = tiff->size();
+  const size_t data_start = start + 2 + 12 * entries.size() + 4;
+  std::string data;
+  PutU16(tiff, static_cast<uint16_t>(entries.size()));
+  for (const EntryToWrite& e : entries) {
+    PutU16(tiff, e.tag);
+    PutU16(tiff, e.type);
+    PutU32(tiff, e.count);
+    if (e.value.size() <= 4) {
+      std::string inline_value = e.value;
+      inline_value.resize(4, '\0');
+      tiff->append(inline_value);
+    } else {
+      PutU32(tiff, static_cast<uint32_t>(data_start + data.size()));
+      data.append(e.value);
+      if (data.size() % 2 != 0) data.push_back('\0');  // values start on a word boundary
+    }
+  }
+  const size_t next_ifd = tiff->size();
+  PutU32(tiff, 0);
+  tiff->append(data);
+  return next_ifd;
+}
+
+}  // namespace
+
+std::string BuildExifApp1(const ExifInfo& info) {
+  std::vector<EntryToWrite> ifd0, exif_ifd;
+  if (!info.make.empty()) ifd0.push_back(Ascii(kTagMake, info.make));
+  if (!info.model.empty()) ifd0.push_back(Ascii(kTagModel, info.model));
+  ifd0.push_back(Short(kTagOrientation, info.orientation >= 1 && info.orientation <= 8 ? info.orientation : 1));
+  if (info.focal_length_mm > 0) exif_ifd.push_back(Rational(kTagFocalLength, info.focal_length_mm));
+  if (info.focal_length_35mm > 0)
+    exif_ifd.push_back(Short(kTagFocalLengthIn35mm, static_cast<int>(std::lround(info.focal_length_35mm))));
+  if (info.pixel_x_dimension > 0)
+    exif_ifd.push_back(Long(kTagPixelXDimension, static_cast<uint32_t>(info.pixel_x_dimension)));
+  if (info.pixel_y_dimension > 0)
+    exif_ifd.push_back(Long(kTagPixelYDimension, static_cast<uint32_t>(info.pixel_y_dimension)));
+  if (info.focal_plane_x_resolution > 0 && info.focal_plane_y_resolution > 0) {
+    exif_ifd.push_back(Rational(kTagFocalPlaneXResolution, info.focal_plane_x_resolution));
+    exif_ifd.push_back(Rational(kTagFocalPlaneYResolution, info.focal_plane_y_resolution));
+    exif_ifd.push_back(Short(kTagFocalPlaneResolutionUnit, info.focal_plane_resolution_unit));
+  }
+  std::string tiff = "II*";
+  tiff.push_back('\0');
+  PutU32(&tiff, 8);
+  size_t pointer_value = 0;
+  if (!exif_ifd.empty()) {
+    ifd0.push_back(Long(kTagExifIfdPointer, 0));  // patched below
+  }
+  std::sort(ifd0.begin(), ifd0.end(), [](const EntryToWrite& a, const EntryToWrite& b) { return a.tag < b.tag; });
+  for (size_t k = 0; k < ifd0.size(); ++k) {
+    if (ifd0[k].tag == kTagExifIfdPointer) pointer_value = 8 + 2 + 12 * k + 8;
+  }
+  AppendIfd(&tiff, ifd0);
+  if (!exif_ifd.empty()) {
+    SetU32(&tiff, pointer_value, static_cast<uint32_t>(tiff.size()));
+    AppendIfd(&tiff, exif_ifd);
+  }
+  std::string app1("Exif\0\0", 6);
+  return app1 + tiff;
+}
+
 }  // namespace reconar

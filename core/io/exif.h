@@ -1,5 +1,5 @@
 #pragma once
-// A minimal EXIF reader: only the tags photogrammetry needs (camera identity, focal length,
+// A minimal EXIF reader and writer: only the tags photogrammetry needs (camera identity, focal length,
 // orientation, sensor geometry). Every read is bounds-checked against the block it came from;
 // a malformed block never fails a caller, it yields present=false (or the fields read before
 // the damage) plus a human-readable `warning`.
@@ -33,5 +33,11 @@ ExifInfo ParseExifApp1(std::string_view app1_payload);
 // Walks a JPEG's marker segments up to the first SOS looking for an EXIF APP1 segment,
 // without decoding pixels. Non-JPEG or damaged input yields present=false (+ warning).
 ExifInfo ReadExifFromJpeg(std::string_view jpeg_bytes);
+
+// The payload of a JPEG APP1 segment ("Exif\0\0" and a little-endian TIFF block) holding the
+// fields of `info` that are set (make, model, orientation, focal length, its 35 mm equivalent,
+// the pixel dimensions, the focal-plane resolution); ParseExifApp1 reads them back. Rationals are
+// written to four decimals, FocalLengthIn35mmFilm rounded to a whole millimetre (it is a SHORT).
+std::string BuildExifApp1(const ExifInfo& info);
 
 }  // namespace reconar

@@ -68,4 +68,19 @@ const char* FocalPriorSourceName(FocalPrior::Source source) {
   return "unknown";
 }
 
+ExifInfo ExifForFocal(int width, int height, double focal_px, const std::string& model) {
+  ExifInfo exif;
+  exif.present = true;
+  exif.make = "reconar";
+  exif.model = model;
+  const double long_side = std::max(width, height);
+  exif.focal_length_mm = focal_px * 36.0 / long_side;
+  exif.focal_length_35mm = exif.focal_length_mm;
+  exif.focal_plane_x_resolution = exif.focal_plane_y_resolution = long_side / 3.6;
+  exif.focal_plane_resolution_unit = 3;
+  exif.pixel_x_dimension = width;
+  exif.pixel_y_dimension = height;
+  return exif;
+}
+
 }  // namespace reconar

@@ -24,4 +24,11 @@ FocalPrior EstimateFocalPrior(const ExifInfo& exif, int width, int height);
 // priors whose name starts with "exif". "exif-35mm", "exif-sensor-table" or "default".
 const char* FocalPriorSourceName(FocalPrior::Source source);
 
+// The EXIF of an image from a camera whose focal length in pixels is known (a capture's keyframes):
+// a virtual sensor 36 mm wide along the image's longer side, so FocalLength is the 35 mm
+// equivalent to four decimals and FocalPlaneX/YResolution (pixels per centimetre) give the focal in
+// pixels back exactly; FocalLengthIn35mmFilm (a whole millimetre) is what EstimateFocalPrior reads.
+// Make "reconar", `model` as given, orientation 1, the pixel dimensions.
+ExifInfo ExifForFocal(int width, int height, double focal_px, const std::string& model);
+
 }  // namespace reconar

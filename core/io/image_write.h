@@ -1,5 +1,6 @@
 #pragma once
-// Writing 8-bit images as PNG (libpng): renders, overlays and debug pictures. Files are written
+// Writing 8-bit images as PNG (libpng: renders, overlays and debug pictures) and as JPEG
+// (libjpeg-turbo, jpeg_encoder.cc: the keyframes a capture takes, with their EXIF). Files are written
 // atomically (core/base/atomic_file.h): a failed write leaves no file and any previous one intact.
 #include <cstdint>
 #include <string>
@@ -18,5 +19,16 @@ Result<std::string> EncodePng(ImageView<const uint8_t> interleaved, int channels
 // EncodePng, then an atomic write to `path`. kIoError naming `path` when it cannot be written
 // (missing directory, permissions, full disk).
 Status WritePng(const std::string& path, ImageView<const uint8_t> interleaved, int channels);
+
+// Encodes gray (channels 1) or interleaved RGB (3) samples as a baseline JPEG of `quality`
+// (1..100), with `app1_payload` (e.g. BuildExifApp1, core/io/exif.h) as an APP1 segment when not
+// empty. kInvalidArgument for an empty view, another channel count, a bad quality or a payload over
+// 65533 bytes; kInternal for a libjpeg failure.
+Result<std::string> EncodeJpeg(ImageView<const uint8_t> interleaved, int channels, int quality,
+                               const std::string& app1_payload = "");
+
+// EncodeJpeg, then an atomic write to `path` (kIoError naming it when it cannot be written).
+Status WriteJpeg(const std::string& path, ImageView<const uint8_t> interleaved, int channels, int quality,
+                 const std::string& app1_payload = "");
 
 }  // namespace reconar

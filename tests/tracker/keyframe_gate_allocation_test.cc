@@ -14,11 +14,12 @@ namespace {
 
 TEST(KeyframeGateAllocationTest, FramesDoNotAllocate) {
   auto scene = testing::MakeRotationScene(
-      std::string(RECONAR_SHARED_DATA_DIR) + "/strecha_fountain-P11/images/0005.jpg", 4, 640, 480);
+      std::string(RECONAR_SHARED_DATA_DIR) + "/strecha_fountain-P11/images/0005.jpg", 2, 640, 480);
   ASSERT_TRUE(scene.ok()) << scene.status().ToString();
   std::vector<Image<uint8_t>> frames;
-  for (int i = 0; i < 60; ++i)
-    frames.push_back(testing::RenderRotatedView(*scene, testing::YawPitchRoll(-12.0 + 0.4 * i, 0, 0)));
+  // A narrow view (the photo box-filtered by 2) turning 32 degrees: keyframes as the overlap runs out.
+  for (int i = 0; i < 80; ++i)
+    frames.push_back(testing::RenderRotatedView(*scene, testing::YawPitchRoll(-16.0 + 0.4 * i, 0, 0)));
   KeyframeGate gate;
   GateFrameReport report;
   size_t frame = 0;

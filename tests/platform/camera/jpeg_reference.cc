@@ -6,6 +6,9 @@
 
 #include <jpeglib.h>
 
+#include "core/base/check.h"
+#include "core/io/image_write.h"
+
 namespace reconar::testing {
 
 std::string ReadFileBytes(const std::string& path) {
@@ -89,29 +92,9 @@ std::vector<uint8_t> LibjpegDecode(const std::string& jpeg, int out_components, 
 }
 
 std::string LibjpegEncodeRgb(const std::vector<uint8_t>& rgb, int width, int height, int quality) {
-  jpeg_compress_struct cinfo{};
-  jpeg_error_mgr err{};
-  cinfo.err = jpeg_std_error(&err);
-  jpeg_create_compress(&cinfo);
-  unsigned char* buffer = nullptr;
-  unsigned long size = 0;
-  jpeg_mem_dest(&cinfo, &buffer, &size);
-  cinfo.image_width = static_cast<JDIMENSION>(width);
-  cinfo.image_height = static_cast<JDIMENSION>(height);
-  cinfo.input_components = 3;
-  cinfo.in_color_space = JCS_RGB;
-  jpeg_set_defaults(&cinfo);  // YCbCr 4:2:0
-  jpeg_set_quality(&cinfo, quality, TRUE);
-  jpeg_start_compress(&cinfo, TRUE);
-  while (cinfo.next_scanline < cinfo.image_height) {
-    JSAMPROW row = const_cast<uint8_t*>(rgb.data()) + static_cast<size_t>(cinfo.next_scanline) * width * 3;
-    jpeg_write_scanlines(&cinfo, &row, 1);
-  }
-  jpeg_finish_compress(&cinfo);
-  std::string bytes(reinterpret_cast<const char*>(buffer), size);
-  jpeg_destroy_compress(&cinfo);
-  std::free(buffer);
-  return bytes;
+  auto bytes = EncodeJpeg(ImageView<const uint8_t>(3 * width, height, 3 * width, rgb.data()), 3, quality);
+  RECONAR_CHECK(bytes.ok()) << bytes.status().ToString();
+  return *bytes;
 }
 
 std::vector<uint8_t> PackNv12(const YcbcrPlanes& p, int pitch) {
