@@ -29,6 +29,7 @@ constexpr char kUsage[] =
     "  tags --ids LIST --size METRES --out FILE.{svg,pdf}  printable AprilTag sheet\n"
     "  tags IMAGES_DIR|IMAGE... [--json]                   the AprilTags in photos\n"
     "  track SOURCE --intrinsics K --tag-size M [--json]   6-DoF tag tracking, one line per frame\n"
+    "  capture SOURCE PROJECT_DIR [--max-keyframes N]      keyframes from a camera, with advice\n"
     "  view --model M (--camera DEV | --frames DIR) ...    AR overlay: live window or PNGs (--out)\n"
     "  calibrate IMAGES... --tag-size M --out FILE         camera intrinsics from photos of tags\n"
     "\n"
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
   if (command == "reconstruct") return reconar::tools::RunReconstruct(argc, argv, 2);
   if (command == "map") return reconar::tools::RunMap(argc, argv, 2);
   if (command == "localize") return reconar::tools::RunLocalize(argc, argv, 2);
+  if (command == "capture") return reconar::tools::RunCapture(argc, argv, 2);
   if (command == "view") {
 #ifdef RECONAR_HAVE_VIEW
     return reconar::tools::RunView(argc, argv, 2);

@@ -1,0 +1,175 @@
+#include "render/ar/capture_session.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "core/io/exif.h"
+#include "core/io/focal_prior.h"
+#include "core/io/image_write.h"
+
+namespace reconar {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string KeyframeName(int ordinal) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "keyframe_%05d.jpg", ordinal);
+  return name;
+}
+
+// Keyframes 1..K already in `images_dir` (the first missing number ends the run of them).
+int KeyframesOnDisk(const std::string& images_dir) {
+  int count = 0;
+  while (fs::exists(fs::path(images_dir) / KeyframeName(count + 1))) ++count;
+  return count;
+}
+
+// A folder or a recording replays the same frames on every run; a device does not.
+bool IsReplay(const std::string& source) {
+  std::error_code error;
+  return fs::is_directory(source, error) || (source.size() > 7 && source.compare(source.size() - 7, 7, ".frames") == 0);
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+Status CaptureOptions::Check() const {
+  if (source.empty()) return InvalidArgument("capture: no source");
+  if (project_dir.empty()) return InvalidArgument("capture: no project directory");
+  if (max_keyframes < 0) return InvalidArgument("capture: max_keyframes < 0");
+  if (jpeg_quality < 1 || jpeg_quality > 100) return InvalidArgument("capture: jpeg_quality must be in [1, 100]");
+  if (!(focal_px >= 0.0)) return InvalidArgument("capture: focal_px < 0");
+  if (max_corrupt_frames_in_a_row < 1) return InvalidArgument("capture: max_corrupt_frames_in_a_row < 1");
+  return gate.Check();
+}
+
+Result<CaptureReport> RunCapture(const CaptureOptions& options,
+                                 const std::function<void(const CaptureEvent&)>& on_event,
+                                 const std::atomic<bool>* stop) {
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  const std::string images_dir = (fs::path(options.project_dir) / "images").string();
+  std::error_code error;
+  fs::create_directories(images_dir, error);
+  if (error) return IoError(images_dir + ": cannot create the directory: " + error.message());
+  FrameSourceOptions source_options = options.source_options;
+  source_options.want_rgb = true;
+  RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<FrameSource> source, OpenFrameSource(options.source, source_options));
+
+  CaptureReport report;
+  report.source = source->Describe();
+  const int on_disk = KeyframesOnDisk(images_dir);
+  const bool replay = IsReplay(options.source);
+  // A replay meets its keyframes again from the first; a live camera goes on after them.
+  int ordinal = replay ? 0 : on_disk;
+  report.keyframes = on_disk;
+  for (int k = 1; k <= on_disk; ++k) report.keyframe_files.push_back((fs::path(images_dir) / KeyframeName(k)).string());
+  const auto emit = [&](CaptureEvent event) {
+    event.frames = report.frames;
+    event.keyframes = report.keyframes;
+    if (on_event) on_event(event);
+  };
+  if (options.max_keyframes > 0 && report.keyframes >= options.max_keyframes && !replay) {
+    report.stop_reason = "--max-keyframes reached";
+    return report;
+  }
+
+  KeyframeGate gate(options.gate);
+  std::vector<double> gate_ms;
+  int corrupt_in_a_row = 0;
+  int64_t first_timestamp = -1;
+  int last_status_second = -1;
+  while (true) {
+    if (stop != nullptr && stop->load()) {
+      report.stop_reason = "stopped";
+      break;
+    }
+    Result<FrameHandle> next = source->Next();
+    if (!next.ok()) {
+      if (IsEndOfStream(next.status())) {
+        report.stop_reason = replay ? "end of the recording" : "end of the stream";
+        break;
+      }
+      if (next.status().code() == StatusCode::kCorruptData &&
+          ++corrupt_in_a_row < options.max_corrupt_frames_in_a_row) {
+        ++report.corrupt;
+        CaptureEvent warning;
+        warning.kind = CaptureEvent::Kind::kWarning;
+        warning.message = "skipped a corrupt frame: " + next.status().message();
+        emit(warning);
+        continue;
+      }
+      report.source_failed = true;
+      report.stop_reason = next.status().message();
+      break;
+    }
+    corrupt_in_a_row = 0;
+    const Frame& frame = **next;
+    if (first_timestamp < 0) first_timestamp = frame.timestamp_ns;
+    ++report.frames;
+    CaptureEvent event;
+    event.frame_index = frame.index;
+    event.video_seconds = static_cast<double>(frame.timestamp_ns - first_timestamp) * 1e-9;
+    const auto start = std::chrono::steady_clock::now();
+    const Status judged = gate.Process(frame.gray, &event.gate);
+    gate_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    if (!judged.ok()) return Status(judged.code(), std::string(frame.name) + ": " + judged.message());
+    switch (event.gate.verdict) {
+      case GateVerdict::kBlurred:
+        ++report.blurred;
+        break;
+      case GateVerdict::kBadExposure:
+        ++report.bad_exposure;
+        break;
+      case GateVerdict::kTooClose:
+        ++report.too_close;
+        break;
+      case GateVerdict::kLost:
+        ++report.lost;
+        break;
+      case GateVerdict::kKeyframe:
+        break;
+    }
+    if (event.gate.verdict == GateVerdict::kKeyframe) {
+      ++ordinal;
+      const std::string path = (fs::path(images_dir) / KeyframeName(ordinal)).string();
+      event.kind = CaptureEvent::Kind::kKeyframe;
+      event.path = path;
+      if (ordinal <= on_disk) {
+        event.kept = true;
+        ++report.keyframes_kept;
+      } else {
+        ExifInfo exif =
+            options.focal_px > 0.0 ? ExifForFocal(frame.width, frame.height, options.focal_px, "") : ExifInfo{};
+        exif.make = "reconar";
+        exif.model = report.source;
+        RECONAR_RETURN_IF_ERROR(WriteJpeg(path, frame.rgb, 3, options.jpeg_quality, BuildExifApp1(exif)));
+        ++report.keyframes;
+        report.keyframe_files.push_back(path);
+      }
+      emit(event);
+      if (options.max_keyframes > 0 && ordinal >= options.max_keyframes) {
+        report.stop_reason = "--max-keyframes reached";
+        break;
+      }
+      continue;
+    }
+    const int second = static_cast<int>(event.video_seconds);
+    if (second != last_status_second) {
+      last_status_second = second;
+      event.kind = CaptureEvent::Kind::kStatus;
+      emit(event);
+    }
+  }
+  report.median_gate_ms = Median(gate_ms);
+  return report;
+}
+
+}  // namespace reconar

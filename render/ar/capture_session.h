@@ -1,0 +1,70 @@
+#pragma once
+// `reconar capture`'s loop (issue 18): frames from a source (live camera, folder, recording) through
+// the keyframe gate (tracker/keyframe_gate.h); each keyframe written atomically as
+// PROJECT/images/keyframe_NNNNN.jpg with EXIF (core/io/exif.h: the focal when it is known), so any
+// tool reads them; events for the person holding the camera (a status each second of video, each
+// keyframe, warnings, the end).
+//
+// Stopping and resuming. A keyframe is on disk whole or not at all, so a crash or SIGKILL loses at
+// most the frame in flight. A folder or a recording is replayed from its start on a re-run: the
+// gate is deterministic, so it takes the same keyframes, and those already on disk are kept, not
+// written again; the run then goes on past them. A live camera's keyframes are numbered on after
+// the last one on disk.
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/base/status.h"
+#include "platform/camera/frame_source.h"
+#include "tracker/keyframe_gate.h"
+
+namespace reconar {
+
+struct CaptureOptions {
+  std::string source;  // OpenFrameSource specification
+  FrameSourceOptions source_options;
+  std::string project_dir;
+  KeyframeGateOptions gate;
+  int max_keyframes = 0;  // stop after this many keyframes in all (those kept included); 0: no limit
+  int jpeg_quality = 92;
+  double focal_px = 0.0;  // > 0: written into each keyframe's EXIF (ExifForFocal)
+  // Corrupt frames in a row (a damaged recording) after which the capture stops.
+  int max_corrupt_frames_in_a_row = 25;
+
+  Status Check() const;
+};
+
+struct CaptureEvent {
+  enum class Kind { kStatus, kKeyframe, kWarning };
+  Kind kind = Kind::kStatus;
+  int64_t frame_index = 0;
+  double video_seconds = 0.0;  // the frame's timestamp since the first frame
+  GateFrameReport gate;        // the frame's judgement (kStatus, kKeyframe)
+  std::string path;            // the keyframe's file (kKeyframe)
+  bool kept = false;           // the keyframe was already on disk (a resumed replay)
+  std::string message;         // kWarning
+  int frames = 0, keyframes = 0;
+};
+
+struct CaptureReport {
+  std::string source;  // the source's Describe()
+  int frames = 0;
+  int keyframes = 0;       // in PROJECT/images at the end
+  int keyframes_kept = 0;  // of which already there from an earlier run
+  int blurred = 0, bad_exposure = 0, too_close = 0, lost = 0, corrupt = 0;
+  double median_gate_ms = 0.0;
+  std::string stop_reason;     // "end of the recording", "--max-keyframes reached", "stopped", or the source's error
+  bool source_failed = false;  // the source ended with an error (a camera that disconnected)
+  std::vector<std::string> keyframe_files;
+};
+
+// Runs the capture until the source ends, max_keyframes are on disk, *stop becomes true (SIGINT),
+// or the source fails (the report says so; what was captured stays). Errors: bad options, a source
+// that cannot be opened, a keyframe that cannot be written (full disk: the file is named, the
+// earlier keyframes are intact).
+Result<CaptureReport> RunCapture(const CaptureOptions& options,
+                                 const std::function<void(const CaptureEvent&)>& on_event,
+                                 const std::atomic<bool>* stop = nullptr);
+
+}  // namespace reconar

@@ -1,0 +1,139 @@
+// reconar capture SOURCE PROJECT_DIR: keyframes from a live camera (or a folder, or a recording)
+// through the keyframe gate into PROJECT_DIR/images, with a status line each second of video and
+// advice for the person holding the camera (render/ar/capture_session.h).
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/base/json_writer.h"
+#include "render/ar/capture_session.h"
+#include "tools/ar_args.h"
+#include "tools/args.h"
+#include "tools/commands.h"
+
+namespace reconar::tools {
+namespace {
+
+constexpr char kHelp[] =
+    "usage: reconar capture SOURCE PROJECT_DIR [options]\n"
+    "\n"
+    "Watches the video of SOURCE and keeps the frames that serve a reconstruction: sharp, well\n"
+    "exposed, and either with enough parallax since the last keyframe or about to lose sight of\n"
+    "it (docs/capture.md gives the rules). Each keyframe is written as\n"
+    "PROJECT_DIR/images/keyframe_NNNNN.jpg with EXIF, atomically. A status line each second of\n"
+    "video says what to do (\"too fast\", \"too dark\", \"move sideways\", \"go back: lost\").\n"
+    "q is not read: stop with Ctrl-C (the keyframes taken stay). Re-running on a folder or a\n"
+    "recording replays it and keeps the keyframes already written; on a camera it adds to them.\n"
+    "SOURCE: /dev/videoN, libcamera[:N], a folder of images, or a .frames recording.\n"
+    "  --intrinsics K        fx,fy,cx,cy[,k1,k2] or a file from `reconar calibrate`: the focal goes\n"
+    "                        into each keyframe's EXIF (a 35 mm equivalent)\n"
+    "  --max-keyframes N     stop after N keyframes (default: until the source ends or Ctrl-C)\n"
+    "  --width W --height H  camera capture size (default 640x480)\n"
+    "  --reconstruct         then run `reconar reconstruct PROJECT_DIR/images PROJECT_DIR`\n"
+    "  --json                one JSON object per event on stdout (status, keyframe, warning, end)\n";
+
+std::atomic<bool> g_stop{false};
+void OnInterrupt(int) { g_stop.store(true); }
+
+void PrintEvent(const CaptureEvent& event, bool json) {
+  const GateFrameReport& g = event.gate;
+  if (json) {
+    JsonWriter out;
+    out.BeginObject();
+    out.Key("event").String(event.kind == CaptureEvent::Kind::kKeyframe  ? "keyframe"
+                            : event.kind == CaptureEvent::Kind::kWarning ? "warning"
+                                                                         : "status");
+    out.Key("frame").Int(event.frame_index).Key("video_seconds").Double(event.video_seconds);
+    out.Key("frames").Int(event.frames).Key("keyframes").Int(event.keyframes);
+    if (event.kind == CaptureEvent::Kind::kWarning) {
+      out.Key("message").String(event.message);
+    } else {
+      out.Key("verdict").String(GateVerdictName(g.verdict)).Key("advice").String(g.advice);
+      out.Key("sharpness").Double(g.sharpness).Key("sharpness_threshold").Double(g.sharpness_threshold);
+      out.Key("mean_level").Double(g.mean_level).Key("clipped").Double(g.clipped_fraction);
+      out.Key("parallax")
+          .Double(g.parallax)
+          .Key("overlap")
+          .Double(g.overlap)
+          .Key("frame_motion")
+          .Double(g.frame_motion);
+    }
+    if (event.kind == CaptureEvent::Kind::kKeyframe) out.Key("path").String(event.path).Key("kept").Bool(event.kept);
+    out.EndObject();
+    std::printf("%s\n", out.str().c_str());
+    std::fflush(stdout);
+    return;
+  }
+  if (event.kind == CaptureEvent::Kind::kWarning) {
+    std::fprintf(stderr, "warning: %s\n", event.message.c_str());
+  } else if (event.kind == CaptureEvent::Kind::kKeyframe) {
+    std::fprintf(stderr, "%7.1f s  keyframe %d: %s%s\n", event.video_seconds, event.keyframes, event.path.c_str(),
+                 event.kept ? " (already there)" : "");
+  } else {
+    std::fprintf(stderr, "%7.1f s  %d keyframes  %-30s  parallax %4.1f %%  overlap %3.0f %%  %s\n", event.video_seconds,
+                 event.keyframes, GateVerdictName(g.verdict), 100.0 * g.parallax, 100.0 * g.overlap, g.advice);
+  }
+}
+
+}  // namespace
+
+int RunCapture(int argc, char** argv, int first) {
+  Args args({"intrinsics", "max-keyframes", "width", "height"}, {"json", "reconstruct"});
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
+  CaptureOptions options;
+  options.source = args.positionals()[0];
+  options.project_dir = args.positionals()[1];
+  auto max_keyframes = args.GetInt("max-keyframes", 0, 0, 1 << 20);
+  if (!max_keyframes.ok()) return Fail(max_keyframes.status());
+  options.max_keyframes = *max_keyframes;
+  auto width = args.GetInt("width", options.source_options.width, 0, 1 << 15);
+  auto height = args.GetInt("height", options.source_options.height, 0, 1 << 15);
+  if (!width.ok()) return Fail(width.status());
+  if (!height.ok()) return Fail(height.status());
+  options.source_options.width = *width;
+  options.source_options.height = *height;
+  if (args.Has("intrinsics")) {
+    auto intrinsics = IntrinsicsFromArg(args.Get("intrinsics"));
+    if (!intrinsics.ok()) return Fail(intrinsics.status());
+    options.focal_px = intrinsics->fx;
+  }
+  const bool json = args.Has("json");
+  std::signal(SIGINT, OnInterrupt);
+  auto report = reconar::RunCapture(
+      options, [json](const CaptureEvent& event) { PrintEvent(event, json); }, &g_stop);
+  std::signal(SIGINT, SIG_DFL);
+  if (!report.ok()) return Fail(report.status());
+  if (json) {
+    JsonWriter out;
+    out.BeginObject().Key("event").String("end").Key("source").String(report->source);
+    out.Key("frames").Int(report->frames).Key("keyframes").Int(report->keyframes);
+    out.Key("keyframes_kept").Int(report->keyframes_kept).Key("blurred").Int(report->blurred);
+    out.Key("bad_exposure").Int(report->bad_exposure).Key("too_close").Int(report->too_close);
+    out.Key("lost").Int(report->lost).Key("corrupt").Int(report->corrupt);
+    out.Key("median_gate_ms").Double(report->median_gate_ms).Key("stop_reason").String(report->stop_reason);
+    out.EndObject();
+    std::printf("%s\n", out.str().c_str());
+  } else {
+    std::printf(
+        "%s: %d frames, %d keyframes in %s/images (%d already there); passed over: %d blurred, %d badly exposed, "
+        "%d too close, %d lost, %d corrupt; gate %.2f ms per frame (median); %s\n",
+        report->source.c_str(), report->frames, report->keyframes, options.project_dir.c_str(), report->keyframes_kept,
+        report->blurred, report->bad_exposure, report->too_close, report->lost, report->corrupt, report->median_gate_ms,
+        report->stop_reason.c_str());
+  }
+  if (report->source_failed) {
+    std::fprintf(stderr, "reconar: error: %s (the %d keyframes taken are kept)\n", report->stop_reason.c_str(),
+                 report->keyframes);
+    return 1;
+  }
+  if (!args.Has("reconstruct")) return 0;
+  const std::string images = options.project_dir + "/images";
+  std::vector<std::string> words = {"reconar", "reconstruct", images, options.project_dir};
+  std::vector<char*> reconstruct_argv;
+  for (std::string& word : words) reconstruct_argv.push_back(word.data());
+  return RunReconstruct(static_cast<int>(reconstruct_argv.size()), reconstruct_argv.data(), 2);
+}
+
+}  // namespace reconar::tools
