@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/base/median.h"
 #include "core/base/prng.h"
 #include "core/geometry/homography_four_point.h"
 
@@ -16,14 +17,6 @@ constexpr int kPyramidLevels = 3;
 constexpr float kMaxForwardBackwardPx = 1.0f;  // analysis pixels
 constexpr double kHomographyInlierPx = 1.0;    // analysis pixels
 constexpr int kHomographyIterations = 64;
-
-// The median of values[0, count) (reorders them).
-template <typename T>
-T MedianInPlace(T* values, int count) {
-  T* middle = values + count / 2;
-  std::nth_element(values, middle, values + count);
-  return *middle;
-}
 
 }  // namespace
 
@@ -127,7 +120,7 @@ void KeyframeGate::MeasureImage(ImageView<const uint8_t> gray, GateFrameReport* 
 double KeyframeGate::SharpnessReference() const {
   if (history_count_ < options_.min_history) return sharpness_max_;
   std::array<double, 64> sorted = sharpness_history_;
-  return MedianInPlace(sorted.data(), history_count_);
+  return MedianInPlace(sorted.data(), static_cast<size_t>(history_count_));
 }
 
 void KeyframeGate::RememberSharpness(double sharpness) {
@@ -222,7 +215,7 @@ double KeyframeGate::Parallax(int count) {
   if (inliers >= 4 && HomographyFourPoint::Estimate(inlier_pairs_.data(), inliers, &models) > 0) best = models[0];
   HomographyFourPoint::Residuals(pairs_.data(), count, best, residuals_.data());
   for (int i = 0; i < count; ++i) residuals_[static_cast<size_t>(i)] = std::sqrt(residuals_[static_cast<size_t>(i)]);
-  return MedianInPlace(residuals_.data(), count);
+  return MedianInPlace(residuals_.data(), static_cast<size_t>(count));
 }
 
 // flow_ for the corners at `from` (in `previous`) into `next`; a result whose flow back does not
@@ -258,8 +251,7 @@ Status KeyframeGate::FollowCorners(GateFrameReport* report) {
     }
     scratch_[static_cast<size_t>(moved++)] = (flow_[k].point - corners_[k]).norm();
     corners_[k] = flow_[k].point;
-    pairs_[static_cast<size_t>(alive)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
-    followed_[static_cast<size_t>(alive++)] = corners_[k] - keyframe_corners_[k];
+    pairs_[static_cast<size_t>(alive++)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
   }
   // Lost: the view may have come back to the keyframe's, so look for its corners from there.
   if (alive < options_.lost_overlap * num_corners_) {
@@ -274,17 +266,19 @@ Status KeyframeGate::FollowCorners(GateFrameReport* report) {
         alive_[k] = flow_[k].status == FlowStatus::kTracked;
         if (!alive_[k]) continue;
         corners_[k] = flow_[k].point;
-        pairs_[static_cast<size_t>(alive)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
-        followed_[static_cast<size_t>(alive++)] = corners_[k] - keyframe_corners_[k];
+        pairs_[static_cast<size_t>(alive++)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
       }
     }
   }
   const float width = static_cast<float>(small_.width());
   report->corners = num_corners_;
   report->overlap = num_corners_ > 0 ? static_cast<double>(alive) / num_corners_ : 0.0;
-  report->frame_motion = moved > 0 ? MedianInPlace(scratch_.data(), moved) / width : 0.0;
-  for (int i = 0; i < alive; ++i) scratch_[static_cast<size_t>(i)] = followed_[static_cast<size_t>(i)].norm();
-  report->motion = alive > 0 ? MedianInPlace(scratch_.data(), alive) / width : 0.0;
+  report->frame_motion = moved > 0 ? MedianInPlace(scratch_.data(), static_cast<size_t>(moved)) / width : 0.0;
+  for (int i = 0; i < alive; ++i) {
+    const Correspondence& pair = pairs_[static_cast<size_t>(i)];
+    scratch_[static_cast<size_t>(i)] = static_cast<float>((pair.x2 - pair.x1).norm());
+  }
+  report->motion = alive > 0 ? MedianInPlace(scratch_.data(), static_cast<size_t>(alive)) / width : 0.0;
   report->parallax = Parallax(alive) / width;
   return Status::Ok();
 }

@@ -114,7 +114,6 @@ class KeyframeGate {
   int lost_frames_ = 0;
   std::array<Eigen::Vector2f, kMaxCorners> keyframe_corners_{};
   std::array<Eigen::Vector2f, kMaxCorners> corners_{};  // in the newest frame
-  std::array<Eigen::Vector2f, kMaxCorners> followed_{};
   std::array<FlowResult, kMaxCorners> flow_{};
   std::array<Eigen::Vector2f, kMaxCorners> forward_{};  // forward flow's results, tracked back
   std::array<FlowResult, kMaxCorners> backward_flow_{};
@@ -125,7 +124,6 @@ class KeyframeGate {
   std::array<double, kMaxCorners> residuals_{};
   int num_corners_ = 0;
   std::array<double, 64> sharpness_history_{};
-  std::array<double, 64> sharpness_sorted_{};
   int history_count_ = 0, history_next_ = 0;
   double sharpness_max_ = 0.0;
   std::vector<uint32_t> column_sums_;  // one row of the frame, for the box filter

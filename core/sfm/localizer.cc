@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/base/elapsed.h"
+#include "core/base/median.h"
 #include "core/features/descriptor_distance.h"
 #include "core/features/kdtree.h"
 #include "core/sfm/mapper.h"
@@ -14,12 +15,6 @@ namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double Median(std::vector<double> values) {
-  const size_t middle = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle), values.end());
-  return values[middle];
-}
 
 // Neighbours searched per query descriptor, among which the nearest of a retrieved keyframe and
 // the nearest of another point there are sought.

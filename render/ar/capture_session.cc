@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/base/median.h"
 #include "core/io/exif.h"
 #include "core/io/focal_prior.h"
 #include "core/io/image_write.h"
@@ -31,12 +32,6 @@ int KeyframesOnDisk(const std::string& images_dir) {
 bool IsReplay(const std::string& source) {
   std::error_code error;
   return fs::is_directory(source, error) || (source.size() > 7 && source.compare(source.size() - 7, 7, ".frames") == 0);
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
-  return values[values.size() / 2];
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "core/base/median.h"
 #include "core/base/thread_pool.h"
 #include "core/base/union_find.h"
 #include "core/mesh/poisson/point_kdtree.h"
@@ -17,12 +18,6 @@ namespace reconar {
 namespace {
 
 enum Verdict : uint8_t { kInlier = 0, kIsolated = 1, kSmallPiece = 2 };
-
-double Median(std::vector<double> values) {
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
-  return values[mid];
-}
 
 // The two tests on pairwise distinct points (a zero distance would make every neighbour of a
 // duplicated point look isolated): one Verdict per point. Sets report->pieces, pieces_kept and
