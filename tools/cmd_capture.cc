@@ -31,7 +31,12 @@ constexpr char kHelp[] =
     "                        into each keyframe's EXIF (a 35 mm equivalent)\n"
     "  --max-keyframes N     stop after N keyframes (default: until the source ends or Ctrl-C)\n"
     "  --width W --height H  camera capture size (default 640x480)\n"
+    "  --no-live             do not grow the sparse model in the background (by default each\n"
+    "                        keyframe's features and matches are computed as it is taken and it is\n"
+    "                        registered into PROJECT_DIR/live/; `reconstruct` reuses that work)\n"
+    "  --realtime            replay a folder or recording at the pace of its timestamps\n"
     "  --reconstruct         then run `reconar reconstruct PROJECT_DIR/images PROJECT_DIR`\n"
+    "  --tag-size M --tag-family F  passed on to `reconstruct` (metres, tag36h11 by default)\n"
     "  --json                one JSON object per event on stdout (status, keyframe, warning, end)\n";
 
 std::atomic<bool> g_stop{false};
@@ -42,13 +47,16 @@ void PrintEvent(const CaptureEvent& event, bool json) {
   if (json) {
     JsonWriter out;
     out.BeginObject();
-    out.Key("event").String(event.kind == CaptureEvent::Kind::kKeyframe  ? "keyframe"
-                            : event.kind == CaptureEvent::Kind::kWarning ? "warning"
-                                                                         : "status");
+    out.Key("event").String(event.kind == CaptureEvent::Kind::kKeyframe     ? "keyframe"
+                            : event.kind == CaptureEvent::Kind::kWarning    ? "warning"
+                            : event.kind == CaptureEvent::Kind::kRegistered ? "registered"
+                                                                            : "status");
     out.Key("frame").Int(event.frame_index).Key("video_seconds").Double(event.video_seconds);
-    out.Key("frames").Int(event.frames).Key("keyframes").Int(event.keyframes);
+    out.Key("frames").Int(event.frames).Key("keyframes").Int(event.keyframes).Key("registered").Int(event.registered);
     if (event.kind == CaptureEvent::Kind::kWarning) {
       out.Key("message").String(event.message);
+    } else if (event.kind == CaptureEvent::Kind::kRegistered) {
+      out.Key("path").String(event.path);
     } else {
       out.Key("verdict").String(GateVerdictName(g.verdict)).Key("advice").String(g.advice);
       out.Key("sharpness").Double(g.sharpness).Key("sharpness_threshold").Double(g.sharpness_threshold);
@@ -68,19 +76,23 @@ void PrintEvent(const CaptureEvent& event, bool json) {
   }
   if (event.kind == CaptureEvent::Kind::kWarning) {
     std::fprintf(stderr, "warning: %s\n", event.message.c_str());
+  } else if (event.kind == CaptureEvent::Kind::kRegistered) {
+    std::fprintf(stderr, "           registered: %s (%d in the live model)\n", event.path.c_str(), event.registered);
   } else if (event.kind == CaptureEvent::Kind::kKeyframe) {
     std::fprintf(stderr, "%7.1f s  keyframe %d: %s%s\n", event.video_seconds, event.keyframes, event.path.c_str(),
                  event.kept ? " (already there)" : "");
   } else {
-    std::fprintf(stderr, "%7.1f s  %d keyframes  %-30s  parallax %4.1f %%  overlap %3.0f %%  %s\n", event.video_seconds,
-                 event.keyframes, GateVerdictName(g.verdict), 100.0 * g.parallax, 100.0 * g.overlap, g.advice);
+    std::fprintf(stderr, "%7.1f s  %d keyframes, %d registered  %-14s  parallax %4.1f %%  overlap %3.0f %%  %s\n",
+                 event.video_seconds, event.keyframes, event.registered, GateVerdictName(g.verdict), 100.0 * g.parallax,
+                 100.0 * g.overlap, g.advice);
   }
 }
 
 }  // namespace
 
 int RunCapture(int argc, char** argv, int first) {
-  Args args({"intrinsics", "max-keyframes", "width", "height"}, {"json", "reconstruct"});
+  Args args({"intrinsics", "max-keyframes", "width", "height", "tag-size", "tag-family"},
+            {"json", "reconstruct", "no-live", "realtime"});
   if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
   CaptureOptions options;
   options.source = args.positionals()[0];
@@ -99,6 +111,8 @@ int RunCapture(int argc, char** argv, int first) {
     if (!intrinsics.ok()) return Fail(intrinsics.status());
     options.focal_px = intrinsics->fx;
   }
+  options.reconstruct_live = !args.Has("no-live");
+  options.replay_in_real_time = args.Has("realtime");
   const bool json = args.Has("json");
   std::signal(SIGINT, OnInterrupt);
   auto report = reconar::RunCapture(
@@ -113,6 +127,12 @@ int RunCapture(int argc, char** argv, int first) {
     out.Key("bad_exposure").Int(report->bad_exposure).Key("too_close").Int(report->too_close);
     out.Key("lost").Int(report->lost).Key("corrupt").Int(report->corrupt);
     out.Key("median_gate_ms").Double(report->median_gate_ms).Key("stop_reason").String(report->stop_reason);
+    if (report->live) {
+      const LiveReconstructionReport& live = report->live_model;
+      out.Key("live").BeginObject().Key("registered").Int(live.registered).Key("points").Int(live.points);
+      out.Key("median_latency_s").Double(live.median_latency_seconds);
+      out.Key("p95_latency_s").Double(live.p95_latency_seconds).EndObject();
+    }
     out.EndObject();
     std::printf("%s\n", out.str().c_str());
   } else {
@@ -122,6 +142,14 @@ int RunCapture(int argc, char** argv, int first) {
         report->source.c_str(), report->frames, report->keyframes, options.project_dir.c_str(), report->keyframes_kept,
         report->blurred, report->bad_exposure, report->too_close, report->lost, report->corrupt, report->median_gate_ms,
         report->stop_reason.c_str());
+    if (report->live) {
+      const LiveReconstructionReport& live = report->live_model;
+      std::printf(
+          "live model: %d of %zu keyframes registered, %d points, in %s/live; keyframe to registration %.1f s "
+          "(median), %.1f s (95th percentile)\n",
+          live.registered, live.keyframes.size(), live.points, options.project_dir.c_str(), live.median_latency_seconds,
+          live.p95_latency_seconds);
+    }
   }
   if (report->source_failed) {
     std::fprintf(stderr, "reconar: error: %s (the %d keyframes taken are kept)\n", report->stop_reason.c_str(),
@@ -131,6 +159,11 @@ int RunCapture(int argc, char** argv, int first) {
   if (!args.Has("reconstruct")) return 0;
   const std::string images = options.project_dir + "/images";
   std::vector<std::string> words = {"reconar", "reconstruct", images, options.project_dir};
+  for (const char* passed : {"tag-size", "tag-family"}) {
+    if (!args.Has(passed)) continue;
+    words.push_back(std::string("--") + passed);
+    words.push_back(args.Get(passed));
+  }
   std::vector<char*> reconstruct_argv;
   for (std::string& word : words) reconstruct_argv.push_back(word.data());
   return RunReconstruct(static_cast<int>(reconstruct_argv.size()), reconstruct_argv.data(), 2);

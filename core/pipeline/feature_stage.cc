@@ -14,19 +14,13 @@
 #include "core/features/sift/sift_io.h"
 #include "core/io/focal_prior.h"
 #include "core/io/image_io.h"
+#include "core/pipeline/stage_record.h"
 
 namespace reconar {
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-// Per-worker extractors: the configured one, and a first-octave-0 one used when a large photo's
-// doubled first octave would not fit the arena (said in the image's warnings).
-struct WorkerExtractors {
-  std::unique_ptr<SiftExtractor> configured;
-  std::unique_ptr<SiftExtractor> fallback;
-};
 
 std::string KeyPathFor(const FeatureStageOptions& options, const std::string& image_path, size_t num_images) {
   if (options.key_output.empty()) return "";
@@ -36,6 +30,73 @@ std::string KeyPathFor(const FeatureStageOptions& options, const std::string& im
 }
 
 }  // namespace
+
+PhotoFeatureExtractor::PhotoFeatureExtractor(const FeatureStageOptions& options) : options_(options) {}
+PhotoFeatureExtractor::~PhotoFeatureExtractor() = default;
+PhotoFeatureExtractor::PhotoFeatureExtractor(PhotoFeatureExtractor&&) noexcept = default;
+
+Result<ImageFeatureSummary> PhotoFeatureExtractor::Extract(const std::string& path, SiftFeatures* features) {
+  const auto start = Clock::now();
+  auto decoded = ReadImage(path);
+  if (!decoded.ok()) return decoded.status();
+  ImageFeatureSummary summary;
+  summary.warnings = decoded->warnings;
+  const Image<float> gray = ToGrayFloat(decoded->rgb);
+  const FocalPrior prior = EstimateFocalPrior(decoded->exif, gray.width(), gray.height());
+  summary.image.name = fs::path(path).filename().string();
+  summary.image.path = path;
+  summary.image.width = gray.width();
+  summary.image.height = gray.height();
+  summary.image.focal_px = prior.focal_px;
+  summary.image.focal_source = FocalPriorSourceName(prior.source);
+  summary.focal_explanation = prior.explanation;
+
+  if (!configured_) configured_ = std::make_unique<SiftExtractor>(options_.sift);
+  SiftExtractor* used = configured_.get();
+  auto result = used->Extract(gray.view());
+  if (!result.ok() && result.status().code() == StatusCode::kResourceExhausted && options_.sift.first_octave < 0) {
+    if (!fallback_) {
+      SiftOptions fallback = options_.sift;
+      fallback.first_octave = 0;
+      fallback_ = std::make_unique<SiftExtractor>(fallback);
+    }
+    summary.warnings.push_back("first octave 0 used: " + result.status().message());
+    used = fallback_.get();
+    result = used->Extract(gray.view());
+  }
+  if (!result.ok()) return Status(result.status().code(), path + ": " + result.status().message());
+  summary.contrast_threshold = used->options().contrast_threshold;
+  const size_t first_count = result->keypoints.size();
+  while (static_cast<int>(result->keypoints.size()) < options_.texture_poor_min_features &&
+         summary.contrast_threshold / 2.0 >= options_.texture_poor_min_contrast_threshold) {
+    summary.contrast_threshold /= 2.0;
+    used->set_contrast_threshold(summary.contrast_threshold);
+    auto again = used->Extract(gray.view());
+    used->set_contrast_threshold(options_.sift.contrast_threshold);
+    if (!again.ok()) break;
+    result = std::move(again);
+  }
+  if (summary.contrast_threshold < options_.sift.contrast_threshold) {
+    char note[160];
+    std::snprintf(note, sizeof(note), "texture-poor: %zu features at contrast threshold %g, %zu at %g", first_count,
+                  options_.sift.contrast_threshold, result->keypoints.size(), summary.contrast_threshold);
+    summary.warnings.push_back(note);
+  }
+  summary.num_features = static_cast<int>(result->keypoints.size());
+  *features = std::move(result).value();
+  summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return summary;
+}
+
+std::string FeatureStageSettings(const FeatureStageOptions& options) {
+  const SiftOptions& sift = options.sift;
+  return StageRecord::Settings({{"first_octave", sift.first_octave},
+                                {"max_features", sift.max_features},
+                                {"contrast_threshold", sift.contrast_threshold},
+                                {"arena_mib", static_cast<double>(sift.arena_bytes) / (1 << 20)},
+                                {"texture_poor_min_features", static_cast<double>(options.texture_poor_min_features)},
+                                {"texture_poor_min_contrast", options.texture_poor_min_contrast_threshold}});
+}
 
 Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image_paths, const Project* project,
                                            const FeatureStageOptions& options,
@@ -49,7 +110,8 @@ Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image
   const size_t n = image_paths.size();
   const int threads = std::min<int>(ThreadPool::ResolveThreadCount(options.num_threads), static_cast<int>(n));
   ThreadPool pool(threads);
-  std::vector<WorkerExtractors> extractors(pool.num_threads());
+  std::vector<PhotoFeatureExtractor> extractors;
+  for (int w = 0; w < pool.num_threads(); ++w) extractors.emplace_back(options);
   std::vector<std::optional<ImageFeatureSummary>> summaries(n);
   // Kept only for callers that asked for them; project runs stream each image's features to disk.
   std::vector<SiftFeatures> features(features_out != nullptr ? n : 0);
@@ -60,71 +122,21 @@ Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image
 
   pool.ParallelFor(0, n, [&](size_t i, int worker) {
     const std::string& path = image_paths[i];
-    const auto image_start = Clock::now();
-    auto decoded = ReadImage(path);
-    if (!decoded.ok()) {
-      skipped[i] = decoded.status().message();
+    SiftFeatures extracted;
+    auto summary = extractors[worker].Extract(path, &extracted);
+    if (!summary.ok()) {
+      skipped[i] = summary.status().message();
       if (progress) progress->Advance();
       return;
     }
-    ImageFeatureSummary summary;
-    summary.warnings = decoded->warnings;
-    const Image<float> gray = ToGrayFloat(decoded->rgb);
-    const FocalPrior prior = EstimateFocalPrior(decoded->exif, gray.width(), gray.height());
-    summary.image.name = fs::path(path).filename().string();
-    summary.image.path = path;
-    summary.image.width = gray.width();
-    summary.image.height = gray.height();
-    summary.image.focal_px = prior.focal_px;
-    summary.image.focal_source = FocalPriorSourceName(prior.source);
-    summary.focal_explanation = prior.explanation;
-
-    WorkerExtractors& mine = extractors[worker];
-    if (!mine.configured) mine.configured = std::make_unique<SiftExtractor>(options.sift);
-    SiftExtractor* used = mine.configured.get();
-    auto result = used->Extract(gray.view());
-    if (!result.ok() && result.status().code() == StatusCode::kResourceExhausted && options.sift.first_octave < 0) {
-      if (!mine.fallback) {
-        SiftOptions fallback = options.sift;
-        fallback.first_octave = 0;
-        mine.fallback = std::make_unique<SiftExtractor>(fallback);
-      }
-      summary.warnings.push_back("first octave 0 used: " + result.status().message());
-      used = mine.fallback.get();
-      result = used->Extract(gray.view());
-    }
-    if (!result.ok()) {
-      skipped[i] = path + ": " + result.status().message();
-      if (progress) progress->Advance();
-      return;
-    }
-    summary.contrast_threshold = used->options().contrast_threshold;
-    const size_t first_count = result->keypoints.size();
-    while (static_cast<int>(result->keypoints.size()) < options.texture_poor_min_features &&
-           summary.contrast_threshold / 2.0 >= options.texture_poor_min_contrast_threshold) {
-      summary.contrast_threshold /= 2.0;
-      used->set_contrast_threshold(summary.contrast_threshold);
-      auto again = used->Extract(gray.view());
-      used->set_contrast_threshold(options.sift.contrast_threshold);
-      if (!again.ok()) break;
-      result = std::move(again);
-    }
-    if (summary.contrast_threshold < options.sift.contrast_threshold) {
-      char note[160];
-      std::snprintf(note, sizeof(note), "texture-poor: %zu features at contrast threshold %g, %zu at %g", first_count,
-                    options.sift.contrast_threshold, result->keypoints.size(), summary.contrast_threshold);
-      summary.warnings.push_back(note);
-    }
-    summary.num_features = static_cast<int>(result->keypoints.size());
     if (project != nullptr) {
-      FeatureFile file{gray.width(), gray.height(), *result};
-      output_errors[i] = WriteFeatureFile(project->FeaturePath(summary.image.name), file);
+      FeatureFile file{summary->image.width, summary->image.height, extracted};
+      output_errors[i] = WriteFeatureFile(project->FeaturePath(summary->image.name), file);
     }
     const std::string key_path = KeyPathFor(options, path, n);
-    if (output_errors[i].ok() && !key_path.empty()) output_errors[i] = WriteLoweKeyFile(key_path, *result);
-    if (features_out != nullptr) features[i] = std::move(result).value();
-    summary.seconds = std::chrono::duration<double>(Clock::now() - image_start).count();
-    summaries[i] = std::move(summary);
+    if (output_errors[i].ok() && !key_path.empty()) output_errors[i] = WriteLoweKeyFile(key_path, extracted);
+    if (features_out != nullptr) features[i] = std::move(extracted);
+    summaries[i] = std::move(summary).value();
     if (progress) progress->Advance();
   });
   if (progress) progress->Finish();

@@ -2,6 +2,7 @@
 // Feature stage: decode each photo, take its focal prior from EXIF, extract SIFT, write
 // <project>/features/<name>.rfeat (and optionally Lowe .key files). Unreadable photos are
 // skipped with a warning naming the file and the reason; the others proceed.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,24 @@ struct FeatureStageReport {
   std::vector<std::string> skipped;  // "path: reason" per unreadable photo
   double seconds = 0;
 };
+
+// What the stage does for one photo: decode it, take its focal prior, extract SIFT (with the
+// fallbacks above), reusing its extractors from call to call. An unreadable photo's error names it.
+class PhotoFeatureExtractor {
+ public:
+  explicit PhotoFeatureExtractor(const FeatureStageOptions& options);
+  ~PhotoFeatureExtractor();
+  PhotoFeatureExtractor(PhotoFeatureExtractor&&) noexcept;
+  Result<ImageFeatureSummary> Extract(const std::string& path, SiftFeatures* features);
+
+ private:
+  FeatureStageOptions options_;
+  std::unique_ptr<SiftExtractor> configured_;
+  std::unique_ptr<SiftExtractor> fallback_;  // first octave 0, for a photo whose doubled octave overflows the arena
+};
+
+// The settings under which PROJECT/stages.txt records the stage (stage_record.h).
+std::string FeatureStageSettings(const FeatureStageOptions& options);
 
 // Extracts features for every path. With `project` non-null the results are written there and the
 // image list is (re)written. Fails only when no image could be processed or an output cannot be

@@ -11,6 +11,7 @@
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/features/sift/sift_io.h"
+#include "core/pipeline/stage_record.h"
 
 namespace reconar {
 namespace {
@@ -47,6 +48,35 @@ Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int heigh
   pair.inlier_matches.reserve(pair.geometry.inliers.size());
   for (int index : pair.geometry.inliers) pair.inlier_matches.push_back(putative[index]);
   return pair;
+}
+
+std::string MatchStageSettings(const MatchStageOptions& options) {
+  return StageRecord::Settings({{"ratio", options.match.max_ratio},
+                                {"checks", options.match.max_leaf_checks},
+                                {"min_inliers", options.two_view.min_inliers},
+                                {"f_threshold", options.two_view.f_threshold_fraction}});
+}
+
+Status WriteMatchesFile(const Project& project, const std::vector<ProjectImage>& images,
+                        const std::vector<VerifiedPair>& pairs) {
+  std::ostringstream out;
+  out << "# reconar matches v1\n";
+  out.precision(12);
+  for (const VerifiedPair& pair : pairs) {
+    const TwoViewGeometry& g = pair.geometry;
+    if (g.config == TwoViewGeometry::Config::kTooFewInliers) continue;
+    out << "pair " << images[static_cast<size_t>(pair.image_a)].name << ' '
+        << images[static_cast<size_t>(pair.image_b)].name << ' '
+        << (g.config == TwoViewGeometry::Config::kVerified ? "verified" : "planar") << ' '
+        << pair.inlier_matches.size();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) out << ' ' << g.F(r, c);
+    }
+    out << '\n';
+    for (const FeatureMatch& m : pair.inlier_matches) out << m.index_a << ' ' << m.index_b << '\n';
+  }
+  RECONAR_RETURN_IF_ERROR(CreateDirectories(project.MatchesDir()));
+  return WriteFileAtomically(project.MatchesPath(), out.str());
 }
 
 Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageOptions& options) {
@@ -190,28 +220,15 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
   report.num_pairs = static_cast<int>(pairs.size());
   report.num_blocks = num_blocks;
   report.estimated_peak_bytes = peak_bytes;
-  std::ostringstream out;
-  out << "# reconar matches v1\n";
-  out.precision(12);
   for (auto& result : results) {
     switch (result->geometry.config) {
       case TwoViewGeometry::Config::kVerified: ++report.num_verified; break;
       case TwoViewGeometry::Config::kPlanarOrRotation: ++report.num_planar; break;
       case TwoViewGeometry::Config::kTooFewInliers: ++report.num_rejected; continue;
     }
-    const TwoViewGeometry& g = result->geometry;
-    out << "pair " << images[result->image_a].name << ' ' << images[result->image_b].name << ' '
-        << (g.config == TwoViewGeometry::Config::kVerified ? "verified" : "planar") << ' '
-        << result->inlier_matches.size();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) out << ' ' << g.F(r, c);
-    }
-    out << '\n';
-    for (const FeatureMatch& m : result->inlier_matches) out << m.index_a << ' ' << m.index_b << '\n';
     report.pairs.push_back(std::move(*result));
   }
-  RECONAR_RETURN_IF_ERROR(CreateDirectories(project.MatchesDir()));
-  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(project.MatchesPath(), out.str()));
+  RECONAR_RETURN_IF_ERROR(WriteMatchesFile(project, images, report.pairs));
   report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return report;
 }

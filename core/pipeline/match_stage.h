@@ -58,7 +58,15 @@ Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int heigh
                                    int width_b, int height_b, const std::vector<FeatureMatch>& putative,
                                    const TwoViewOptions& options);
 
+// The settings under which PROJECT/stages.txt records the stage (stage_record.h).
+std::string MatchStageSettings(const MatchStageOptions& options);
+
 Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageOptions& options);
+
+// Writes PROJECT/matches/matches.txt (atomically) from pairs in the stage's order (image_a <
+// image_b, indices into `images`); pairs with too few inliers are left out.
+Status WriteMatchesFile(const Project& project, const std::vector<ProjectImage>& images,
+                        const std::vector<VerifiedPair>& pairs);
 
 struct MatchesFilePair {
   std::string name_a, name_b, config;  // config: "verified" or "planar"

@@ -267,15 +267,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       }
       return Status::Ok();
     };
-    RECONAR_RETURN_IF_ERROR(
-        runner.Run("features",
-                   Settings({{"first_octave", sift.first_octave},
-                             {"max_features", sift.max_features},
-                             {"contrast_threshold", sift.contrast_threshold},
-                             {"arena_mib", Mib(sift.arena_bytes)},
-                             {"texture_poor_min_features", static_cast<double>(features.texture_poor_min_features)},
-                             {"texture_poor_min_contrast", features.texture_poor_min_contrast_threshold}}),
-                   FeaturesUpToDate(project, image_paths), false, run_features));
+    RECONAR_RETURN_IF_ERROR(runner.Run("features", FeatureStageSettings(features),
+                                       FeaturesUpToDate(project, image_paths), false, run_features));
 
     MatchStageOptions matching = options.matching;
     matching.num_threads = threads;
@@ -289,12 +282,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       }
       return Status::Ok();
     };
-    RECONAR_RETURN_IF_ERROR(runner.Run("matching",
-                                       Settings({{"ratio", matching.match.max_ratio},
-                                                 {"checks", matching.match.max_leaf_checks},
-                                                 {"min_inliers", matching.two_view.min_inliers},
-                                                 {"f_threshold", matching.two_view.f_threshold_fraction}}),
-                                       Exists(project.MatchesPath()), runner.redone(), run_matching));
+    RECONAR_RETURN_IF_ERROR(runner.Run("matching", MatchStageSettings(matching), Exists(project.MatchesPath()),
+                                       runner.redone(), run_matching));
 
     const bool with_tags = options.tag_size_m > 0.0;
     if (with_tags) {

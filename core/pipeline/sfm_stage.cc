@@ -72,6 +72,31 @@ void FocalStatistics(const Reconstruction& rec, SfmStageReport* report) {
 
 }  // namespace
 
+MapperImage ToMapperImage(const ProjectImage& image, const std::vector<SiftKeypoint>& keypoints) {
+  MapperImage out;
+  out.name = image.name;
+  out.width = image.width;
+  out.height = image.height;
+  out.focal_prior = image.focal_px;
+  out.focal_from_exif = image.focal_source.rfind("exif", 0) == 0;
+  out.keypoints.reserve(keypoints.size());
+  out.keypoint_scales.reserve(keypoints.size());
+  for (const SiftKeypoint& k : keypoints) {
+    out.keypoints.emplace_back(k.x, k.y);
+    out.keypoint_scales.push_back(k.scale);
+  }
+  return out;
+}
+
+MapperPair ToMapperPair(int image_a, int image_b, const std::vector<FeatureMatch>& matches, bool planar) {
+  MapperPair pair;
+  pair.matches.image_a = image_a;
+  pair.matches.image_b = image_b;
+  pair.matches.matches = matches;
+  pair.planar = planar;
+  return pair;
+}
+
 Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions& options,
                                    Reconstruction* reconstruction_out) {
   SfmStageReport report;
@@ -81,22 +106,12 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   std::vector<MapperImage> images(list.size());
   for (size_t i = 0; i < list.size(); ++i) {
     index_of[list[i].name] = static_cast<int>(i);
-    MapperImage& image = images[i];
-    image.name = list[i].name;
-    image.width = list[i].width;
-    image.height = list[i].height;
-    image.focal_prior = list[i].focal_px;
-    image.focal_from_exif = list[i].focal_source.rfind("exif", 0) == 0;
     const std::string path = project.FeaturePath(list[i].name);
     RECONAR_ASSIGN_OR_RETURN(const FeatureFile features, ReadFeatureFile(path));
-    if (features.image_width != image.width || features.image_height != image.height) {
+    if (features.image_width != list[i].width || features.image_height != list[i].height) {
       return FileError(StatusCode::kCorruptData, path, "image size differs from " + project.ImageListPath());
     }
-    image.keypoints.reserve(features.features.keypoints.size());
-    for (const SiftKeypoint& k : features.features.keypoints) {
-      image.keypoints.emplace_back(k.x, k.y);
-      image.keypoint_scales.push_back(k.scale);
-    }
+    images[i] = ToMapperImage(list[i], features.features.keypoints);
   }
   RECONAR_ASSIGN_OR_RETURN(const std::vector<MatchesFilePair> matches, ReadMatchesFile(project.MatchesPath()));
   std::vector<MapperPair> pairs;
@@ -107,12 +122,7 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
       return FileError(StatusCode::kCorruptData, project.MatchesPath(),
                        "pair " + m.name_a + " " + m.name_b + " names an image missing from " + project.ImageListPath());
     }
-    MapperPair pair;
-    pair.matches.image_a = a->second;
-    pair.matches.image_b = b->second;
-    pair.matches.matches = m.matches;
-    pair.planar = m.config == "planar";
-    pairs.push_back(std::move(pair));
+    pairs.push_back(ToMapperPair(a->second, b->second, m.matches, m.config == "planar"));
   }
   std::vector<std::vector<TagObservation>> tag_observations;
   std::vector<TagCornerKeypoint> corner_keypoints;

@@ -10,6 +10,7 @@
 
 #include "core/base/json_writer.h"
 #include "core/base/status.h"
+#include "core/features/sift/sift.h"
 #include "core/pipeline/project.h"
 #include "core/sfm/mapper.h"
 #include "core/sfm/reconstruction.h"
@@ -51,6 +52,10 @@ struct SfmStageReport {
 // focal statistics (paper Table 1), initial pair, refinement choices, unregistered images with
 // reasons, and with tags their registration summary.
 void WriteSfmReportFields(const SfmStageReport& report, JsonWriter* json);
+
+// The mapper's view of a project image with its keypoints, and of a verified pair.
+MapperImage ToMapperImage(const ProjectImage& image, const std::vector<SiftKeypoint>& keypoints);
+MapperPair ToMapperPair(int image_a, int image_b, const std::vector<FeatureMatch>& matches, bool planar);
 
 // FailedPrecondition when the mapper finds no initial pair (its message says why); errors of
 // the project files name the file.

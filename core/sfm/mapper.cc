@@ -130,10 +130,15 @@ class Mapper {
 
   Status StartFromSeed(const Reconstruction& seed) {
     Reconstruction& rec = model_.rec;
-    if (seed.images.size() != rec.images.size() || seed.cameras.size() != rec.cameras.size())
+    // The seed may hold only the first images (a model grown while more photos arrive).
+    if (seed.images.size() > rec.images.size() || seed.cameras.size() > rec.cameras.size())
       return InvalidArgument("mapper: a seed model of other images");
-    for (size_t c = 0; c < rec.cameras.size(); ++c) rec.cameras[c] = seed.cameras[c];
-    for (size_t i = 0; i < rec.images.size(); ++i) {
+    for (size_t i = 0; i < seed.images.size(); ++i) {
+      if (seed.images[i].name != rec.images[i].name || seed.images[i].camera_id != rec.images[i].camera_id)
+        return InvalidArgument("mapper: a seed model of other images");
+    }
+    for (size_t c = 0; c < seed.cameras.size(); ++c) rec.cameras[c] = seed.cameras[c];
+    for (size_t i = 0; i < seed.images.size(); ++i) {
       if (!seed.images[i].registered) continue;
       rec.images[i].registered = true;
       rec.images[i].cam_from_world = seed.images[i].cam_from_world;
@@ -441,6 +446,20 @@ Status MergeIntoLargest(const std::vector<MapperImage>& images, const std::vecto
 }
 
 }  // namespace
+
+Result<Reconstruction> ContinueIncrementalMapper(const std::vector<MapperImage>& images,
+                                                 const std::vector<MapperPair>& pairs, const MapperOptions& options,
+                                                 const Reconstruction& previous, MapperReport* report) {
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  MapperReport local_report;
+  if (report == nullptr) report = &local_report;
+  *report = MapperReport();
+  if (previous.NumRegisteredImages() < 2) return InvalidArgument("mapper: continuing a model of fewer than two images");
+  const std::set<std::pair<int, int>> no_excluded_starts;
+  Mapper mapper(images, pairs, options, report, no_excluded_starts, nullptr);
+  RECONAR_RETURN_IF_ERROR(mapper.Run(nullptr, &previous));
+  return mapper.TakeResult();
+}
 
 Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& images,
                                             const std::vector<MapperPair>& pairs, const MapperOptions& options,

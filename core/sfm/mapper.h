@@ -213,4 +213,13 @@ Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& imag
                                             MapperReport* report, const MapperProgress& progress = nullptr,
                                             std::vector<Reconstruction>* other_models = nullptr);
 
+// Grows `previous`, a model of the first previous.images.size() of `images` (built by either
+// function from those images and their pairs), over all of them: its registered images start
+// with their poses and cameras, every track is triangulated again, the rest register as they can,
+// and the whole is adjusted as at the end of a run. For a model that grows while photos arrive
+// (a capture). InvalidArgument when `previous` is not such a model.
+Result<Reconstruction> ContinueIncrementalMapper(const std::vector<MapperImage>& images,
+                                                 const std::vector<MapperPair>& pairs, const MapperOptions& options,
+                                                 const Reconstruction& previous, MapperReport* report = nullptr);
+
 }  // namespace reconar

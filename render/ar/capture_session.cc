@@ -4,7 +4,10 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <thread>
 
+#include "core/base/atomic_file.h"
 #include "core/base/median.h"
 #include "core/io/exif.h"
 #include "core/io/focal_prior.h"
@@ -54,6 +57,8 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
   std::error_code error;
   fs::create_directories(images_dir, error);
   if (error) return IoError(images_dir + ": cannot create the directory: " + error.message());
+  // What a capture killed mid-write left (a keyframe or feature file in flight).
+  RECONAR_RETURN_IF_ERROR(RemoveStaleTemporaryFiles(options.project_dir).status());
   FrameSourceOptions source_options = options.source_options;
   source_options.want_rgb = true;
   RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<FrameSource> source, OpenFrameSource(options.source, source_options));
@@ -76,9 +81,27 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     return report;
   }
 
+  std::unique_ptr<LiveReconstruction> live;
+  std::vector<std::string> live_paths;  // in the order given to `live`
+  if (options.reconstruct_live) live = std::make_unique<LiveReconstruction>(Project(options.project_dir), options.live);
+  const auto emit_registered = [&](int64_t frame_index, double video_seconds) {
+    if (!live) return;
+    for (const int k : live->TakeNewlyRegistered()) {
+      CaptureEvent event;
+      event.kind = CaptureEvent::Kind::kRegistered;
+      event.frame_index = frame_index;
+      event.video_seconds = video_seconds;
+      event.path = live_paths[static_cast<size_t>(k)];
+      event.registered = live->NumRegistered();
+      emit(event);
+    }
+  };
+  const auto replay_start = std::chrono::steady_clock::now();
+
   KeyframeGate gate(options.gate);
   std::vector<double> gate_ms;
   int corrupt_in_a_row = 0;
+  std::string last_damage;
   int64_t first_timestamp = -1;
   int last_status_second = -1;
   while (true) {
@@ -92,7 +115,11 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
         report.stop_reason = replay ? "end of the recording" : "end of the stream";
         break;
       }
-      if (next.status().code() == StatusCode::kCorruptData &&
+      // A damaged frame is skipped; the same damage met again (a recording cut short, which cannot
+      // be read past) ends the capture like a camera that disconnected.
+      const bool same_damage = next.status().message() == last_damage;
+      last_damage = next.status().message();
+      if (next.status().code() == StatusCode::kCorruptData && !same_damage &&
           ++corrupt_in_a_row < options.max_corrupt_frames_in_a_row) {
         ++report.corrupt;
         CaptureEvent warning;
@@ -112,6 +139,10 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     CaptureEvent event;
     event.frame_index = frame.index;
     event.video_seconds = static_cast<double>(frame.timestamp_ns - first_timestamp) * 1e-9;
+    if (replay && options.replay_in_real_time)
+      std::this_thread::sleep_until(replay_start + std::chrono::duration<double>(event.video_seconds));
+    emit_registered(event.frame_index, event.video_seconds);
+    if (live) event.registered = live->NumRegistered();
     const auto start = std::chrono::steady_clock::now();
     const Status judged = gate.Process(frame.gray, &event.gate);
     gate_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
@@ -149,6 +180,10 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
         ++report.keyframes;
         report.keyframe_files.push_back(path);
       }
+      if (live) {
+        live->AddKeyframe(path);
+        live_paths.push_back(path);
+      }
       emit(event);
       if (options.max_keyframes > 0 && ordinal >= options.max_keyframes) {
         report.stop_reason = "--max-keyframes reached";
@@ -164,6 +199,12 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     }
   }
   report.median_gate_ms = Median(gate_ms);
+  if (live) {
+    // The worker finishes the keyframes it has not reached; its events still reach the caller.
+    RECONAR_ASSIGN_OR_RETURN(report.live_model, live->Finish());
+    report.live = true;
+    emit_registered(-1, -1.0);
+  }
   return report;
 }
 

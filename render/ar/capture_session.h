@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/pipeline/live_reconstruction.h"
 #include "platform/camera/frame_source.h"
 #include "tracker/keyframe_gate.h"
 
@@ -31,20 +32,27 @@ struct CaptureOptions {
   double focal_px = 0.0;  // > 0: written into each keyframe's EXIF (ExifForFocal)
   // Corrupt frames in a row (a damaged recording) after which the capture stops.
   int max_corrupt_frames_in_a_row = 25;
+  // The sparse model grown in the background from the keyframes (live_reconstruction.h).
+  bool reconstruct_live = true;
+  LiveReconstructionOptions live;
+  // A folder or recording replayed at the pace of its timestamps, as a camera would deliver it
+  // (for measuring the live model's latency); false: as fast as the gate goes.
+  bool replay_in_real_time = false;
 
   Status Check() const;
 };
 
 struct CaptureEvent {
-  enum class Kind { kStatus, kKeyframe, kWarning };
+  enum class Kind { kStatus, kKeyframe, kRegistered, kWarning };
   Kind kind = Kind::kStatus;
   int64_t frame_index = 0;
   double video_seconds = 0.0;  // the frame's timestamp since the first frame
   GateFrameReport gate;        // the frame's judgement (kStatus, kKeyframe)
-  std::string path;            // the keyframe's file (kKeyframe)
+  std::string path;            // the keyframe's file (kKeyframe, kRegistered)
   bool kept = false;           // the keyframe was already on disk (a resumed replay)
   std::string message;         // kWarning
   int frames = 0, keyframes = 0;
+  int registered = 0;  // keyframes in the live model
 };
 
 struct CaptureReport {
@@ -57,6 +65,8 @@ struct CaptureReport {
   std::string stop_reason;     // "end of the recording", "--max-keyframes reached", "stopped", or the source's error
   bool source_failed = false;  // the source ended with an error (a camera that disconnected)
   std::vector<std::string> keyframe_files;
+  bool live = false;  // CaptureOptions::reconstruct_live: `live_model` holds the live model's report
+  LiveReconstructionReport live_model;
 };
 
 // Runs the capture until the source ends, max_keyframes are on disk, *stop becomes true (SIGINT),

@@ -60,4 +60,13 @@ CommandRun RunCommand(const std::string& command, StderrMode stderr_mode) {
   return run;
 }
 
+int SpawnCommand(const std::string& command) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", ("exec " + command + " > /dev/null 2>&1").c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
 }  // namespace reconar::testing

@@ -27,6 +27,10 @@ std::string LinkFiles(const std::string& dir, const std::string& source_dir, con
 // `command` through /bin/sh (popen).
 CommandRun RunCommand(const std::string& command, StderrMode stderr_mode = StderrMode::kMerge);
 
+// Starts `command` through /bin/sh in a process of its own, its output discarded; returns its pid
+// (for a test that kills it).
+int SpawnCommand(const std::string& command);
+
 #ifdef RECONAR_BINARY
 // The reconar executable (RECONAR_BINARY, defined by the tests in tests/tools) with `arguments`.
 inline CommandRun RunReconar(const std::string& arguments, StderrMode stderr_mode = StderrMode::kMerge) {

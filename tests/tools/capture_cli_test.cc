@@ -1,19 +1,27 @@
-// `reconar capture` on the AR video's 93 real frames (a folder source): keyframes written as JPEG
-// with the focal in their EXIF, a capture interrupted and run again ends with the keyframes of an
-// uninterrupted one, corrupt frames are skipped with a warning, and a project that cannot be
-// written fails naming it.
+// `reconar capture` on the AR video's 93 real frames (a folder source, and a .frames recording of
+// them): keyframes written as JPEG with the focal in their EXIF; the live model registering them
+// while the capture runs, and `reconstruct` reusing its features and matches; a capture stopped
+// (--max-keyframes, SIGKILL) and run again ends with the keyframes and model of an uninterrupted
+// one; corrupt frames are skipped with a warning; a recording cut short and a full disk end with a
+// clear error and lose nothing; a project that cannot be written fails naming it.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/base/json_reader.h"
 #include "core/io/exif.h"
 #include "core/io/focal_prior.h"
 #include "core/io/image_io.h"
+#include "platform/camera/recorded_frames.h"
 #include "tests/support/ar_video.h"
 #include "tests/support/run_command.h"
 
@@ -130,6 +138,191 @@ TEST(CaptureCli, CorruptFramesAreSkippedWithAWarning) {
   EXPECT_NE(run.output.find("frame0041.jpg"), std::string::npos) << run.output;
   EXPECT_GE(Keyframes(root / "project").size(), 3u);
   for (const fs::path& file : Keyframes(root / "project")) EXPECT_TRUE(ReadImage(file.string()).ok()) << file;
+  fs::remove_all(root);
+}
+
+// Every file of the capture's results: the keyframes, the features and matches, the live model.
+std::map<std::string, std::string> CaptureResults(const fs::path& project) {
+  std::map<std::string, std::string> files;
+  for (const char* dir : {"images", "features", "matches", "live"}) {
+    if (!fs::exists(project / dir)) continue;
+    for (const auto& entry : fs::directory_iterator(project / dir)) {
+      if (entry.path().filename() == "report.json") continue;  // times differ
+      std::string bytes = ReadBytes(entry.path());
+      // The image list names each keyframe by its path, which holds the project's.
+      for (size_t at = bytes.find(project.string()); at != std::string::npos; at = bytes.find(project.string(), at))
+        bytes.replace(at, project.string().size(), "PROJECT");
+      files[std::string(dir) + "/" + entry.path().filename().string()] = bytes;
+    }
+  }
+  return files;
+}
+
+// The AR video's JPEG frames as a camera delivering MJPEG would have recorded them, 30 frames per second.
+void WriteArVideoRecording(const fs::path& path) {
+  auto writer = RecordedFramesWriter::Create(path.string());
+  ASSERT_TRUE(writer.ok()) << writer.status().ToString();
+  std::vector<fs::path> frames;
+  for (const auto& entry : fs::directory_iterator(Frames())) {
+    if (entry.path().extension() == ".jpg") frames.push_back(entry.path());
+  }
+  std::sort(frames.begin(), frames.end());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const std::string jpeg = ReadBytes(frames[i]);
+    RawFrame raw;
+    raw.layout.format = PixelFormat::kMjpeg;
+    raw.layout.width = 640;
+    raw.layout.height = 480;
+    raw.data = reinterpret_cast<const uint8_t*>(jpeg.data());
+    raw.size = jpeg.size();
+    ASSERT_TRUE((*writer)->Append(raw, static_cast<int64_t>(i) * 1000000000 / 30).ok());
+  }
+  ASSERT_TRUE((*writer)->Finish().ok());
+}
+
+double Number(const JsonValue& object, const char* key) {
+  const JsonValue* value = object.Find(key);
+  return value != nullptr && value->is_number() ? value->number() : -1.0;
+}
+
+// The live model registers every keyframe while the capture runs; `reconstruct` (here its sparse
+// stages, `sfm`) then reuses the features and matches, which are the ones it would have computed;
+// with --tag-size the model is in metres, the tag's edges measured against the printed 0.14 m.
+TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
+  const fs::path root = testing::MakeTestDirectory("capture_live");
+  const fs::path project = root / "project";
+  const CameraIntrinsics k = testing::ArVideoCamera();
+  const CommandRun run = RunReconar("capture " + Frames() + " " + project.string() +
+                                        " --json --realtime --intrinsics " + std::to_string(k.fx) + "," +
+                                        std::to_string(k.fy) + "," + std::to_string(k.cx) + "," + std::to_string(k.cy),
+                                    testing::StderrMode::kSeparate);
+  ASSERT_EQ(run.exit_code, 0) << run.output << run.error;
+  auto end = EndEvent(run.output);
+  ASSERT_TRUE(end.ok()) << end.status().ToString();
+  const double keyframes = Number(*end, "keyframes");
+  const JsonValue* live = end->Find("live");
+  ASSERT_NE(live, nullptr) << run.output;
+  size_t registered_events = 0;
+  for (size_t at = run.output.find("\"event\":\"registered\""); at != std::string::npos;
+       at = run.output.find("\"event\":\"registered\"", at + 1))
+    ++registered_events;
+  std::printf(
+      "%g keyframes, %g registered live (%zu events), %g points; keyframe to registration %.2f s median, "
+      "%.2f s 95th percentile\n",
+      keyframes, Number(*live, "registered"), registered_events, Number(*live, "points"),
+      Number(*live, "median_latency_s"), Number(*live, "p95_latency_s"));
+  EXPECT_GE(keyframes, 3.0);
+  EXPECT_EQ(Number(*live, "registered"), keyframes);
+  EXPECT_EQ(static_cast<double>(registered_events), keyframes);
+  EXPECT_TRUE(fs::exists(project / "live" / "points3D.txt"));
+  EXPECT_TRUE(fs::exists(project / "live" / "report.json"));
+
+  const CommandRun sfm = RunReconar("sfm " + (project / "images").string() + " " + project.string() +
+                                    " --threads 2 --tag-size " + std::to_string(testing::kArVideoTagSize));
+  ASSERT_EQ(sfm.exit_code, 0) << sfm.output;
+  EXPECT_NE(sfm.output.find("features  reused"), std::string::npos) << sfm.output;
+  EXPECT_NE(sfm.output.find("matching  reused"), std::string::npos) << sfm.output;
+  auto tags = ReadJsonFile((project / "tags.json").string());
+  ASSERT_TRUE(tags.ok()) << tags.status().ToString();
+  ASSERT_TRUE(tags->Find("metric")->bool_value()) << sfm.output;
+  const JsonValue& edges = *(*tags->Find("tags"))[0].Find("edges_m");
+  for (size_t e = 0; e < edges.size(); ++e) {
+    std::printf("tag edge %zu: %.4f m (printed %.2f m)\n", e, edges[e].number(), testing::kArVideoTagSize);
+    EXPECT_NEAR(edges[e].number(), testing::kArVideoTagSize, 0.003);
+  }
+
+  // What the match stage computes from the keyframes in a project of its own, to the byte.
+  const CommandRun fresh =
+      RunReconar("sfm " + (project / "images").string() + " " + (root / "offline").string() + " --threads 2");
+  ASSERT_EQ(fresh.exit_code, 0) << fresh.output;
+  EXPECT_EQ(ReadBytes(project / "matches" / "matches.txt"), ReadBytes(root / "offline" / "matches" / "matches.txt"));
+  EXPECT_EQ(ReadBytes(project / "features" / "images.txt"), ReadBytes(root / "offline" / "features" / "images.txt"));
+  for (const fs::path& keyframe : Keyframes(project)) {
+    const std::string features = "features/" + keyframe.filename().string() + ".rfeat";
+    EXPECT_EQ(ReadBytes(project / features), ReadBytes(root / "offline" / features)) << features;
+  }
+  fs::remove_all(root);
+}
+
+// Killed (SIGKILL) once 30 % and once 70 % of an uninterrupted capture's keyframes are on disk, then
+// run again: the same keyframes, features, matches and live model, to the byte.
+TEST(CaptureCli, AKilledCaptureRunAgainEndsAsAnUninterruptedOne) {
+  const fs::path root = testing::MakeTestDirectory("capture_killed");
+  const fs::path recording = root / "ar_video.frames";
+  WriteArVideoRecording(recording);
+  const std::string capture = std::string(RECONAR_BINARY) + " capture " + recording.string() + " ";
+  ASSERT_EQ(RunReconar("capture " + recording.string() + " " + (root / "whole").string()).exit_code, 0);
+  const auto whole = CaptureResults(root / "whole");
+  const size_t whole_keyframes = Keyframes(root / "whole").size();
+  ASSERT_GE(whole_keyframes, 4u);
+  ASSERT_TRUE(whole.count("live/points3D.txt"));
+  int killed = 0;
+  for (const double share : {0.3, 0.7}) {
+    const fs::path project = root / ("killed_" + std::to_string(static_cast<int>(100 * share)));
+    const size_t kill_at = std::max<size_t>(1, static_cast<size_t>(share * static_cast<double>(whole_keyframes)));
+    const int pid = testing::SpawnCommand(capture + project.string() + " --realtime");
+    ASSERT_GT(pid, 0);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (Keyframes(project).size() < kill_at && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    ::kill(pid, SIGKILL);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    if (WIFSIGNALED(status)) ++killed;
+    const size_t on_disk = Keyframes(project).size();
+    EXPECT_GE(on_disk, kill_at);
+    EXPECT_LT(on_disk, whole_keyframes);
+    const CommandRun again = RunReconar("capture " + recording.string() + " " + project.string());
+    ASSERT_EQ(again.exit_code, 0) << again.output;
+    const auto resumed = CaptureResults(project);
+    EXPECT_EQ(resumed.size(), whole.size()) << "killed at " << on_disk << " keyframes";
+    for (const auto& [name, bytes] : whole) {
+      const auto it = resumed.find(name);
+      ASSERT_NE(it, resumed.end()) << name << " missing after a kill at " << on_disk << " keyframes";
+      EXPECT_TRUE(it->second == bytes) << name << " differs after a kill at " << on_disk << " keyframes";
+    }
+  }
+  EXPECT_EQ(killed, 2);
+  fs::remove_all(root);
+}
+
+// A camera that stops delivering: the recording cut in the middle of a frame. The capture ends
+// with the recording's error and exit code 1; the keyframes taken and the live model stay.
+TEST(CaptureCli, ARecordingCutShortEndsWithItsErrorAndKeepsTheKeyframes) {
+  const fs::path root = testing::MakeTestDirectory("capture_cut");
+  const fs::path recording = root / "cut.frames";
+  WriteArVideoRecording(recording);
+  fs::resize_file(recording, fs::file_size(recording) * 6 / 10 + 1000);
+  const CommandRun run = RunReconar("capture " + recording.string() + " " + (root / "project").string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("reconar: error: " + recording.string()), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("truncated"), std::string::npos) << run.output;
+  std::printf("%s", run.output.substr(run.output.find("reconar: error:")).c_str());
+  const std::vector<fs::path> keyframes = Keyframes(root / "project");
+  EXPECT_GE(keyframes.size(), 2u);
+  for (const fs::path& file : keyframes) EXPECT_TRUE(ReadImage(file.string()).ok()) << file;
+  EXPECT_TRUE(fs::exists(root / "project" / "live" / "report.json"));
+  fs::remove_all(root);
+}
+
+// The disk fills while keyframes and their features are written (ulimit -f; SIGXFSZ ignored, so a
+// write fails with EFBIG): an error naming the file, every file on disk whole, none half written.
+TEST(CaptureCli, AFullDiskEndsWithAClearErrorAndNoHalfFile) {
+  const fs::path root = testing::MakeTestDirectory("capture_full_disk");
+  const fs::path project = root / "project";
+  const CommandRun run =
+      testing::RunCommand("bash -c \"trap '' XFSZ; ulimit -f 80; exec " + std::string(RECONAR_BINARY) + " capture " +
+                          Frames() + " " + project.string() + "\"");
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  ASSERT_NE(run.output.find("reconar: error:"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(project.string()), std::string::npos) << "the error names the file: " << run.output;
+  std::printf("%s", run.output.substr(run.output.find("reconar: error:")).c_str());
+  for (const auto& entry : fs::recursive_directory_iterator(project)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(name.find(".tmp-"), std::string::npos) << "temporary file left: " << entry.path();
+    if (entry.path().extension() == ".jpg") EXPECT_TRUE(ReadImage(entry.path().string()).ok()) << entry.path();
+  }
+  EXPECT_GE(Keyframes(project).size(), 1u);
   fs::remove_all(root);
 }
 

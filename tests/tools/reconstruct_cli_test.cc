@@ -184,16 +184,6 @@ std::map<std::string, std::string> ProjectFiles(const std::string& project) {
   return files;
 }
 
-// Starts `command` in its own process; returns its pid.
-pid_t Spawn(const std::string& command) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::execl("/bin/sh", "sh", "-c", ("exec " + command + " > /dev/null 2>&1").c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  return pid;
-}
-
 TEST(ReconstructCli, KilledRunsResumeToTheSameFiles) {
   const std::string data = std::string(RECONAR_SOURCE_DIR) + "/data/templeSparseRing";
   const std::string dir = testing::MakeTestDirectory("reconar_reconstruct_resume");
@@ -215,7 +205,8 @@ TEST(ReconstructCli, KilledRunsResumeToTheSameFiles) {
   int interrupted = 0;
   for (const double fraction : {0.2, 0.5, 0.8}) {
     const std::string project = dir + "/killed_" + std::to_string(static_cast<int>(100 * fraction));
-    const pid_t pid = Spawn(std::string(RECONAR_BINARY) + " reconstruct " + data + " " + project + arguments);
+    const pid_t pid =
+        testing::SpawnCommand(std::string(RECONAR_BINARY) + " reconstruct " + data + " " + project + arguments);
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::duration<double>(fraction * seconds));
     ::kill(pid, SIGKILL);

@@ -1,0 +1,251 @@
+#include "core/pipeline/live_reconstruction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "core/base/atomic_file.h"
+#include "core/base/json_writer.h"
+#include "core/base/median.h"
+#include "core/features/sift/sift_io.h"
+#include "core/pipeline/reconstruct.h"
+#include "core/pipeline/sfm_stage.h"
+#include "core/pipeline/stage_record.h"
+#include "core/sfm/model_io.h"
+
+namespace reconar {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsBetween(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double>(to - from).count();
+}
+
+// The value under which `fraction` of the sorted values lie (nearest rank).
+double Percentile(std::vector<double> values, double fraction) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t rank = static_cast<size_t>(std::ceil(fraction * static_cast<double>(values.size())));
+  return values[std::min(values.size(), std::max<size_t>(rank, 1)) - 1];
+}
+
+}  // namespace
+
+LiveReconstructionOptions::LiveReconstructionOptions() {
+  const ReconstructOptions reconstruct;
+  features = reconstruct.features;
+  matching = reconstruct.matching;
+  mapper = reconstruct.sfm.mapper;
+}
+
+LiveReconstruction::LiveReconstruction(const Project& project, const LiveReconstructionOptions& options)
+    : project_(project), options_(options), start_(Clock::now()), extractor_(options.features) {
+  worker_ = std::thread([this] { Work(); });
+}
+
+LiveReconstruction::~LiveReconstruction() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void LiveReconstruction::AddKeyframe(const std::string& path) {
+  LiveKeyframe keyframe;
+  keyframe.path = path;
+  keyframe.taken_seconds = SecondsBetween(start_, Clock::now());
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queued_.push_back(std::move(keyframe));
+  }
+  wake_.notify_all();
+}
+
+std::vector<int> LiveReconstruction::TakeNewlyRegistered() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<int> taken;
+  taken.swap(newly_registered_);
+  return taken;
+}
+
+int LiveReconstruction::NumKeyframes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<int>(queued_.size());
+}
+
+int LiveReconstruction::NumRegistered() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return registered_now_;
+}
+
+void LiveReconstruction::Work() {
+  while (true) {
+    size_t index = 0;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stopping_ || finishing_ || done_ < queued_.size(); });
+      if (stopping_ || done_ == queued_.size()) return;  // finishing with nothing left
+      index = done_;
+    }
+    const Status status = ProcessKeyframe(index);
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    if (!status.ok()) {
+      worker_error_ = status;
+      return;
+    }
+  }
+}
+
+Status LiveReconstruction::ProcessKeyframe(size_t index) {
+  std::string path;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    path = queued_[index].path;
+  }
+  auto start = Clock::now();
+  SiftFeatures features;
+  Result<ImageFeatureSummary> summary = extractor_.Extract(path, &features);
+  if (!summary.ok()) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queued_[index].failure = summary.status().message();
+    return Status::Ok();
+  }
+  RECONAR_RETURN_IF_ERROR(CreateDirectories(project_.FeaturesDir()));
+  RECONAR_RETURN_IF_ERROR(WriteFeatureFile(project_.FeaturePath(summary->image.name),
+                                           FeatureFile{summary->image.width, summary->image.height, features}));
+  if (!matcher_) {
+    MatchOptions one_thread = options_.matching.match;
+    one_thread.num_threads = 1;
+    RECONAR_ASSIGN_OR_RETURN(matcher_, Matcher::Create(one_thread));
+  }
+  const int image = static_cast<int>(images_.size());
+  RECONAR_RETURN_IF_ERROR(
+      matcher_->AddImage(image, features.descriptors.data(), static_cast<int>(features.keypoints.size())));
+  images_.push_back(summary->image);
+  keyframe_of_image_.push_back(index);
+  mapper_images_.push_back(ToMapperImage(summary->image, features.keypoints));
+  features_.push_back(std::move(features));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queued_[index].num_features = summary->num_features;
+  }
+  const auto matching_start = Clock::now();
+  seconds_features_ += SecondsBetween(start, matching_start);
+
+  // Against every earlier keyframe, in the match stage's order (the earlier image queries).
+  const ProjectImage& mine = images_.back();
+  for (int other = 0; other < image; ++other) {
+    RECONAR_ASSIGN_OR_RETURN(const std::vector<FeatureMatch> putative, matcher_->Match(other, image));
+    const ProjectImage& theirs = images_[static_cast<size_t>(other)];
+    Result<VerifiedPair> verified =
+        VerifyMatches(features_[static_cast<size_t>(other)], theirs.width, theirs.height, features_.back(), mine.width,
+                      mine.height, putative, options_.matching.two_view);
+    if (!verified.ok()) return verified.status().WithContext(theirs.name + " / " + mine.name);
+    if (verified->geometry.config == TwoViewGeometry::Config::kTooFewInliers) continue;
+    verified->image_a = other;
+    verified->image_b = image;
+    mapper_pairs_.push_back(ToMapperPair(other, image, verified->inlier_matches,
+                                         verified->geometry.config == TwoViewGeometry::Config::kPlanarOrRotation));
+    pairs_.push_back(std::move(verified).value());
+  }
+  const auto mapping_start = Clock::now();
+  seconds_matching_ += SecondsBetween(matching_start, mapping_start);
+
+  MapperOptions mapper = options_.mapper;
+  mapper.num_threads = 1;
+  Result<Reconstruction> grown = has_model_ ? ContinueIncrementalMapper(mapper_images_, mapper_pairs_, mapper, model_)
+                                            : RunIncrementalMapper(mapper_images_, mapper_pairs_, mapper, nullptr);
+  seconds_mapping_ += SecondsBetween(mapping_start, Clock::now());
+  if (!grown.ok()) {
+    // No initial pair among the keyframes so far: the next keyframe may give one.
+    if (grown.status().code() == StatusCode::kFailedPrecondition) return Status::Ok();
+    return grown.status();
+  }
+  model_ = std::move(grown).value();
+  has_model_ = true;
+  const double now = SecondsBetween(start_, Clock::now());
+  std::lock_guard<std::mutex> lock(mutex_);
+  registered_now_ = model_.NumRegisteredImages();
+  for (size_t i = 0; i < model_.images.size(); ++i) {
+    LiveKeyframe& keyframe = queued_[keyframe_of_image_[i]];
+    if (model_.images[i].registered && keyframe.registered_seconds < 0.0) {
+      keyframe.registered_seconds = now;
+      newly_registered_.push_back(static_cast<int>(keyframe_of_image_[i]));
+    }
+  }
+  return Status::Ok();
+}
+
+Result<LiveReconstructionReport> LiveReconstruction::Finish() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    finishing_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  LiveReconstructionReport report;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    report.keyframes = queued_;
+    if (!worker_error_.ok()) return worker_error_;
+  }
+  report.registered = has_model_ ? model_.NumRegisteredImages() : 0;
+  report.points = has_model_ ? model_.NumPoints() : 0;
+  report.seconds_features = seconds_features_;
+  report.seconds_matching = seconds_matching_;
+  report.seconds_mapping = seconds_mapping_;
+  std::vector<double> latencies;
+  for (const LiveKeyframe& keyframe : report.keyframes) {
+    if (keyframe.registered_seconds >= 0.0) latencies.push_back(keyframe.registered_seconds - keyframe.taken_seconds);
+  }
+  report.median_latency_seconds = Median(latencies);
+  report.p95_latency_seconds = Percentile(latencies, 0.95);
+  if (images_.empty()) return report;
+
+  // What `reconstruct` reuses: the features and matches under its stage records.
+  RECONAR_RETURN_IF_ERROR(project_.WriteImageList(images_));
+  // In the match stage's order, so that the file is the one it would write.
+  std::sort(pairs_.begin(), pairs_.end(), [](const VerifiedPair& a, const VerifiedPair& b) {
+    return std::make_pair(a.image_a, a.image_b) < std::make_pair(b.image_a, b.image_b);
+  });
+  RECONAR_RETURN_IF_ERROR(WriteMatchesFile(project_, images_, pairs_));
+  StageRecord record(project_);
+  RECONAR_RETURN_IF_ERROR(record.Record("features", FeatureStageSettings(options_.features)));
+  RECONAR_RETURN_IF_ERROR(record.Record("matching", MatchStageSettings(options_.matching)));
+
+  const std::string live_dir = project_.root() + "/live";
+  RECONAR_RETURN_IF_ERROR(CreateDirectories(live_dir));
+  if (has_model_) {
+    RECONAR_RETURN_IF_ERROR(WriteColmapTextModel(model_, live_dir));
+  } else {
+    for (const char* name : {"cameras.txt", "images.txt", "points3D.txt"})
+      RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(live_dir + "/" + name));
+  }
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("keyframes").Int(static_cast<long long>(report.keyframes.size()));
+  json.Key("registered").Int(report.registered);
+  json.Key("points").Int(report.points);
+  json.Key("median_latency_s").Double(report.median_latency_seconds);
+  json.Key("p95_latency_s").Double(report.p95_latency_seconds);
+  json.Key("seconds_features").Double(report.seconds_features);
+  json.Key("seconds_matching").Double(report.seconds_matching);
+  json.Key("seconds_mapping").Double(report.seconds_mapping);
+  json.Key("images").BeginArray();
+  for (const LiveKeyframe& keyframe : report.keyframes) {
+    json.BeginObject().Key("path").String(keyframe.path).Key("taken_s").Double(keyframe.taken_seconds);
+    if (keyframe.registered_seconds >= 0.0) json.Key("registered_s").Double(keyframe.registered_seconds);
+    json.Key("features").Int(keyframe.num_features);
+    if (!keyframe.failure.empty()) json.Key("failure").String(keyframe.failure);
+    json.EndObject();
+  }
+  json.EndArray().EndObject();
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(live_dir + "/report.json", json.str() + "\n"));
+  return report;
+}
+
+}  // namespace reconar

@@ -1,0 +1,113 @@
+#pragma once
+// A sparse model that grows while photos arrive (`reconar capture`, issue 18). A worker thread
+// takes the keyframes in the order they were taken, one at a time:
+//   1. features, as the feature stage extracts them, written to PROJECT/features/ at once;
+//   2. matches against every earlier keyframe, verified as the match stage verifies them (the
+//      same pairs, in the same order: a capture holds tens of keyframes, not thousands);
+//   3. the model grown by ContinueIncrementalMapper (core/sfm/mapper.h) from the last one, or
+//      started once two keyframes make an initial pair.
+// One keyframe at a time in a fixed order makes the result independent of how far the worker
+// lags behind the camera: a replay that resumes after a crash ends with the same model.
+//
+// Finish() drains the queue and leaves a project `reconar reconstruct PROJECT/images PROJECT`
+// continues from: features/ and images.txt, matches/matches.txt, their stages recorded under the
+// settings the reconstruction would use (so it reuses them), and the live model in PROJECT/live/
+// (COLMAP text) with PROJECT/live/report.json (when each keyframe registered).
+#include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/features/matcher.h"
+#include "core/pipeline/feature_stage.h"
+#include "core/pipeline/match_stage.h"
+#include "core/pipeline/project.h"
+#include "core/sfm/mapper.h"
+#include "core/sfm/reconstruction.h"
+
+namespace reconar {
+
+struct LiveReconstructionOptions {
+  // As `reconar reconstruct` runs them (ReconstructOptions' defaults), so that it reuses them; the
+  // worker is one thread.
+  LiveReconstructionOptions();
+  FeatureStageOptions features;
+  MatchStageOptions matching;
+  MapperOptions mapper;
+};
+
+struct LiveKeyframe {
+  std::string path;
+  double taken_seconds = 0.0;        // since the live reconstruction started
+  double registered_seconds = -1.0;  // when it first registered; < 0: not (yet)
+  int num_features = 0;
+  std::string failure;  // an unreadable keyframe's reason
+};
+
+struct LiveReconstructionReport {
+  std::vector<LiveKeyframe> keyframes;
+  int registered = 0;  // in the final model
+  int points = 0;
+  double median_latency_seconds = 0.0;  // taken -> registered, over the keyframes that registered
+  double p95_latency_seconds = 0.0;
+  double seconds_features = 0.0, seconds_matching = 0.0, seconds_mapping = 0.0;  // the worker's time
+  std::string error;  // a failure that stopped the worker (the keyframes stay on disk)
+};
+
+class LiveReconstruction {
+ public:
+  LiveReconstruction(const Project& project, const LiveReconstructionOptions& options);
+  ~LiveReconstruction();  // stops the worker (what it finished stays on disk)
+  LiveReconstruction(const LiveReconstruction&) = delete;
+  LiveReconstruction& operator=(const LiveReconstruction&) = delete;
+
+  // Queues a keyframe written whole at `path`; returns at once.
+  void AddKeyframe(const std::string& path);
+  // Indices (in AddKeyframe order) of the keyframes registered since the last call.
+  std::vector<int> TakeNewlyRegistered();
+  // Keyframes queued, and how many of them are in the model now.
+  int NumKeyframes() const;
+  int NumRegistered() const;
+
+  // Waits for the queue to drain, writes the outputs above; errors name the file.
+  Result<LiveReconstructionReport> Finish();
+
+ private:
+  void Work();
+  Status ProcessKeyframe(size_t index);
+  Status WriteOutputs();
+
+  const Project project_;
+  const LiveReconstructionOptions options_;
+  const std::chrono::steady_clock::time_point start_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::vector<LiveKeyframe> queued_;   // guarded by mutex_
+  size_t done_ = 0;                    // keyframes processed; guarded by mutex_
+  bool stopping_ = false;              // guarded by mutex_: leave now
+  bool finishing_ = false;             // guarded by mutex_: leave once the queue is empty
+  std::vector<int> newly_registered_;  // guarded by mutex_
+  int registered_now_ = 0;             // guarded by mutex_
+  Status worker_error_;                // guarded by mutex_
+
+  // The worker's own state.
+  PhotoFeatureExtractor extractor_;
+  std::unique_ptr<Matcher> matcher_;
+  std::vector<ProjectImage> images_;
+  std::vector<SiftFeatures> features_;
+  std::vector<size_t> keyframe_of_image_;  // images_[i] is queued_[keyframe_of_image_[i]]
+  std::vector<VerifiedPair> pairs_;
+  std::vector<MapperImage> mapper_images_;
+  std::vector<MapperPair> mapper_pairs_;
+  Reconstruction model_;
+  bool has_model_ = false;
+  double seconds_features_ = 0.0, seconds_matching_ = 0.0, seconds_mapping_ = 0.0;
+
+  std::thread worker_;
+};
+
+}  // namespace reconar
