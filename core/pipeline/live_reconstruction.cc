@@ -159,6 +159,12 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   mapper.num_threads = 1;
   Result<Reconstruction> grown = has_model_ ? ContinueIncrementalMapper(mapper_images_, mapper_pairs_, mapper, model_)
                                             : RunIncrementalMapper(mapper_images_, mapper_pairs_, mapper, nullptr);
+  if (has_model_ && grown.ok() && 2 * grown->NumRegisteredImages() < static_cast<int>(images_.size())) {
+    // A model that holds under half the keyframes may have started from a poor pair (the first two
+    // keyframes of a walk forward): the mapper from scratch chooses its pair among all of them.
+    Result<Reconstruction> fresh = RunIncrementalMapper(mapper_images_, mapper_pairs_, mapper, nullptr);
+    if (fresh.ok() && fresh->NumRegisteredImages() > grown->NumRegisteredImages()) grown = std::move(fresh);
+  }
   seconds_mapping_ += SecondsBetween(mapping_start, Clock::now());
   if (!grown.ok()) {
     // No initial pair among the keyframes so far: the next keyframe may give one.

@@ -11,7 +11,9 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -21,9 +23,14 @@
 #include "core/io/exif.h"
 #include "core/io/focal_prior.h"
 #include "core/io/image_io.h"
+#include "core/io/image_write.h"
+#include "core/sfm/model_io.h"
 #include "platform/camera/recorded_frames.h"
 #include "tests/support/ar_video.h"
+#include "tests/support/corridor_walk.h"
+#include "tests/support/frame_effects.h"
 #include "tests/support/run_command.h"
+#include "tests/support/sfm_evaluation.h"
 
 namespace reconar {
 namespace {
@@ -323,6 +330,130 @@ TEST(CaptureCli, AFullDiskEndsWithAClearErrorAndNoHalfFile) {
     if (entry.path().extension() == ".jpg") EXPECT_TRUE(ReadImage(entry.path().string()).ok()) << entry.path();
   }
   EXPECT_GE(Keyframes(project).size(), 1u);
+  fs::remove_all(root);
+}
+
+// A model's registered cameras against the truth (7-DoF aligned), each image's truth found by
+// `truth_name` of its name ("" for none: a failure).
+struct ModelScore {
+  int registered = 0;
+  testing::CameraPoseErrors errors;
+};
+ModelScore ScoreAgainstTruth(const fs::path& model_dir, const testing::GroundTruthByName& truth,
+                             const std::function<std::string(const std::string&)>& truth_name) {
+  ModelScore score;
+  auto model = ReadColmapTextModel(model_dir.string());
+  EXPECT_TRUE(model.ok()) << model.status().ToString();
+  if (!model.ok()) return score;
+  std::vector<testing::CameraPose> estimated, reference;
+  for (const SfmImage& image : model->images) {
+    if (!image.registered) continue;
+    ++score.registered;
+    const auto gt = truth.find(truth_name(image.name));
+    if (gt == truth.end()) {
+      ADD_FAILURE() << image.name << " has no ground truth";
+      continue;
+    }
+    estimated.push_back({image.cam_from_world.rotation, image.Center()});
+    reference.push_back(testing::PoseOf(gt->second));
+  }
+  auto errors = testing::CameraCenterErrors(estimated, reference);
+  EXPECT_TRUE(errors.ok()) << errors.status().ToString();
+  if (errors.ok()) score.errors = *errors;
+  return score;
+}
+
+// A hand-held video with known poses: a slow walk down the rendered corridor (corridor_walk.h: its
+// panels are pictures, the camera sways, bobs and turns as a walker's does), with a 9-pixel motion
+// blur on every seventh frame and a darker stretch (the exposure at 60 %). The blurred frames are
+// never keyframes; the keyframes register in the live model (at least 95 %), whose cameras are as
+// close to the truth as those of `sfm` on every k-th frame, k giving as many frames.
+TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
+  const fs::path root = testing::MakeTestDirectory("capture_hand_held");
+  const fs::path video = root / "video";
+  fs::create_directories(video);
+  testing::CorridorWalkOptions walk;
+  walk.frames = 90;
+  walk.step_m = 0.05;
+  auto truth = testing::RenderCorridorWalk(video.string(), walk);
+  ASSERT_TRUE(truth.ok()) << truth.status().ToString();
+  std::vector<std::string> names;
+  for (const auto& [name, camera] : *truth) names.push_back(name);
+  std::sort(names.begin(), names.end());
+  ASSERT_EQ(names.size(), 90u);
+  std::set<int> blurred;
+  for (int i = 0; i < walk.frames; ++i) {
+    const bool blur = i % 7 == 3, dark = i >= 40 && i < 55;
+    if (!blur && !dark) continue;
+    if (blur) blurred.insert(i);
+    auto frame = ReadImage((video / names[static_cast<size_t>(i)]).string());
+    ASSERT_TRUE(frame.ok()) << frame.status().ToString();
+    Image<uint8_t> changed = std::move(frame->rgb);
+    if (blur) changed = testing::MotionBlurred(changed, 9);
+    if (dark) changed = testing::ExposureScaled(changed, 0.6);
+    ASSERT_TRUE(WritePng((video / names[static_cast<size_t>(i)]).string(), changed.view(), 3).ok());
+  }
+
+  const fs::path project = root / "capture";
+  const CommandRun run =
+      RunReconar("capture " + video.string() + " " + project.string() + " --json", testing::StderrMode::kSeparate);
+  ASSERT_EQ(run.exit_code, 0) << run.output << run.error;
+  auto end = EndEvent(run.output);
+  ASSERT_TRUE(end.ok()) << end.status().ToString();
+  // Which frame each keyframe is, from the keyframe events.
+  std::map<std::string, std::string> frame_of_keyframe;
+  std::istringstream lines(run.output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("\"event\":\"keyframe\"") == std::string::npos) continue;
+    auto event = ParseJson(line, "a keyframe event");
+    ASSERT_TRUE(event.ok()) << line;
+    const int frame = static_cast<int>(Number(*event, "frame"));
+    ASSERT_TRUE(frame >= 0 && frame < walk.frames) << line;
+    EXPECT_EQ(blurred.count(frame), 0u) << "blurred frame " << frame << " taken as a keyframe";
+    frame_of_keyframe[fs::path(event->Find("path")->string()).filename().string()] = names[static_cast<size_t>(frame)];
+  }
+  const int keyframes = static_cast<int>(frame_of_keyframe.size());
+  ASSERT_GE(keyframes, 5);
+  const ModelScore live = ScoreAgainstTruth(project / "live", *truth, [&](const std::string& name) {
+    const auto it = frame_of_keyframe.find(name);
+    return it == frame_of_keyframe.end() ? std::string() : it->second;
+  });
+
+  // Every k-th frame, k giving as many frames as the capture took keyframes.
+  const int k = std::max(1, static_cast<int>(std::lround(static_cast<double>(walk.frames) / keyframes)));
+  std::vector<std::string> every_kth;
+  for (int i = 0; i < walk.frames && static_cast<int>(every_kth.size()) < keyframes; i += k)
+    every_kth.push_back(names[static_cast<size_t>(i)]);
+  const fs::path kth_dir = testing::LinkFiles((root / "every_kth").string(), video.string(), every_kth);
+  const CommandRun sfm =
+      RunReconar("sfm " + kth_dir.string() + " " + (root / "every_kth_project").string() + " --threads 2");
+  ModelScore kth;
+  if (sfm.exit_code == 0) {
+    kth =
+        ScoreAgainstTruth(root / "every_kth_project" / "sparse", *truth, [](const std::string& name) { return name; });
+  }
+  const double walk_length = walk.step_m * (walk.frames - 1);
+  std::printf(
+      "%d frames, %zu blurred, 15 darker: %d keyframes (passed over: %g judged blurred, %g badly exposed, %g too "
+      "close, %g lost); live model %d of %d registered, centre error mean %.3f %% of the %.2f m walk "
+      "(max %.3f %%), rotation mean %.3f deg\n",
+      walk.frames, blurred.size(), keyframes, Number(*end, "blurred"), Number(*end, "bad_exposure"),
+      Number(*end, "too_close"), Number(*end, "lost"), live.registered, keyframes,
+      100.0 * live.errors.centre_mean / walk_length, walk_length, 100.0 * live.errors.centre_max / walk_length,
+      live.errors.rotation_mean_deg);
+  std::printf(
+      "every %d-th frame (%zu frames, %zu of them blurred): %d registered, centre error mean %.3f %% (max %.3f "
+      "%%), rotation mean %.3f deg%s\n",
+      k, every_kth.size(),
+      static_cast<size_t>(std::count_if(every_kth.begin(), every_kth.end(),
+                                        [&](const std::string& n) {
+                                          return blurred.count(static_cast<int>(
+                                                     std::find(names.begin(), names.end(), n) - names.begin())) > 0;
+                                        })),
+      kth.registered, 100.0 * kth.errors.centre_mean / walk_length, 100.0 * kth.errors.centre_max / walk_length,
+      kth.errors.rotation_mean_deg, sfm.exit_code == 0 ? "" : " (sfm failed)");
+  EXPECT_GE(live.registered, static_cast<int>(std::ceil(0.95 * keyframes)));
+  if (kth.registered == keyframes) EXPECT_LE(live.errors.centre_mean, kth.errors.centre_mean);
   fs::remove_all(root);
 }
 

@@ -14,6 +14,7 @@
 #include "core/io/gray.h"
 #include "core/io/image_io.h"
 #include "tests/support/corridor_walk.h"
+#include "tests/support/frame_effects.h"
 #include "tests/support/run_command.h"
 #include "tests/tracker/rotation_video.h"
 
@@ -38,25 +39,7 @@ std::vector<Image<uint8_t>> Sweep(const testing::RotationScene& scene, int count
   return frames;
 }
 
-// Horizontal motion blur: the mean of `length` pixels along each row.
-Image<uint8_t> MotionBlurred(const Image<uint8_t>& frame, int length) {
-  Image<uint8_t> out(frame.width(), frame.height());
-  for (int y = 0; y < frame.height(); ++y) {
-    for (int x = 0; x < frame.width(); ++x) {
-      int sum = 0;
-      for (int k = 0; k < length; ++k) sum += frame.row(y)[std::clamp(x + k - length / 2, 0, frame.width() - 1)];
-      out.row(y)[x] = static_cast<uint8_t>(sum / length);
-    }
-  }
-  return out;
-}
-
-Image<uint8_t> Darkened(const Image<uint8_t>& frame, double gain) {
-  Image<uint8_t> out(frame.width(), frame.height());
-  for (int y = 0; y < frame.height(); ++y)
-    for (int x = 0; x < frame.width(); ++x) out.row(y)[x] = static_cast<uint8_t>(frame.row(y)[x] * gain);
-  return out;
-}
+using testing::MotionBlurred;
 
 std::vector<GateFrameReport> RunGate(const std::vector<Image<uint8_t>>& frames,
                                      const KeyframeGateOptions& options = KeyframeGateOptions()) {
@@ -186,7 +169,7 @@ TEST(KeyframeGateTest, BlurredFramesAreNeverKeyframes) {
 TEST(KeyframeGateTest, DarkFramesAreNotTakenAndSaySo) {
   const testing::RotationScene scene = Scene();
   std::vector<Image<uint8_t>> frames = Sweep(scene, 40, -8.0, 0.4);
-  for (size_t i = 10; i < 30; ++i) frames[i] = Darkened(frames[i], 0.15);
+  for (size_t i = 10; i < 30; ++i) frames[i] = testing::ExposureScaled(frames[i], 0.15);
   const std::vector<GateFrameReport> reports = RunGate(frames);
   for (size_t i = 10; i < 30; ++i) {
     EXPECT_EQ(reports[i].verdict, GateVerdict::kBadExposure) << i << " mean " << reports[i].mean_level;
