@@ -60,7 +60,8 @@ void PrintEvent(const CaptureEvent& event, bool json) {
     } else {
       out.Key("verdict").String(GateVerdictName(g.verdict)).Key("advice").String(g.advice);
       out.Key("sharpness").Double(g.sharpness).Key("sharpness_threshold").Double(g.sharpness_threshold);
-      out.Key("mean_level").Double(g.mean_level).Key("clipped").Double(g.clipped_fraction);
+      out.Key("mean_level").Double(g.mean_level).Key("dark_level").Double(g.dark_level);
+      out.Key("bright_level").Double(g.bright_level).Key("highlights").Double(g.highlight_fraction);
       out.Key("parallax")
           .Double(g.parallax)
           .Key("overlap")

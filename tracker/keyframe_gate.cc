@@ -1,6 +1,7 @@
 #include "tracker/keyframe_gate.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -11,7 +12,6 @@
 namespace reconar {
 namespace {
 
-constexpr int kShadowLevel = 4;
 constexpr int kHighlightLevel = 251;
 constexpr int kPyramidLevels = 3;
 constexpr float kMaxForwardBackwardPx = 1.0f;  // analysis pixels
@@ -44,10 +44,10 @@ Status KeyframeGateOptions::Check() const {
     return InvalidArgument("KeyframeGateOptions: sharpness_window must be in [1, 64]");
   if (min_history < 1 || min_history > sharpness_window)
     return InvalidArgument("KeyframeGateOptions: min_history must be in [1, sharpness_window]");
-  if (!(max_clipped_fraction > 0.0 && max_clipped_fraction <= 1.0))
-    return InvalidArgument("KeyframeGateOptions: max_clipped_fraction must be in (0, 1]");
-  if (!(min_mean_level >= 0.0 && max_mean_level > min_mean_level && max_mean_level <= 255.0))
-    return InvalidArgument("KeyframeGateOptions: need 0 <= min_mean_level < max_mean_level <= 255");
+  if (!(max_highlight_fraction > 0.0 && max_highlight_fraction <= 1.0))
+    return InvalidArgument("KeyframeGateOptions: max_highlight_fraction must be in (0, 1]");
+  if (!(min_bright_level >= 0.0 && max_dark_level <= 255.0))
+    return InvalidArgument("KeyframeGateOptions: need min_bright_level >= 0 and max_dark_level <= 255");
   if (!(keyframe_parallax > 0.0)) return InvalidArgument("KeyframeGateOptions: keyframe_parallax <= 0");
   if (!(lost_overlap >= 0.0 && keyframe_overlap > lost_overlap && keyframe_overlap <= 1.0))
     return InvalidArgument("KeyframeGateOptions: need 0 <= lost_overlap < keyframe_overlap <= 1");
@@ -90,17 +90,28 @@ void KeyframeGate::Downscale(ImageView<const uint8_t> gray) {
 // other row (the box filter would take away the finest detail that blur removes first).
 void KeyframeGate::MeasureImage(ImageView<const uint8_t> gray, GateFrameReport* report) const {
   const int w = small_.width(), h = small_.height();
-  long long clipped = 0, level_sum = 0;
+  std::array<int, 256> histogram{};
+  long long level_sum = 0;
   for (int y = 0; y < h; ++y) {
     const uint8_t* row = small_.row(y);
     for (int x = 0; x < w; ++x) {
       level_sum += row[x];
-      clipped += (row[x] <= kShadowLevel || row[x] >= kHighlightLevel) ? 1 : 0;
+      ++histogram[row[x]];
     }
   }
-  const double pixels = static_cast<double>(w) * h;
-  report->mean_level = static_cast<double>(level_sum) / pixels;
-  report->clipped_fraction = static_cast<double>(clipped) / pixels;
+  const long long pixels = static_cast<long long>(w) * h;
+  report->mean_level = static_cast<double>(level_sum) / static_cast<double>(pixels);
+  long long below = 0, highlights = 0;
+  int dark = -1, bright = -1;
+  for (int level = 0; level < 256; ++level) {
+    below += histogram[static_cast<size_t>(level)];
+    if (dark < 0 && 20 * below > pixels) dark = level;
+    if (bright < 0 && 20 * below >= 19 * pixels) bright = level;
+    if (level >= kHighlightLevel) highlights += histogram[static_cast<size_t>(level)];
+  }
+  report->dark_level = dark;
+  report->bright_level = bright;
+  report->highlight_fraction = static_cast<double>(highlights) / static_cast<double>(pixels);
   long long laplacian_sum = 0, laplacian_squares = 0, count = 0;
   for (int y = 1; y + 1 < gray.height; y += 2) {
     const uint8_t* up = gray.row(y - 1);
@@ -306,16 +317,15 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
   MeasureImage(gray, report);
   if (have_keyframe_) RECONAR_RETURN_IF_ERROR(FollowCorners(report));
 
-  const bool exposed = report->clipped_fraction <= options_.max_clipped_fraction &&
-                       report->mean_level >= options_.min_mean_level && report->mean_level <= options_.max_mean_level;
+  const bool too_dark = report->bright_level < options_.min_bright_level;
+  const bool too_bright = report->dark_level > options_.max_dark_level;
+  const bool exposed = !too_dark && !too_bright && report->highlight_fraction <= options_.max_highlight_fraction;
   report->sharpness_threshold = options_.sharpness_ratio * SharpnessReference();
   if (exposed) RememberSharpness(report->sharpness);
   const bool fast = report->frame_motion > options_.max_frame_motion;
   if (!exposed) {
     report->verdict = GateVerdict::kBadExposure;
-    report->advice = report->mean_level < options_.min_mean_level   ? "too dark"
-                     : report->mean_level > options_.max_mean_level ? "too bright"
-                                                                    : "light too harsh: clipped shadows or highlights";
+    report->advice = too_dark ? "too dark" : too_bright ? "too bright" : "light too harsh: highlights burnt out";
   } else if (report->sharpness < report->sharpness_threshold) {
     report->verdict = GateVerdict::kBlurred;
     report->advice = fast ? "too fast" : "hold steady: blurred";

@@ -8,7 +8,7 @@
 //    against the median of the recent frames'
 //    (the scene sets the scale: a leafy facade and a white wall differ a hundredfold), so a frame
 //    blurred by motion falls out while the scene's own level is accepted;
-//  - exposure: the share of clipped shadows and highlights, and the mean level;
+//  - exposure: the darkest and brightest 5 % of the levels, and the share of burnt-out highlights;
 //  - motion against the last keyframe: corners found in the keyframe (one per grid cell, the
 //    strongest Shi-Tomasi response) followed frame to frame by pyramidal Lucas-Kanade, each kept
 //    only when the flow back from the new frame returns it within a pixel (Kalal, Mikolajczyk &
@@ -40,10 +40,13 @@ struct KeyframeGateOptions {
   double sharpness_ratio = 0.6;
   int sharpness_window = 31;
   int min_history = 5;
-  // Exposure: pixels at or below 4 / at or above 251 grey levels are clipped.
-  double max_clipped_fraction = 0.25;
-  double min_mean_level = 35.0;   // darker on average: "too dark"
-  double max_mean_level = 225.0;  // brighter: "too bright"
+  // Exposure, from the analysis image's histogram. Too dark when even its brightest 5 % are under
+  // min_bright_level; too bright when even its darkest 5 % are over max_dark_level; highlights
+  // burnt out (at or above 251) over more than max_highlight_fraction of it. A black or white
+  // background around a well-exposed object passes (docs/capture.md).
+  double min_bright_level = 60.0;
+  double max_dark_level = 195.0;
+  double max_highlight_fraction = 0.25;
   // Motion, as fractions of the analysis width.
   double keyframe_parallax = 0.02;       // a keyframe once the parallax since the last one reaches this ...
   double keyframe_overlap = 0.6;         // ... or fewer than this share of its corners are still followed
@@ -58,7 +61,7 @@ struct KeyframeGateOptions {
 enum class GateVerdict : uint8_t {
   kKeyframe,     // taken
   kBlurred,      // sharpness under the threshold
-  kBadExposure,  // clipped or too dark / too bright
+  kBadExposure,  // too dark, too bright, or highlights burnt out
   kTooClose,     // sharp and exposed, but not far enough from the last keyframe
   kLost,         // too little overlap with the last keyframe
 };
@@ -69,8 +72,10 @@ struct GateFrameReport {
   const char* advice = "";           // plain words for the person: "too fast", "too dark", "move sideways", ...
   double sharpness = 0.0;            // variance of the Laplacian (grey levels^2)
   double sharpness_threshold = 0.0;  // what this frame had to reach
-  double clipped_fraction = 0.0;
   double mean_level = 0.0;
+  double dark_level = 0.0;          // the 5th percentile of the grey levels
+  double bright_level = 0.0;        // the 95th percentile
+  double highlight_fraction = 0.0;  // share at or above 251
   double motion = 0.0;        // median displacement since the last keyframe / analysis width
   double parallax = 0.0;      // median distance from the keyframe's homography / analysis width
   double frame_motion = 0.0;  // median displacement since the previous frame / analysis width

@@ -177,6 +177,38 @@ TEST(KeyframeGateTest, DarkFramesAreNotTakenAndSaySo) {
   }
 }
 
+TEST(KeyframeGateTest, BurntOutFramesAreNotTaken) {
+  const testing::RotationScene scene = Scene();
+  std::vector<Image<uint8_t>> frames = Sweep(scene, 30, -6.0, 0.4);
+  for (size_t i = 10; i < 20; ++i) frames[i] = testing::ExposureScaled(frames[i], 4.0);
+  const std::vector<GateFrameReport> reports = RunGate(frames);
+  for (size_t i = 10; i < 20; ++i) {
+    EXPECT_EQ(reports[i].verdict, GateVerdict::kBadExposure)
+        << i << " dark level " << reports[i].dark_level << " highlights " << reports[i].highlight_fraction;
+  }
+}
+
+// A plaster figure on black velvet, lit (Middlebury's templeRing, real photos): half the frame is
+// black, yet the object is well exposed and the frames are usable.
+TEST(KeyframeGateTest, AnObjectOnABlackBackgroundIsWellExposed) {
+  KeyframeGate gate;
+  int judged = 0;
+  for (int k = 1; k <= 8; ++k) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "/middlebury_templeRing/templeR%04d.png", k);
+    auto photo = ReadImage(std::string(RECONAR_SHARED_DATA_DIR) + name);
+    ASSERT_TRUE(photo.ok()) << photo.status().ToString();
+    const Image<uint8_t> gray = ToGray8(photo->rgb);
+    GateFrameReport report;
+    ASSERT_TRUE(gate.Process(gray.view(), &report).ok());
+    EXPECT_NE(report.verdict, GateVerdict::kBadExposure)
+        << name << ": mean " << report.mean_level << ", 5th / 95th percentile " << report.dark_level << " / "
+        << report.bright_level;
+    ++judged;
+  }
+  EXPECT_EQ(judged, 8);
+}
+
 // A jump away loses the keyframe; coming back finds its corners again without a new keyframe.
 TEST(KeyframeGateTest, LostAfterAJumpAndFoundAgainOnComingBack) {
   const testing::RotationScene scene = Scene(2);
