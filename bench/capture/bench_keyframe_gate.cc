@@ -5,17 +5,23 @@
 // mean and clipped share, goodFeaturesToTrack on keyframes, calcOpticalFlowPyrLK forward and back
 // (window 11, 3 levels, as ours), findHomography (RANSAC, 1 px) from the keyframe's corners and the
 // median distance from it (the parallax). Reported as ratios: these machines are noisy.
+// Then the gate again with a capture's live model working in the same process (its worker thread
+// extracting, matching and registering the AR video's frames as keyframes, as `reconar capture`
+// runs it), against the gate alone in the same run.
 //   bench_keyframe_gate [repeats=5]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "bench/common/bench_images.h"
 #include "core/io/image_io.h"
+#include "core/pipeline/live_reconstruction.h"
 #include "tests/support/ar_video.h"
 #include "tests/tracker/rotation_video.h"
 #include "tracker/keyframe_gate.h"
@@ -140,6 +146,7 @@ void Measure(const char* name, const std::vector<Image<uint8_t>>& frames, int re
 int main(int argc, char** argv) {
   const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
   const std::string photo = std::string(RECONAR_SHARED_DATA_DIR) + "/strecha_fountain-P11/images/0005.jpg";
+  std::vector<std::vector<Image<uint8_t>>> sweeps;
   for (const auto& [width, height] : {std::pair<int, int>{640, 480}, std::pair<int, int>{1280, 720}}) {
     auto scene = reconar::testing::MakeRotationScene(photo, 1280 / width, width, height);
     if (!scene.ok()) {
@@ -153,6 +160,7 @@ int main(int argc, char** argv) {
     }
     const std::string name = "rotating sweep " + std::to_string(width) + "x" + std::to_string(height);
     Measure(name.c_str(), frames, repeats);
+    sweeps.push_back(std::move(frames));
   }
   std::vector<Image<uint8_t>> video;
   for (const reconar::testing::ArVideoFrame& frame : reconar::testing::ReadArVideoFrames()) {
@@ -164,5 +172,28 @@ int main(int argc, char** argv) {
     video.push_back(reconar::ToGray8(decoded->rgb));
   }
   Measure("AR video 640x480 (real frames)", video, repeats);
+
+  // The gate alone, then beside the live model's worker, alternating.
+  const std::filesystem::path project = std::filesystem::temp_directory_path() / "bench_keyframe_gate_live";
+  std::filesystem::remove_all(project);
+  const std::vector<reconar::testing::ArVideoFrame> frames = reconar::testing::ReadArVideoFrames();
+  for (const auto& sweep : {std::make_pair(&sweeps[0], "rotating sweep 640x480"),
+                            std::make_pair(&sweeps[1], "rotating sweep 1280x720")}) {
+    std::vector<double> alone, beside;
+    int busy = 0;
+    for (int r = 0; r < repeats; ++r) {
+      alone.push_back(RunOurs(*sweep.first).median_ms);
+      reconar::LiveReconstruction live(reconar::Project(project.string()), reconar::LiveReconstructionOptions());
+      for (size_t k = 0; k < frames.size(); k += 2)
+        live.AddKeyframe(reconar::testing::ArVideoDir() + "/frames/" + frames[k].name);
+      beside.push_back(RunOurs(*sweep.first).median_ms);
+      busy += live.NumProcessed() < live.NumKeyframes();  // still working when the gate ended
+    }
+    std::printf("%-34s %3zu frames  reconar %.2f ms/frame alone, %.2f ms/frame beside the live model's worker "
+                "(busy throughout in %d of %d runs), ratio %.2f\n",
+                sweep.second, sweep.first->size(), reconar::bench::Median(alone), reconar::bench::Median(beside), busy,
+                repeats, reconar::bench::Median(beside) / reconar::bench::Median(alone));
+  }
+  std::filesystem::remove_all(project);
   return 0;
 }

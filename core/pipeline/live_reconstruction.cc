@@ -76,6 +76,11 @@ int LiveReconstruction::NumKeyframes() const {
   return static_cast<int>(queued_.size());
 }
 
+int LiveReconstruction::NumProcessed() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<int>(done_);
+}
+
 int LiveReconstruction::NumRegistered() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return registered_now_;

@@ -69,8 +69,9 @@ class LiveReconstruction {
   void AddKeyframe(const std::string& path);
   // Indices (in AddKeyframe order) of the keyframes registered since the last call.
   std::vector<int> TakeNewlyRegistered();
-  // Keyframes queued, and how many of them are in the model now.
+  // Keyframes queued, finished by the worker, and in the model now.
   int NumKeyframes() const;
+  int NumProcessed() const;  // taken by the worker and finished
   int NumRegistered() const;
 
   // Waits for the queue to drain, writes the outputs above; errors name the file.

@@ -453,7 +453,10 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
       kth.registered, 100.0 * kth.errors.centre_mean / walk_length, 100.0 * kth.errors.centre_max / walk_length,
       kth.errors.rotation_mean_deg, sfm.exit_code == 0 ? "" : " (sfm failed)");
   EXPECT_GE(live.registered, static_cast<int>(std::ceil(0.95 * keyframes)));
-  if (kth.registered == keyframes) EXPECT_LE(live.errors.centre_mean, kth.errors.centre_mean);
+  // Compared only when every k-th frame registered all its frames (else the capture is better already).
+  if (kth.registered == static_cast<int>(every_kth.size())) {
+    EXPECT_LE(live.errors.centre_mean, kth.errors.centre_mean);
+  }
   fs::remove_all(root);
 }
 
