@@ -35,6 +35,10 @@ constexpr char kHelp[] =
     "                        keyframe's features and matches are computed as it is taken and it is\n"
     "                        registered into PROJECT_DIR/live/; `reconstruct` reuses that work)\n"
     "  --realtime            replay a folder or recording at the pace of its timestamps\n"
+    "  --out-preview DIR     the view with the gate's verdict (border: green keyframe, blue keep\n"
+    "                        moving, red refused), the keyframes (green once registered) and the\n"
+    "                        coverage ring (directions the object has been seen from), as\n"
+    "                        DIR/preview_FFFFFF.png each keyframe and second, and DIR/latest.png\n"
     "  --reconstruct         then run `reconar reconstruct PROJECT_DIR/images PROJECT_DIR`\n"
     "  --tag-size M --tag-family F  passed on to `reconstruct` (metres, tag36h11 by default)\n"
     "  --json                one JSON object per event on stdout (status, keyframe, warning, end)\n";
@@ -92,7 +96,7 @@ void PrintEvent(const CaptureEvent& event, bool json) {
 }  // namespace
 
 int RunCapture(int argc, char** argv, int first) {
-  Args args({"intrinsics", "max-keyframes", "width", "height", "tag-size", "tag-family"},
+  Args args({"intrinsics", "max-keyframes", "width", "height", "tag-size", "tag-family", "out-preview"},
             {"json", "reconstruct", "no-live", "realtime"});
   if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
   CaptureOptions options;
@@ -114,6 +118,7 @@ int RunCapture(int argc, char** argv, int first) {
   }
   options.reconstruct_live = !args.Has("no-live");
   options.replay_in_real_time = args.Has("realtime");
+  if (args.Has("out-preview")) options.preview_dir = args.Get("out-preview");
   const bool json = args.Has("json");
   std::signal(SIGINT, OnInterrupt);
   auto report = reconar::RunCapture(

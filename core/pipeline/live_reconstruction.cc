@@ -18,6 +18,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+constexpr int kCoverageSectors = 12;
+
 double SecondsBetween(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
 }
@@ -31,6 +33,42 @@ double Percentile(std::vector<double> values, double fraction) {
 }
 
 }  // namespace
+
+std::vector<bool> ViewCoverage(const Reconstruction& model, int sectors) {
+  std::vector<bool> covered(static_cast<size_t>(std::max(sectors, 0)), false);
+  std::vector<double> xs, ys, zs;
+  for (const SfmPoint& point : model.points) {
+    if (point.deleted) continue;
+    xs.push_back(point.position.x());
+    ys.push_back(point.position.y());
+    zs.push_back(point.position.z());
+  }
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> centres;
+  for (const SfmImage& image : model.images) {
+    if (!image.registered) continue;
+    up += image.cam_from_world.rotation.transpose() * Eigen::Vector3d(0.0, -1.0, 0.0);
+    centres.push_back(image.Center());
+  }
+  if (sectors <= 0 || xs.empty() || centres.size() < 2 || up.norm() < 1e-9) return covered;
+  up.normalize();
+  const Eigen::Vector3d object(Median(xs), Median(ys), Median(zs));
+  // Azimuths in the plane across `up`, from the first camera's direction.
+  Eigen::Vector3d axis_x = centres[0] - object;
+  axis_x -= axis_x.dot(up) * up;
+  if (axis_x.norm() < 1e-12) axis_x = up.unitOrthogonal();
+  axis_x.normalize();
+  const Eigen::Vector3d axis_y = up.cross(axis_x);
+  constexpr double kTwoPi = 6.283185307179586;
+  for (const Eigen::Vector3d& centre : centres) {
+    const Eigen::Vector3d d = centre - object;
+    double azimuth = std::atan2(d.dot(axis_y), d.dot(axis_x));
+    if (azimuth < 0.0) azimuth += kTwoPi;
+    const int sector = std::min(sectors - 1, static_cast<int>(azimuth / kTwoPi * sectors));
+    covered[static_cast<size_t>(sector)] = true;
+  }
+  return covered;
+}
 
 LiveReconstructionOptions::LiveReconstructionOptions() {
   const ReconstructOptions reconstruct;
@@ -74,6 +112,11 @@ std::vector<int> LiveReconstruction::TakeNewlyRegistered() {
 int LiveReconstruction::NumKeyframes() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return static_cast<int>(queued_.size());
+}
+
+std::vector<bool> LiveReconstruction::Coverage() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return coverage_;
 }
 
 int LiveReconstruction::NumProcessed() const {
@@ -179,8 +222,10 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   model_ = std::move(grown).value();
   has_model_ = true;
   const double now = SecondsBetween(start_, Clock::now());
+  std::vector<bool> coverage = ViewCoverage(model_, kCoverageSectors);
   std::lock_guard<std::mutex> lock(mutex_);
   registered_now_ = model_.NumRegisteredImages();
+  coverage_ = std::move(coverage);
   for (size_t i = 0; i < model_.images.size(); ++i) {
     LiveKeyframe& keyframe = queued_[keyframe_of_image_[i]];
     if (model_.images[i].registered && keyframe.registered_seconds < 0.0) {

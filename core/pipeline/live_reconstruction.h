@@ -58,6 +58,12 @@ struct LiveReconstructionReport {
   std::string error;  // a failure that stopped the worker (the keyframes stay on disk)
 };
 
+// The directions from which a model's object has been seen, for the capture's coverage indicator:
+// `sectors` equal sectors of azimuth about the vertical through the points' median (vertical: the
+// registered cameras' mean up direction), sector 0 starting at the first registered camera; true
+// where a registered camera stands. All false for a model of fewer than two cameras or no points.
+std::vector<bool> ViewCoverage(const Reconstruction& model, int sectors);
+
 class LiveReconstruction {
  public:
   LiveReconstruction(const Project& project, const LiveReconstructionOptions& options);
@@ -67,6 +73,8 @@ class LiveReconstruction {
 
   // Queues a keyframe written whole at `path`; returns at once.
   void AddKeyframe(const std::string& path);
+  // ViewCoverage of the model as it is now (12 sectors).
+  std::vector<bool> Coverage() const;
   // Indices (in AddKeyframe order) of the keyframes registered since the last call.
   std::vector<int> TakeNewlyRegistered();
   // Keyframes queued, finished by the worker, and in the model now.
@@ -93,6 +101,7 @@ class LiveReconstruction {
   bool finishing_ = false;             // guarded by mutex_: leave once the queue is empty
   std::vector<int> newly_registered_;  // guarded by mutex_
   int registered_now_ = 0;             // guarded by mutex_
+  std::vector<bool> coverage_;         // guarded by mutex_
   Status worker_error_;                // guarded by mutex_
 
   // The worker's own state.

@@ -12,6 +12,7 @@
 #include "core/io/exif.h"
 #include "core/io/focal_prior.h"
 #include "core/io/image_write.h"
+#include "render/ar/capture_preview.h"
 
 namespace reconar {
 namespace {
@@ -83,10 +84,12 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
 
   std::unique_ptr<LiveReconstruction> live;
   std::vector<std::string> live_paths;  // in the order given to `live`
+  std::vector<bool> keyframe_registered;  // in the same order
   if (options.reconstruct_live) live = std::make_unique<LiveReconstruction>(Project(options.project_dir), options.live);
   const auto emit_registered = [&](int64_t frame_index, double video_seconds) {
     if (!live) return;
     for (const int k : live->TakeNewlyRegistered()) {
+      keyframe_registered[static_cast<size_t>(k)] = true;
       CaptureEvent event;
       event.kind = CaptureEvent::Kind::kRegistered;
       event.frame_index = frame_index;
@@ -97,6 +100,37 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     }
   };
   const auto replay_start = std::chrono::steady_clock::now();
+  if (!options.preview_dir.empty()) {
+    fs::create_directories(options.preview_dir, error);
+    if (error) return IoError(options.preview_dir + ": cannot create the directory: " + error.message());
+  }
+  Image<uint8_t> last_view, preview;  // the last frame previewed, and with the overlay drawn
+  GateVerdict last_verdict = GateVerdict::kTooClose;
+  // The overlay on the last frame previewed, as `name` and as latest.png.
+  const auto draw_preview = [&](const char* name) -> Status {
+    preview = last_view;
+    CapturePreviewState state;
+    state.verdict = last_verdict;
+    state.keyframe_registered = keyframe_registered;
+    if (live) state.coverage = live->Coverage();
+    DrawCapturePreview(state, &preview);
+    if (name != nullptr)
+      RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options.preview_dir) / name).string(), preview.view(), 3));
+    RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options.preview_dir) / "latest.png").string(), preview.view(), 3));
+    ++report.previews;
+    return Status::Ok();
+  };
+  const auto write_preview = [&](const Frame& frame, GateVerdict verdict) -> Status {
+    if (options.preview_dir.empty() || frame.rgb.data == nullptr) return Status::Ok();
+    if (last_view.width() != frame.width || last_view.height() != frame.height)
+      last_view = Image<uint8_t>(frame.width, frame.height, 3);
+    for (int y = 0; y < frame.height; ++y)
+      std::copy(frame.rgb.row(y), frame.rgb.row(y) + 3 * frame.width, last_view.row(y));
+    last_verdict = verdict;
+    char name[40];
+    std::snprintf(name, sizeof(name), "preview_%06lld.png", static_cast<long long>(frame.index));
+    return draw_preview(name);
+  };
 
   KeyframeGate gate(options.gate);
   std::vector<double> gate_ms;
@@ -184,7 +218,9 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
         live->AddKeyframe(path);
         live_paths.push_back(path);
       }
+      keyframe_registered.push_back(false);
       emit(event);
+      RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate.verdict));
       if (options.max_keyframes > 0 && ordinal >= options.max_keyframes) {
         report.stop_reason = "--max-keyframes reached";
         break;
@@ -196,6 +232,7 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
       last_status_second = second;
       event.kind = CaptureEvent::Kind::kStatus;
       emit(event);
+      RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate.verdict));
     }
   }
   report.median_gate_ms = Median(gate_ms);
@@ -205,6 +242,8 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     report.live = true;
     emit_registered(-1, -1.0);
   }
+  // latest.png once more, with every registration the live model made.
+  if (!options.preview_dir.empty() && last_view.width() > 0) RECONAR_RETURN_IF_ERROR(draw_preview(nullptr));
   return report;
 }
 

@@ -38,6 +38,9 @@ struct CaptureOptions {
   // A folder or recording replayed at the pace of its timestamps, as a camera would deliver it
   // (for measuring the live model's latency); false: as fast as the gate goes.
   bool replay_in_real_time = false;
+  // Not empty: a preview (capture_preview.h) of each keyframe and of one frame per second of video,
+  // written there as preview_FFFFFF.png (F the frame index) and latest.png.
+  std::string preview_dir;
 
   Status Check() const;
 };
@@ -65,6 +68,7 @@ struct CaptureReport {
   std::string stop_reason;     // "end of the recording", "--max-keyframes reached", "stopped", or the source's error
   bool source_failed = false;  // the source ended with an error (a camera that disconnected)
   std::vector<std::string> keyframe_files;
+  int previews = 0;   // pictures written to CaptureOptions::preview_dir
   bool live = false;  // CaptureOptions::reconstruct_live: `live_model` holds the live model's report
   LiveReconstructionReport live_model;
 };

@@ -199,10 +199,11 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
   const fs::path root = testing::MakeTestDirectory("capture_live");
   const fs::path project = root / "project";
   const CameraIntrinsics k = testing::ArVideoCamera();
-  const CommandRun run = RunReconar("capture " + Frames() + " " + project.string() +
-                                        " --json --realtime --intrinsics " + std::to_string(k.fx) + "," +
-                                        std::to_string(k.fy) + "," + std::to_string(k.cx) + "," + std::to_string(k.cy),
-                                    testing::StderrMode::kSeparate);
+  const CommandRun run =
+      RunReconar("capture " + Frames() + " " + project.string() + " --out-preview " + (root / "preview").string() +
+                     " --json --realtime --intrinsics " + std::to_string(k.fx) + "," + std::to_string(k.fy) + "," +
+                     std::to_string(k.cx) + "," + std::to_string(k.cy),
+                 testing::StderrMode::kSeparate);
   ASSERT_EQ(run.exit_code, 0) << run.output << run.error;
   auto end = EndEvent(run.output);
   ASSERT_TRUE(end.ok()) << end.status().ToString();
@@ -223,6 +224,17 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
   EXPECT_EQ(static_cast<double>(registered_events), keyframes);
   EXPECT_TRUE(fs::exists(project / "live" / "points3D.txt"));
   EXPECT_TRUE(fs::exists(project / "live" / "report.json"));
+  // The preview after the end: every keyframe's square green (registered), bottom left, 8 px apart.
+  auto latest = ReadImage((root / "preview" / "latest.png").string());
+  ASSERT_TRUE(latest.ok()) << latest.status().ToString();
+  ASSERT_EQ(latest->rgb.width(), 640);
+  for (int k = 0; k < static_cast<int>(keyframes); ++k) {
+    const uint8_t* pixel = latest->rgb.row(480 - 4 * 8 + 3) + 3 * (2 * 8 + k * 16 + 3);
+    EXPECT_GT(pixel[1], 150) << "keyframe " << k;
+    EXPECT_LT(pixel[0], 100) << "keyframe " << k;
+  }
+  EXPECT_GE(std::distance(fs::directory_iterator(root / "preview"), fs::directory_iterator()),
+            static_cast<std::ptrdiff_t>(keyframes) + 1);
 
   const CommandRun sfm = RunReconar("sfm " + (project / "images").string() + " " + project.string() +
                                     " --threads 2 --tag-size " + std::to_string(testing::kArVideoTagSize));

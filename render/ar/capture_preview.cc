@@ -1,0 +1,73 @@
+#include "render/ar/capture_preview.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace reconar {
+namespace {
+
+using Colour = std::array<uint8_t, 3>;
+
+constexpr Colour kGreen = {40, 200, 60};
+constexpr Colour kBlue = {60, 140, 255};
+constexpr Colour kRed = {230, 40, 40};
+constexpr Colour kGrey = {170, 170, 170};
+constexpr Colour kDark = {50, 50, 50};
+
+// `alpha` of `colour` over the pixel.
+void Blend(Image<uint8_t>* rgb, int x, int y, const Colour& colour, double alpha) {
+  if (x < 0 || y < 0 || x >= rgb->width() || y >= rgb->height()) return;
+  uint8_t* pixel = rgb->row(y) + 3 * x;
+  for (int c = 0; c < 3; ++c)
+    pixel[c] = static_cast<uint8_t>(std::lround((1.0 - alpha) * pixel[c] + alpha * colour[static_cast<size_t>(c)]));
+}
+
+void FillRect(Image<uint8_t>* rgb, int x0, int y0, int x1, int y1, const Colour& colour, double alpha) {
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) Blend(rgb, x, y, colour, alpha);
+}
+
+}  // namespace
+
+void DrawCapturePreview(const CapturePreviewState& state, Image<uint8_t>* rgb) {
+  const int w = rgb->width(), h = rgb->height();
+  const int unit = std::max(2, std::min(w, h) / 60);  // 8 px at 480 lines
+
+  const Colour border = state.verdict == GateVerdict::kKeyframe   ? kGreen
+                        : state.verdict == GateVerdict::kTooClose ? kBlue
+                                                                  : kRed;
+  FillRect(rgb, 0, 0, w, unit, border, 1.0);
+  FillRect(rgb, 0, h - unit, w, h, border, 1.0);
+  FillRect(rgb, 0, unit, unit, h - unit, border, 1.0);
+  FillRect(rgb, w - unit, unit, w, h - unit, border, 1.0);
+
+  // Keyframes: squares along the bottom, as many as fit.
+  const int step = 2 * unit;
+  const int y0 = h - 4 * unit, y1 = y0 + step - unit / 2;
+  for (size_t k = 0; k < state.keyframe_registered.size(); ++k) {
+    const int x0 = 2 * unit + static_cast<int>(k) * step;
+    if (x0 + step > w - 2 * unit) break;
+    FillRect(rgb, x0, y0, x0 + step - unit / 2, y1, state.keyframe_registered[k] ? kGreen : kGrey, 0.9);
+  }
+
+  // Coverage ring, counter-clockwise from the right as ViewCoverage's azimuths.
+  if (state.coverage.empty()) return;
+  const double outer = 6.0 * unit, inner = 3.5 * unit;
+  const double cx = w - 2 * unit - outer, cy = 2 * unit + outer;
+  constexpr double kTwoPi = 6.283185307179586;
+  const int sectors = static_cast<int>(state.coverage.size());
+  for (int y = static_cast<int>(cy - outer); y <= static_cast<int>(cy + outer); ++y) {
+    for (int x = static_cast<int>(cx - outer); x <= static_cast<int>(cx + outer); ++x) {
+      const double dx = x - cx, dy = cy - y;  // image y points down
+      const double r = std::hypot(dx, dy);
+      if (r < inner || r > outer) continue;
+      double azimuth = std::atan2(dy, dx);
+      if (azimuth < 0.0) azimuth += kTwoPi;
+      const int sector = std::min(sectors - 1, static_cast<int>(azimuth / kTwoPi * sectors));
+      Blend(rgb, x, y, state.coverage[static_cast<size_t>(sector)] ? kGreen : kDark, 0.8);
+    }
+  }
+}
+
+}  // namespace reconar

@@ -1,0 +1,27 @@
+#pragma once
+// The capture's preview (`reconar capture --out-preview DIR`): the live frame with what the person
+// holding the camera should see at a glance, drawn on the CPU (no display needed):
+//  - a border in the gate's verdict: green a keyframe, blue keep moving (too close), red a frame
+//    the gate refused (blurred, badly exposed, lost);
+//  - along the bottom, one square per keyframe: green once registered in the live model, grey
+//    until then;
+//  - top right, the coverage ring: the directions from which the live model has seen the object
+//    (ViewCoverage), green where a registered keyframe stands, dark where none does yet.
+// The words (advice, counts) are on the status line; the picture needs none.
+#include <vector>
+
+#include "core/base/image.h"
+#include "tracker/keyframe_gate.h"
+
+namespace reconar {
+
+struct CapturePreviewState {
+  GateVerdict verdict = GateVerdict::kTooClose;
+  std::vector<bool> keyframe_registered;  // one per keyframe taken, in order
+  std::vector<bool> coverage;             // sectors, counter-clockwise from the right
+};
+
+// Draws onto `rgb` (3 channels, interleaved) in place.
+void DrawCapturePreview(const CapturePreviewState& state, Image<uint8_t>* rgb);
+
+}  // namespace reconar
