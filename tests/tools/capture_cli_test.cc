@@ -379,7 +379,8 @@ ModelScore ScoreAgainstTruth(const fs::path& model_dir, const testing::GroundTru
 // panels are pictures, the camera sways, bobs and turns as a walker's does), with a 9-pixel motion
 // blur on every seventh frame and a darker stretch (the exposure at 60 %). The blurred frames are
 // never keyframes; the keyframes register in the live model (at least 95 %), whose cameras are as
-// close to the truth as those of `sfm` on every k-th frame, k giving as many frames.
+// close to the truth as those of `sfm` on every k-th frame, k giving as many frames, and as those
+// of `sfm` run afterwards on the same keyframes.
 TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
   const fs::path root = testing::MakeTestDirectory("capture_hand_held");
   const fs::path video = root / "video";
@@ -431,6 +432,15 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
     return it == frame_of_keyframe.end() ? std::string() : it->second;
   });
 
+  // `sfm` run offline on the same keyframes (reusing the capture's features and matches).
+  const CommandRun offline_run =
+      RunReconar("sfm " + (project / "images").string() + " " + project.string() + " --threads 2");
+  ASSERT_EQ(offline_run.exit_code, 0) << offline_run.output;
+  const ModelScore offline = ScoreAgainstTruth(project / "sparse", *truth, [&](const std::string& name) {
+    const auto it = frame_of_keyframe.find(name);
+    return it == frame_of_keyframe.end() ? std::string() : it->second;
+  });
+
   // Every k-th frame, k giving as many frames as the capture took keyframes.
   const int k = std::max(1, static_cast<int>(std::lround(static_cast<double>(walk.frames) / keyframes)));
   std::vector<std::string> every_kth;
@@ -464,7 +474,15 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
                                         })),
       kth.registered, 100.0 * kth.errors.centre_mean / walk_length, 100.0 * kth.errors.centre_max / walk_length,
       kth.errors.rotation_mean_deg, sfm.exit_code == 0 ? "" : " (sfm failed)");
+  std::printf(
+      "offline sfm on the keyframes: %d registered, centre error mean %.3f %% (max %.3f %%), rotation mean "
+      "%.3f deg\n",
+      offline.registered, 100.0 * offline.errors.centre_mean / walk_length,
+      100.0 * offline.errors.centre_max / walk_length, offline.errors.rotation_mean_deg);
   EXPECT_GE(live.registered, static_cast<int>(std::ceil(0.95 * keyframes)));
+  // The live model, grown one keyframe at a time, is as good as the offline one (within half again).
+  EXPECT_GE(live.registered, offline.registered);
+  EXPECT_LE(live.errors.centre_mean, 1.5 * offline.errors.centre_mean);
   // Compared only when every k-th frame registered all its frames (else the capture is better already).
   if (kth.registered == static_cast<int>(every_kth.size())) {
     EXPECT_LE(live.errors.centre_mean, kth.errors.centre_mean);
