@@ -37,7 +37,8 @@ constexpr char kHelp[] =
     "  --realtime            replay a folder or recording at the pace of its timestamps\n"
     "  --out-preview DIR     the view with the gate's verdict (border: green keyframe, blue keep\n"
     "                        moving, red refused), the keyframes (green once registered) and the\n"
-    "                        coverage ring (directions the object has been seen from), as\n"
+    "                        coverage ring (directions the object has been seen from) and the\n"
+    "                        tags in view (--tag-family, tag36h11 by default), as\n"
     "                        DIR/preview_FFFFFF.png each keyframe and second, and DIR/latest.png\n"
     "  --reconstruct         then run `reconar reconstruct PROJECT_DIR/images PROJECT_DIR`\n"
     "  --tag-size M --tag-family F  passed on to `reconstruct` (metres, tag36h11 by default)\n"
@@ -119,6 +120,7 @@ int RunCapture(int argc, char** argv, int first) {
   options.reconstruct_live = !args.Has("no-live");
   options.replay_in_real_time = args.Has("realtime");
   if (args.Has("out-preview")) options.preview_dir = args.Get("out-preview");
+  if (args.Has("tag-family")) options.preview_tag_family = args.Get("tag-family");
   const bool json = args.Has("json");
   std::signal(SIGINT, OnInterrupt);
   auto report = reconar::RunCapture(

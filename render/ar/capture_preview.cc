@@ -14,6 +14,7 @@ constexpr Colour kBlue = {60, 140, 255};
 constexpr Colour kRed = {230, 40, 40};
 constexpr Colour kGrey = {170, 170, 170};
 constexpr Colour kDark = {50, 50, 50};
+constexpr Colour kYellow = {255, 220, 0};
 
 // `alpha` of `colour` over the pixel.
 void Blend(Image<uint8_t>* rgb, int x, int y, const Colour& colour, double alpha) {
@@ -26,6 +27,18 @@ void Blend(Image<uint8_t>* rgb, int x, int y, const Colour& colour, double alpha
 void FillRect(Image<uint8_t>* rgb, int x0, int y0, int x1, int y1, const Colour& colour, double alpha) {
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) Blend(rgb, x, y, colour, alpha);
+}
+
+// A line `thickness` pixels wide (a square brush stepped along it).
+void DrawLine(Image<uint8_t>* rgb, const Eigen::Vector2d& a, const Eigen::Vector2d& b, int thickness,
+              const Colour& colour) {
+  const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm())));
+  for (int i = 0; i <= steps; ++i) {
+    const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(i) / steps);
+    const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+    FillRect(rgb, x - thickness / 2, y - thickness / 2, x - thickness / 2 + thickness, y - thickness / 2 + thickness,
+             colour, 1.0);
+  }
 }
 
 }  // namespace
@@ -41,6 +54,11 @@ void DrawCapturePreview(const CapturePreviewState& state, Image<uint8_t>* rgb) {
   FillRect(rgb, 0, h - unit, w, h, border, 1.0);
   FillRect(rgb, 0, unit, unit, h - unit, border, 1.0);
   FillRect(rgb, w - unit, unit, w, h - unit, border, 1.0);
+
+  for (const std::array<Eigen::Vector2d, 4>& tag : state.tags) {
+    for (int c = 0; c < 4; ++c)
+      DrawLine(rgb, tag[static_cast<size_t>(c)], tag[static_cast<size_t>((c + 1) % 4)], 3, kYellow);
+  }
 
   // Keyframes: squares along the bottom, as many as fit.
   const int step = 2 * unit;

@@ -6,8 +6,11 @@
 //  - along the bottom, one square per keyframe: green once registered in the live model, grey
 //    until then;
 //  - top right, the coverage ring: the directions from which the live model has seen the object
-//    (ViewCoverage), green where a registered keyframe stands, dark where none does yet.
+//    (ViewCoverage), green where a registered keyframe stands, dark where none does yet;
+//  - the tags in view, outlined in yellow.
 // The words (advice, counts) are on the status line; the picture needs none.
+#include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "core/base/image.h"
@@ -19,6 +22,7 @@ struct CapturePreviewState {
   GateVerdict verdict = GateVerdict::kTooClose;
   std::vector<bool> keyframe_registered;  // one per keyframe taken, in order
   std::vector<bool> coverage;             // sectors, counter-clockwise from the right
+  std::vector<std::array<Eigen::Vector2d, 4>> tags;  // corners of the tags in view, pixels
 };
 
 // Draws onto `rgb` (3 channels, interleaved) in place.

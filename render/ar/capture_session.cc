@@ -13,6 +13,7 @@
 #include "core/io/focal_prior.h"
 #include "core/io/image_write.h"
 #include "render/ar/capture_preview.h"
+#include "tracker/tag_detector.h"
 
 namespace reconar {
 namespace {
@@ -104,6 +105,15 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     fs::create_directories(options.preview_dir, error);
     if (error) return IoError(options.preview_dir + ": cannot create the directory: " + error.message());
   }
+  std::unique_ptr<TagDetector> tag_detector;
+  TagDetectionList tags_in_view(16);
+  std::vector<std::array<Eigen::Vector2d, 4>> last_tags;
+  if (!options.preview_dir.empty() && !options.preview_tag_family.empty()) {
+    RECONAR_ASSIGN_OR_RETURN(const TagFamily family, ParseTagFamily(options.preview_tag_family));
+    TagDetectorOptions detector_options;
+    detector_options.family = family;
+    RECONAR_ASSIGN_OR_RETURN(tag_detector, TagDetector::Create(detector_options));
+  }
   Image<uint8_t> last_view, preview;  // the last frame previewed, and with the overlay drawn
   GateVerdict last_verdict = GateVerdict::kTooClose;
   // The overlay on the last frame previewed, as `name` and as latest.png.
@@ -113,6 +123,7 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     state.verdict = last_verdict;
     state.keyframe_registered = keyframe_registered;
     if (live) state.coverage = live->Coverage();
+    state.tags = last_tags;
     DrawCapturePreview(state, &preview);
     if (name != nullptr)
       RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options.preview_dir) / name).string(), preview.view(), 3));
@@ -127,6 +138,11 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     for (int y = 0; y < frame.height; ++y)
       std::copy(frame.rgb.row(y), frame.rgb.row(y) + 3 * frame.width, last_view.row(y));
     last_verdict = verdict;
+    last_tags.clear();
+    if (tag_detector && tag_detector->Detect(frame.gray, &tags_in_view).ok()) {
+      for (const TagDetection& tag : tags_in_view)
+        last_tags.push_back({tag.corners[0], tag.corners[1], tag.corners[2], tag.corners[3]});
+    }
     char name[40];
     std::snprintf(name, sizeof(name), "preview_%06lld.png", static_cast<long long>(frame.index));
     return draw_preview(name);

@@ -41,6 +41,7 @@ struct CaptureOptions {
   // Not empty: a preview (capture_preview.h) of each keyframe and of one frame per second of video,
   // written there as preview_FFFFFF.png (F the frame index) and latest.png.
   std::string preview_dir;
+  std::string preview_tag_family = "tag36h11";  // tags outlined in the preview; "" none
 
   Status Check() const;
 };

@@ -233,6 +233,15 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
     EXPECT_GT(pixel[1], 150) << "keyframe " << k;
     EXPECT_LT(pixel[0], 100) << "keyframe " << k;
   }
+  // The tag, in view in every frame of the video, outlined in yellow (255, 220, 0).
+  int yellow = 0;
+  for (int y = 0; y < 480; ++y) {
+    for (int x = 0; x < 640; ++x) {
+      const uint8_t* pixel = latest->rgb.row(y) + 3 * x;
+      yellow += pixel[0] > 235 && pixel[1] > 200 && pixel[1] < 240 && pixel[2] < 40 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(yellow, 400) << "the tag's outline";
   EXPECT_GE(std::distance(fs::directory_iterator(root / "preview"), fs::directory_iterator()),
             static_cast<std::ptrdiff_t>(keyframes) + 1);
 
