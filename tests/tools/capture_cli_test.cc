@@ -228,10 +228,10 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
   auto latest = ReadImage((root / "preview" / "latest.png").string());
   ASSERT_TRUE(latest.ok()) << latest.status().ToString();
   ASSERT_EQ(latest->rgb.width(), 640);
-  for (int k = 0; k < static_cast<int>(keyframes); ++k) {
-    const uint8_t* pixel = latest->rgb.row(480 - 4 * 8 + 3) + 3 * (2 * 8 + k * 16 + 3);
-    EXPECT_GT(pixel[1], 150) << "keyframe " << k;
-    EXPECT_LT(pixel[0], 100) << "keyframe " << k;
+  for (int square = 0; square < static_cast<int>(keyframes); ++square) {
+    const uint8_t* pixel = latest->rgb.row(480 - 4 * 8 + 3) + 3 * (2 * 8 + square * 16 + 3);
+    EXPECT_GT(pixel[1], 150) << "keyframe " << square;
+    EXPECT_LT(pixel[0], 100) << "keyframe " << square;
   }
   // The tag, in view in every frame of the video, outlined in yellow (255, 220, 0).
   int yellow = 0;
@@ -348,7 +348,9 @@ TEST(CaptureCli, AFullDiskEndsWithAClearErrorAndNoHalfFile) {
   for (const auto& entry : fs::recursive_directory_iterator(project)) {
     const std::string name = entry.path().filename().string();
     EXPECT_EQ(name.find(".tmp-"), std::string::npos) << "temporary file left: " << entry.path();
-    if (entry.path().extension() == ".jpg") EXPECT_TRUE(ReadImage(entry.path().string()).ok()) << entry.path();
+    if (entry.path().extension() == ".jpg") {
+      EXPECT_TRUE(ReadImage(entry.path().string()).ok()) << entry.path();
+    }
   }
   EXPECT_GE(Keyframes(project).size(), 1u);
   fs::remove_all(root);
