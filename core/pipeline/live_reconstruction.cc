@@ -62,8 +62,10 @@ std::vector<bool> ViewCoverage(const Reconstruction& model, int sectors) {
   constexpr double kTwoPi = 6.283185307179586;
   for (const Eigen::Vector3d& centre : centres) {
     const Eigen::Vector3d d = centre - object;
-    double azimuth = std::atan2(d.dot(axis_y), d.dot(axis_x));
+    // Sector 0 centred on the first camera, so that no camera sits on a sector's edge by design.
+    double azimuth = std::atan2(d.dot(axis_y), d.dot(axis_x)) + 0.5 * kTwoPi / sectors;
     if (azimuth < 0.0) azimuth += kTwoPi;
+    if (azimuth >= kTwoPi) azimuth -= kTwoPi;
     const int sector = std::min(sectors - 1, static_cast<int>(azimuth / kTwoPi * sectors));
     covered[static_cast<size_t>(sector)] = true;
   }

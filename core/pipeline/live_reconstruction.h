@@ -60,7 +60,7 @@ struct LiveReconstructionReport {
 
 // The directions from which a model's object has been seen, for the capture's coverage indicator:
 // `sectors` equal sectors of azimuth about the vertical through the points' median (vertical: the
-// registered cameras' mean up direction), sector 0 starting at the first registered camera; true
+// registered cameras' mean up direction), sector 0 centred on the first registered camera; true
 // where a registered camera stands. All false for a model of fewer than two cameras or no points.
 std::vector<bool> ViewCoverage(const Reconstruction& model, int sectors);
 

@@ -80,8 +80,9 @@ void DrawCapturePreview(const CapturePreviewState& state, Image<uint8_t>* rgb) {
       const double dx = x - cx, dy = cy - y;  // image y points down
       const double r = std::hypot(dx, dy);
       if (r < inner || r > outer) continue;
-      double azimuth = std::atan2(dy, dx);
+      double azimuth = std::atan2(dy, dx) + 0.5 * kTwoPi / sectors;  // sector 0 centred on the right
       if (azimuth < 0.0) azimuth += kTwoPi;
+      if (azimuth >= kTwoPi) azimuth -= kTwoPi;
       const int sector = std::min(sectors - 1, static_cast<int>(azimuth / kTwoPi * sectors));
       Blend(rgb, x, y, state.coverage[static_cast<size_t>(sector)] ? kGreen : kDark, 0.8);
     }

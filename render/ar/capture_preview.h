@@ -21,7 +21,7 @@ namespace reconar {
 struct CapturePreviewState {
   GateVerdict verdict = GateVerdict::kTooClose;
   std::vector<bool> keyframe_registered;  // one per keyframe taken, in order
-  std::vector<bool> coverage;             // sectors, counter-clockwise from the right
+  std::vector<bool> coverage;             // sectors counter-clockwise, sector 0 centred on the right
   std::vector<std::array<Eigen::Vector2d, 4>> tags;  // corners of the tags in view, pixels
 };
 
