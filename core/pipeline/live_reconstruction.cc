@@ -205,15 +205,21 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   const auto mapping_start = Clock::now();
   seconds_matching_ += SecondsBetween(matching_start, mapping_start);
 
-  MapperOptions mapper = options_.mapper;
-  mapper.num_threads = 1;
-  Result<Reconstruction> grown = has_model_ ? ContinueIncrementalMapper(mapper_images_, mapper_pairs_, mapper, model_)
-                                            : RunIncrementalMapper(mapper_images_, mapper_pairs_, mapper, nullptr);
+  // The new keyframe gets the local adjustment; the whole model a global one at growth milestones.
+  MapperContinuation growth;
+  growth.final_adjustment = false;
+  growth.registered_at_last_global = registered_at_last_global_;
+  Result<Reconstruction> grown =
+      has_model_ ? ContinueIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), model_, &growth)
+                 : RunIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), nullptr);
   if (has_model_ && grown.ok() && 2 * grown->NumRegisteredImages() < static_cast<int>(images_.size())) {
     // A model that holds under half the keyframes may have started from a poor pair (the first two
     // keyframes of a walk forward): the mapper from scratch chooses its pair among all of them.
-    Result<Reconstruction> fresh = RunIncrementalMapper(mapper_images_, mapper_pairs_, mapper, nullptr);
-    if (fresh.ok() && fresh->NumRegisteredImages() > grown->NumRegisteredImages()) grown = std::move(fresh);
+    Result<Reconstruction> fresh = RunIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), nullptr);
+    if (fresh.ok() && fresh->NumRegisteredImages() > grown->NumRegisteredImages()) {
+      grown = std::move(fresh);
+      growth.registered_at_last_global = grown->NumRegisteredImages();
+    }
   }
   seconds_mapping_ += SecondsBetween(mapping_start, Clock::now());
   if (!grown.ok()) {
@@ -221,8 +227,22 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
     if (grown.status().code() == StatusCode::kFailedPrecondition) return Status::Ok();
     return grown.status();
   }
+  if (!has_model_) growth.registered_at_last_global = grown->NumRegisteredImages();
+  registered_at_last_global_ = growth.registered_at_last_global;
   model_ = std::move(grown).value();
   has_model_ = true;
+  model_final_ = false;
+  PublishModel();
+  return Status::Ok();
+}
+
+MapperOptions LiveReconstruction::MapperOnOneThread() const {
+  MapperOptions mapper = options_.mapper;
+  mapper.num_threads = 1;
+  return mapper;
+}
+
+void LiveReconstruction::PublishModel() {
   const double now = SecondsBetween(start_, Clock::now());
   std::vector<bool> coverage = ViewCoverage(model_, kCoverageSectors);
   std::lock_guard<std::mutex> lock(mutex_);
@@ -235,6 +255,18 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
       newly_registered_.push_back(static_cast<int>(keyframe_of_image_[i]));
     }
   }
+}
+
+Status LiveReconstruction::AdjustFinally() {
+  if (!has_model_ || model_final_) return Status::Ok();
+  const auto start = Clock::now();
+  Result<Reconstruction> adjusted =
+      ContinueIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), model_);
+  seconds_final_adjustment_ += SecondsBetween(start, Clock::now());
+  if (!adjusted.ok()) return adjusted.status().WithContext("the live model's final adjustment");
+  model_ = std::move(adjusted).value();
+  model_final_ = true;
+  PublishModel();
   return Status::Ok();
 }
 
@@ -248,14 +280,19 @@ Result<LiveReconstructionReport> LiveReconstruction::Finish() {
   LiveReconstructionReport report;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    report.keyframes = queued_;
     if (!worker_error_.ok()) return worker_error_;
+  }
+  RECONAR_RETURN_IF_ERROR(AdjustFinally());
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    report.keyframes = queued_;
   }
   report.registered = has_model_ ? model_.NumRegisteredImages() : 0;
   report.points = has_model_ ? model_.NumPoints() : 0;
   report.seconds_features = seconds_features_;
   report.seconds_matching = seconds_matching_;
   report.seconds_mapping = seconds_mapping_;
+  report.seconds_final_adjustment = seconds_final_adjustment_;
   std::vector<double> latencies;
   for (const LiveKeyframe& keyframe : report.keyframes) {
     if (keyframe.registered_seconds >= 0.0) latencies.push_back(keyframe.registered_seconds - keyframe.taken_seconds);
@@ -293,6 +330,7 @@ Result<LiveReconstructionReport> LiveReconstruction::Finish() {
   json.Key("seconds_features").Double(report.seconds_features);
   json.Key("seconds_matching").Double(report.seconds_matching);
   json.Key("seconds_mapping").Double(report.seconds_mapping);
+  json.Key("seconds_final_adjustment").Double(report.seconds_final_adjustment);
   json.Key("images").BeginArray();
   for (const LiveKeyframe& keyframe : report.keyframes) {
     json.BeginObject().Key("path").String(keyframe.path).Key("taken_s").Double(keyframe.taken_seconds);

@@ -5,7 +5,9 @@
 //   2. matches against every earlier keyframe, verified as the match stage verifies them (the
 //      same pairs, in the same order: a capture holds tens of keyframes, not thousands);
 //   3. the model grown by ContinueIncrementalMapper (core/sfm/mapper.h) from the last one, or
-//      started once two keyframes make an initial pair.
+//      started once two keyframes make an initial pair: the new keyframe gets a local bundle
+//      adjustment, the whole model a global one when it has grown by a quarter, and the final
+//      adjustment (the intrinsics model chosen, then adjusted to convergence) runs in Finish().
 // One keyframe at a time in a fixed order makes the result independent of how far the worker
 // lags behind the camera: a replay that resumes after a crash ends with the same model.
 //
@@ -55,6 +57,7 @@ struct LiveReconstructionReport {
   double median_latency_seconds = 0.0;  // taken -> registered, over the keyframes that registered
   double p95_latency_seconds = 0.0;
   double seconds_features = 0.0, seconds_matching = 0.0, seconds_mapping = 0.0;  // the worker's time
+  double seconds_final_adjustment = 0.0;                                         // in Finish()
   std::string error;  // a failure that stopped the worker (the keyframes stay on disk)
 };
 
@@ -88,7 +91,11 @@ class LiveReconstruction {
  private:
   void Work();
   Status ProcessKeyframe(size_t index);
-  Status WriteOutputs();
+  MapperOptions MapperOnOneThread() const;
+  // Makes model_ the one the capture sees: registered count, coverage, newly registered keyframes.
+  void PublishModel();
+  // The final global adjustment of the live model, once (Finish()).
+  Status AdjustFinally();
 
   const Project project_;
   const LiveReconstructionOptions options_;
@@ -115,7 +122,9 @@ class LiveReconstruction {
   std::vector<MapperPair> mapper_pairs_;
   Reconstruction model_;
   bool has_model_ = false;
-  double seconds_features_ = 0.0, seconds_matching_ = 0.0, seconds_mapping_ = 0.0;
+  bool model_final_ = false;           // model_ has had its final adjustment
+  int registered_at_last_global_ = 0;  // MapperContinuation's milestone count
+  double seconds_features_ = 0.0, seconds_matching_ = 0.0, seconds_mapping_ = 0.0, seconds_final_adjustment_ = 0.0;
 
   std::thread worker_;
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <set>
 #include <utility>
 
@@ -41,21 +42,26 @@ class Mapper {
         initial_pair_scores_(scores) {}
 
   // From the best initial pair, or, with `seed`, from its registered images' poses and their
-  // cameras (a merge of models, model_merge.h): the seed's points are triangulated again from the
-  // tracks of every pair.
-  Status Run(const MapperProgress& progress, const Reconstruction* seed = nullptr) {
+  // cameras (a merge of models, model_merge.h; a model grown while photos arrive): the seed's points
+  // are triangulated again from the tracks of every pair. With a `continuation` that is not final,
+  // the model is only grown (see MapperContinuation).
+  Status Run(const MapperProgress& progress, const Reconstruction* seed = nullptr,
+             MapperContinuation* continuation = nullptr) {
     const auto start = Clock::now();
+    const bool growth_only = continuation != nullptr && !continuation->final_adjustment;
     RECONAR_RETURN_IF_ERROR(Setup());
+    int last_global = 0;
     if (seed != nullptr) {
-      RECONAR_RETURN_IF_ERROR(StartFromSeed(*seed));
+      RECONAR_RETURN_IF_ERROR(StartFromSeed(*seed, !growth_only));
+      last_global = growth_only ? continuation->registered_at_last_global : model_.rec.NumRegisteredImages();
     } else {
       RECONAR_RETURN_IF_ERROR(
           InitializeFromBestPair(&model_, images_, pairs_, opt_, report_, excluded_starts_,
                                  excluded_starts_.empty() ? InitialPairOrder::kMatchCount : InitialPairOrder::kGeometry,
                                  initial_pair_scores_));
+      last_global = model_.rec.NumRegisteredImages();
     }
     if (progress) progress(model_.rec.NumRegisteredImages(), static_cast<int>(images_.size()));
-    int last_global = model_.rec.NumRegisteredImages();
     while (true) {
       bool registered_one = false;
       RECONAR_ASSIGN_OR_RETURN(registered_one, RegisterNextImage());
@@ -66,6 +72,12 @@ class Mapper {
         last_global = registered;
       }
       if (progress) progress(registered, static_cast<int>(images_.size()));
+    }
+    if (growth_only) {
+      continuation->registered_at_last_global = last_global;
+      FinishReport();
+      report_->seconds_total = SecondsSince(start);
+      return Status::Ok();
     }
     RECONAR_RETURN_IF_ERROR(GlobalRefinement(GrowthAdjustment(opt_.global_ba_iterations)));
     IntrinsicsChoice choice;
@@ -128,23 +140,34 @@ class Mapper {
     return Status::Ok();
   }
 
-  Status StartFromSeed(const Reconstruction& seed) {
+  // The seed's images are found by name; each mapper camera takes the seed camera of its first
+  // registered seed image. With `refine`, the seeded model is adjusted globally.
+  Status StartFromSeed(const Reconstruction& seed, bool refine) {
     Reconstruction& rec = model_.rec;
-    // The seed may hold only the first images (a model grown while more photos arrive).
-    if (seed.images.size() > rec.images.size() || seed.cameras.size() > rec.cameras.size())
-      return InvalidArgument("mapper: a seed model of other images");
-    for (size_t i = 0; i < seed.images.size(); ++i) {
-      if (seed.images[i].name != rec.images[i].name || seed.images[i].camera_id != rec.images[i].camera_id)
-        return InvalidArgument("mapper: a seed model of other images");
+    std::map<std::string, size_t> index_of;
+    for (size_t i = 0; i < rec.images.size(); ++i) index_of.emplace(rec.images[i].name, i);
+    std::vector<bool> camera_seeded(rec.cameras.size(), false);
+    for (const SfmImage& seeded : seed.images) {
+      if (!seeded.registered) continue;
+      const auto it = index_of.find(seeded.name);
+      if (it == index_of.end())
+        return InvalidArgument("mapper: the seed model's image " + seeded.name + " is not given");
+      if (seeded.camera_id < 0 || static_cast<size_t>(seeded.camera_id) >= seed.cameras.size())
+        return InvalidArgument("mapper: the seed model's image " + seeded.name + " has no camera");
+      SfmImage& image = rec.images[it->second];
+      const SfmCamera& camera = seed.cameras[static_cast<size_t>(seeded.camera_id)];
+      if (camera.width != images_[it->second].width || camera.height != images_[it->second].height)
+        return InvalidArgument("mapper: the seed model's image " + seeded.name + " is of another size");
+      const size_t camera_id = static_cast<size_t>(image.camera_id);
+      if (!camera_seeded[camera_id]) rec.cameras[camera_id] = camera;
+      camera_seeded[camera_id] = true;
+      image.registered = true;
+      image.cam_from_world = seeded.cam_from_world;
+      model_.failure[it->second].clear();
     }
-    for (size_t c = 0; c < seed.cameras.size(); ++c) rec.cameras[c] = seed.cameras[c];
-    for (size_t i = 0; i < seed.images.size(); ++i) {
-      if (!seed.images[i].registered) continue;
-      rec.images[i].registered = true;
-      rec.images[i].cam_from_world = seed.images[i].cam_from_world;
-      model_.failure[i].clear();
-    }
+    if (model_.rec.NumRegisteredImages() < 2) return InvalidArgument("mapper: a seed model of fewer than two images");
     for (const int image : model_.RegisteredImages()) TriangulateImage(&model_, image, opt_);
+    if (!refine) return Status::Ok();
     return GlobalRefinement(GrowthAdjustment(opt_.global_ba_iterations));
   }
 
@@ -449,7 +472,8 @@ Status MergeIntoLargest(const std::vector<MapperImage>& images, const std::vecto
 
 Result<Reconstruction> ContinueIncrementalMapper(const std::vector<MapperImage>& images,
                                                  const std::vector<MapperPair>& pairs, const MapperOptions& options,
-                                                 const Reconstruction& previous, MapperReport* report) {
+                                                 const Reconstruction& previous, MapperContinuation* continuation,
+                                                 MapperReport* report, const MapperProgress& progress) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   MapperReport local_report;
   if (report == nullptr) report = &local_report;
@@ -457,7 +481,7 @@ Result<Reconstruction> ContinueIncrementalMapper(const std::vector<MapperImage>&
   if (previous.NumRegisteredImages() < 2) return InvalidArgument("mapper: continuing a model of fewer than two images");
   const std::set<std::pair<int, int>> no_excluded_starts;
   Mapper mapper(images, pairs, options, report, no_excluded_starts, nullptr);
-  RECONAR_RETURN_IF_ERROR(mapper.Run(nullptr, &previous));
+  RECONAR_RETURN_IF_ERROR(mapper.Run(progress, &previous, continuation));
   return mapper.TakeResult();
 }
 

@@ -213,13 +213,27 @@ Result<Reconstruction> RunIncrementalMapper(const std::vector<MapperImage>& imag
                                             MapperReport* report, const MapperProgress& progress = nullptr,
                                             std::vector<Reconstruction>* other_models = nullptr);
 
-// Grows `previous`, a model of the first previous.images.size() of `images` (built by either
-// function from those images and their pairs), over all of them: its registered images start
-// with their poses and cameras, every track is triangulated again, the rest register as they can,
-// and the whole is adjusted as at the end of a run. For a model that grows while photos arrive
-// (a capture). InvalidArgument when `previous` is not such a model.
+// How ContinueIncrementalMapper adjusts the model it grows.
+struct MapperContinuation {
+  // true: the whole model is adjusted as at the end of a run (the intrinsics model chosen, then the
+  // final adjustment). false: each new image gets the local adjustment, and the model a global one
+  // when the registered count reaches MapperOptions::global_ba_growth x registered_at_last_global,
+  // which is updated: a model that grows a photo at a time, adjusted as a whole once at its end.
+  bool final_adjustment = true;
+  int registered_at_last_global = 0;
+};
+
+// Grows `previous`, a model of some of `images` (found by name; built by either function, or read
+// back from its files), over all of them: its registered images start with their poses and
+// cameras, every track is triangulated again, the rest register as they can, and the model is
+// adjusted as `continuation` says (null: as at the end of a run). For a model that grows while
+// photos arrive (a capture), and for mapping that continues from it. InvalidArgument when
+// `previous` holds fewer than two registered images, or an image not among `images` or of another size.
 Result<Reconstruction> ContinueIncrementalMapper(const std::vector<MapperImage>& images,
                                                  const std::vector<MapperPair>& pairs, const MapperOptions& options,
-                                                 const Reconstruction& previous, MapperReport* report = nullptr);
+                                                 const Reconstruction& previous,
+                                                 MapperContinuation* continuation = nullptr,
+                                                 MapperReport* report = nullptr,
+                                                 const MapperProgress& progress = nullptr);
 
 }  // namespace reconar

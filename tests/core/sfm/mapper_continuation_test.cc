@@ -1,0 +1,197 @@
+// ContinueIncrementalMapper: a model grown one photo at a time (a capture's live model), and a
+// model continued from one read back by name.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/sfm/mapper.h"
+#include "tests/core/sfm/synthetic_scene.h"
+#include "tests/support/sfm_evaluation.h"
+
+namespace reconar {
+namespace {
+
+using testing::MakeScene;
+using testing::Scene;
+using testing::SceneOptions;
+
+// The first n images of a scene and the pairs among them.
+struct Prefix {
+  std::vector<MapperImage> images;
+  std::vector<MapperPair> pairs;
+};
+Prefix FirstImages(const Scene& scene, int n) {
+  Prefix prefix;
+  prefix.images.assign(scene.images.begin(), scene.images.begin() + n);
+  for (const MapperPair& pair : scene.pairs) {
+    if (pair.matches.image_a < n && pair.matches.image_b < n) prefix.pairs.push_back(pair);
+  }
+  return prefix;
+}
+
+testing::CameraPoseErrors ErrorsAgainstTruth(const Reconstruction& model, const Scene& scene) {
+  std::vector<testing::CameraPose> estimated, truth;
+  for (const SfmImage& image : model.images) {
+    if (!image.registered) continue;
+    const auto in_scene = std::find_if(scene.images.begin(), scene.images.end(),
+                                       [&](const MapperImage& photo) { return photo.name == image.name; });
+    const Rigid3& pose = scene.poses[static_cast<size_t>(in_scene - scene.images.begin())];
+    estimated.push_back({image.cam_from_world.rotation, image.Center()});
+    truth.push_back({pose.rotation, CameraCenterInWorld(pose)});
+  }
+  Result<testing::CameraPoseErrors> errors = testing::CameraCenterErrors(estimated, truth);
+  EXPECT_TRUE(errors.ok()) << errors.status().ToString();
+  return errors.ok() ? *errors : testing::CameraPoseErrors{};
+}
+
+SceneOptions Ring() {
+  SceneOptions options;
+  options.num_cameras = 12;
+  options.num_points = 1500;
+  options.seed = 11;
+  return options;
+}
+
+// A photo at a time, grown with local adjustments and adjusted as a whole once at the end: as
+// accurate as the mapper's run over all the photos at once, with far fewer global adjustments than
+// adjusting the whole model after every photo (each continuation final).
+TEST(MapperContinuationTest, AModelGrownAPhotoAtATimeMatchesTheWholeRun) {
+  const SceneOptions options = Ring();
+  const Scene scene = MakeScene(options);
+  const MapperOptions mapper = testing::SingleThreaded();
+  const int n = static_cast<int>(scene.images.size());
+
+  int first = 2;
+  Result<Reconstruction> start = InvalidArgument("no initial pair yet");
+  while (!start.ok() && first < n) {
+    ++first;
+    const Prefix prefix = FirstImages(scene, first);
+    start = RunIncrementalMapper(prefix.images, prefix.pairs, mapper, nullptr);
+  }
+  ASSERT_TRUE(start.ok()) << start.status().ToString();
+
+  struct Grown {
+    Reconstruction model;
+    int global_adjustments = 0;
+    double seconds = 0.0;
+  };
+  // Each photo continued with local adjustments (growth) or with the final adjustment every time.
+  const auto grow = [&](bool final_each_time) -> Grown {
+    Grown grown;
+    grown.model = *start;
+    MapperContinuation growth;
+    growth.final_adjustment = final_each_time;
+    growth.registered_at_last_global = start->NumRegisteredImages();
+    const auto begin = std::chrono::steady_clock::now();
+    for (int size = first + 1; size <= n; ++size) {
+      const Prefix prefix = FirstImages(scene, size);
+      MapperReport report;
+      Result<Reconstruction> model =
+          ContinueIncrementalMapper(prefix.images, prefix.pairs, mapper, grown.model, &growth, &report);
+      EXPECT_TRUE(model.ok()) << "at " << size << ": " << model.status().ToString();
+      if (!model.ok()) return grown;
+      EXPECT_EQ(model->NumRegisteredImages(), size) << "the new photo registers at once";
+      grown.global_adjustments += report.num_global_ba;
+      grown.model = std::move(model).value();
+    }
+    if (!final_each_time) {
+      MapperReport report;
+      Result<Reconstruction> model = ContinueIncrementalMapper(scene.images, scene.pairs, mapper, grown.model);
+      EXPECT_TRUE(model.ok()) << model.status().ToString();
+      if (model.ok()) grown.model = std::move(model).value();
+    }
+    grown.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+    return grown;
+  };
+  const Grown growing = grow(false);
+  const Grown final_each_time = grow(true);
+  ASSERT_EQ(growing.model.NumRegisteredImages(), n);
+  ASSERT_EQ(final_each_time.model.NumRegisteredImages(), n);
+
+  Result<Reconstruction> whole = RunIncrementalMapper(scene.images, scene.pairs, mapper, nullptr);
+  ASSERT_TRUE(whole.ok()) << whole.status().ToString();
+  const testing::CameraPoseErrors grown = ErrorsAgainstTruth(growing.model, scene);
+  const testing::CameraPoseErrors adjusted_each_time = ErrorsAgainstTruth(final_each_time.model, scene);
+  const testing::CameraPoseErrors at_once = ErrorsAgainstTruth(*whole, scene);
+  std::printf(
+      "  from %d photos on: growing %d global adjustments, %.2f s, centre error mean %.5f max %.5f, rotation max "
+      "%.4f deg; final adjustment each time %d, %.2f s, mean %.5f; all at once: mean %.5f max %.5f\n",
+      first, growing.global_adjustments, growing.seconds, grown.centre_mean, grown.centre_max, grown.rotation_max_deg,
+      final_each_time.global_adjustments, final_each_time.seconds, adjusted_each_time.centre_mean, at_once.centre_mean,
+      at_once.centre_max);
+  EXPECT_LT(2 * growing.global_adjustments, final_each_time.global_adjustments);
+  // The bound of the mapper's ring test (1 % of the radius; see mapper_test.cc), and no worse than
+  // the run over all photos by more than half again.
+  EXPECT_LT(grown.centre_max, 0.01 * options.ring_radius);
+  EXPECT_LE(grown.centre_mean, 1.5 * at_once.centre_mean + 1e-4 * options.ring_radius);
+  EXPECT_LT(grown.rotation_max_deg, 0.25);
+  EXPECT_NEAR(growing.model.cameras[0].focal, scene.camera.focal, 0.01 * scene.camera.focal);
+}
+
+// A model is found by its images' names: continued over the images in another order, with more
+// of them, it keeps its poses and registers the rest.
+TEST(MapperContinuationTest, TheSeedIsFoundByNameInAnyOrder) {
+  const Scene scene = MakeScene(Ring());
+  const MapperOptions mapper = testing::SingleThreaded();
+  const int n = static_cast<int>(scene.images.size());
+  const Prefix half = FirstImages(scene, n / 2 + 1);
+  Result<Reconstruction> seed = RunIncrementalMapper(half.images, half.pairs, mapper, nullptr);
+  ASSERT_TRUE(seed.ok()) << seed.status().ToString();
+  ASSERT_EQ(seed->NumRegisteredImages(), n / 2 + 1);
+
+  // Reversed image order; pairs renumbered to match.
+  std::vector<MapperImage> reversed(scene.images.rbegin(), scene.images.rend());
+  std::vector<MapperPair> pairs = scene.pairs;
+  for (MapperPair& pair : pairs) {
+    pair.matches.image_a = n - 1 - pair.matches.image_a;
+    pair.matches.image_b = n - 1 - pair.matches.image_b;
+  }
+  MapperReport report;
+  Result<Reconstruction> continued = ContinueIncrementalMapper(reversed, pairs, mapper, *seed, nullptr, &report);
+  ASSERT_TRUE(continued.ok()) << continued.status().ToString();
+  EXPECT_EQ(continued->NumRegisteredImages(), n);
+  for (int i = 0; i < n; ++i)
+    EXPECT_EQ(continued->images[static_cast<size_t>(i)].name, reversed[static_cast<size_t>(i)].name);
+  // The seed's cameras keep their poses, up to what the final adjustment moves (a small share of
+  // the ring's radius: the gauge is the seed's).
+  for (const SfmImage& seeded : seed->images) {
+    const SfmImage& now =
+        continued->images[static_cast<size_t>(n - 1) - static_cast<size_t>(&seeded - &seed->images[0])];
+    ASSERT_EQ(now.name, seeded.name);
+    EXPECT_LT((now.Center() - seeded.Center()).norm(), 0.01 * Ring().ring_radius) << seeded.name;
+  }
+  const testing::CameraPoseErrors errors = ErrorsAgainstTruth(*continued, scene);
+  EXPECT_LT(errors.centre_max, 0.01 * Ring().ring_radius);
+}
+
+TEST(MapperContinuationTest, ASeedOfOtherImagesIsInvalidArgument) {
+  const Scene scene = MakeScene(Ring());
+  const MapperOptions mapper = testing::SingleThreaded();
+  Result<Reconstruction> seed = RunIncrementalMapper(scene.images, scene.pairs, mapper, nullptr);
+  ASSERT_TRUE(seed.ok()) << seed.status().ToString();
+
+  std::vector<MapperImage> renamed = scene.images;
+  renamed[3].name = "another.jpg";
+  Result<Reconstruction> other = ContinueIncrementalMapper(renamed, scene.pairs, mapper, *seed);
+  ASSERT_FALSE(other.ok());
+  EXPECT_EQ(other.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(other.status().message().find(scene.images[3].name), std::string::npos) << other.status().ToString();
+
+  std::vector<MapperImage> resized = scene.images;
+  for (MapperImage& image : resized) image.width *= 2;
+  Result<Reconstruction> larger = ContinueIncrementalMapper(resized, scene.pairs, mapper, *seed);
+  ASSERT_FALSE(larger.ok());
+  EXPECT_NE(larger.status().message().find("another size"), std::string::npos) << larger.status().ToString();
+
+  Reconstruction one = *seed;
+  for (size_t i = 1; i < one.images.size(); ++i) one.images[i].registered = false;
+  EXPECT_EQ(ContinueIncrementalMapper(scene.images, scene.pairs, mapper, one).status().code(),
+            StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace reconar
