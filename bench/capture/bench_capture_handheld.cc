@@ -211,8 +211,12 @@ int main(int argc, char** argv) {
   const int keyframes = static_cast<int>(frame_of_keyframe.size());
   const Score live = ScoreModel(capture.project_dir + "/live", truth, frame_of_keyframe);
   std::vector<std::string> keyframe_paths = report->keyframe_files;
+  // In the capture's project, mapping continues from the live model; in a project of its own, it starts over.
   reconar::Status status = SparseOnly(keyframe_paths, capture.project_dir);
-  const Score offline = status.ok() ? ScoreModel(capture.project_dir + "/sparse", truth, frame_of_keyframe) : Score();
+  const Score continued = status.ok() ? ScoreModel(capture.project_dir + "/sparse", truth, frame_of_keyframe) : Score();
+  status = SparseOnly(keyframe_paths, (out / "offline").string());
+  const Score offline =
+      status.ok() ? ScoreModel((out / "offline" / "sparse").string(), truth, frame_of_keyframe) : Score();
 
   const int k = std::max(1, static_cast<int>(std::lround(static_cast<double>(frames) / std::max(1, keyframes))));
   std::vector<std::string> every_kth;
@@ -238,6 +242,8 @@ int main(int argc, char** argv) {
       "%.3f deg; keyframe to registration %.2f s median, %.2f s p95\n",
       live.registered, keyframes, 100.0 * live.registered / std::max(1, keyframes), 100.0 * live.centre_mean / extent,
       live.rotation_mean, report->live_model.median_latency_seconds, report->live_model.p95_latency_seconds);
+  std::printf("sfm continued:     %d of %d registered, centre error mean %.4f %%, rotation mean %.3f deg\n",
+              continued.registered, keyframes, 100.0 * continued.centre_mean / extent, continued.rotation_mean);
   std::printf("sfm on keyframes:  %d of %d registered, centre error mean %.4f %%, rotation mean %.3f deg\n",
               offline.registered, keyframes, 100.0 * offline.centre_mean / extent, offline.rotation_mean);
   std::printf(

@@ -312,7 +312,7 @@ Result<LiveReconstructionReport> LiveReconstruction::Finish() {
   RECONAR_RETURN_IF_ERROR(record.Record("features", FeatureStageSettings(options_.features)));
   RECONAR_RETURN_IF_ERROR(record.Record("matching", MatchStageSettings(options_.matching)));
 
-  const std::string live_dir = project_.root() + "/live";
+  const std::string live_dir = project_.LiveDir();
   RECONAR_RETURN_IF_ERROR(CreateDirectories(live_dir));
   if (has_model_) {
     RECONAR_RETURN_IF_ERROR(WriteColmapTextModel(model_, live_dir));

@@ -42,6 +42,7 @@ class Project {
   std::string DensePointsPath() const { return root_ + "/dense/points.ply"; }
   std::string MeshDir() const { return root_ + "/mesh"; }
   std::string MapDir() const { return root_ + "/map"; }
+  std::string LiveDir() const { return root_ + "/live"; }         // the capture's live model (live_reconstruction.h)
   std::string MapPath() const { return MapDir() + "/map.rmap"; }  // core/sfm/localization_map.h
 
   Status WriteImageList(const std::vector<ProjectImage>& images) const;

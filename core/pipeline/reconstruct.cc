@@ -307,7 +307,13 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     const MapperOptions& mapper = sfm.mapper;
     const auto run_mapping = [&](StageSummary* summary) -> Status {
       RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
-      if (with_tags && !r.tags.metric) summary->note = "no metric registration: " + r.tags.reason;
+      if (r.live_model == "continued") {
+        summary->note = "continued from the capture's live model";
+      } else if (!r.live_model.empty()) {
+        summary->note = "the capture's live model " + r.live_model;
+      }
+      if (with_tags && !r.tags.metric)
+        summary->note += std::string(summary->note.empty() ? "" : "; ") + "no metric registration: " + r.tags.reason;
       if (r.mapper.models.size() > 1) {
         std::string sizes;
         for (size_t k = 1; k < r.mapper.models.size(); ++k)

@@ -70,6 +70,47 @@ void FocalStatistics(const Reconstruction& rec, SfmStageReport* report) {
   report->focal_35mm_equivalent = 36.0 * mean;  // the long side of a 36 x 24 mm frame
 }
 
+// The capture's live model (PROJECT/live/) when options allow and it can seed the mapper; else an
+// error, with *note saying why ("not used: ...") when there is a model.
+Result<Reconstruction> LiveModel(const Project& project, const SfmStageOptions& options, std::string* note) {
+  note->clear();
+  const std::string dir = project.LiveDir();
+  std::error_code error;
+  if (!options.continue_from_live || !std::filesystem::exists(dir + "/points3D.txt", error))
+    return NotFound(dir + ": no live model");
+  Result<Reconstruction> live = ReadColmapTextModel(dir);
+  if (!live.ok()) {
+    *note = "not used: " + live.status().message();
+    return live.status();
+  }
+  if (live->NumRegisteredImages() < 2) {
+    *note = "not used: " + dir + " holds fewer than two photos";
+    return FailedPrecondition(*note);
+  }
+  return live;
+}
+
+Result<Reconstruction> ContinueFromLiveModel(const Reconstruction& live, const std::vector<MapperImage>& images,
+                                             const std::vector<MapperPair>& pairs, const MapperOptions& options,
+                                             const MapperProgress& progress, SfmStageReport* report) {
+  Result<Reconstruction> continued =
+      ContinueIncrementalMapper(images, pairs, options, live, nullptr, &report->mapper, progress);
+  if (!continued.ok()) {
+    report->live_model = "not used: " + continued.status().message();
+    return continued;
+  }
+  report->live_model = "continued";
+  MapperReport::Model summary;
+  for (const SfmImage& image : continued->images) {
+    if (image.registered) summary.images.push_back(image.name);
+  }
+  summary.num_points = continued->NumPoints();
+  summary.initial_pair = "continued from the live model";
+  report->mapper.initial_pair = summary.initial_pair;
+  report->mapper.models = {std::move(summary)};
+  return continued;
+}
+
 }  // namespace
 
 MapperImage ToMapperImage(const ProjectImage& image, const std::vector<SiftKeypoint>& keypoints) {
@@ -158,7 +199,27 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     shown = std::max(shown, done);
   };
   std::vector<Reconstruction> other_models;
-  auto reconstruction = RunIncrementalMapper(images, pairs, options.mapper, &report.mapper, on_progress, &other_models);
+  Result<Reconstruction> reconstruction = InvalidArgument("not mapped");
+  Result<Reconstruction> live = LiveModel(project, options, &report.live_model);
+  if (live.ok()) {
+    reconstruction = ContinueFromLiveModel(*live, images, pairs, options.mapper, on_progress, &report);
+  }
+  if (!live.ok() || !reconstruction.ok() ||
+      2 * reconstruction->NumRegisteredImages() < static_cast<int>(images.size())) {
+    MapperReport scratch_report;
+    std::vector<Reconstruction> scratch_others;
+    auto scratch = RunIncrementalMapper(images, pairs, options.mapper, &scratch_report, on_progress, &scratch_others);
+    if (scratch.ok() &&
+        (!reconstruction.ok() || scratch->NumRegisteredImages() > reconstruction->NumRegisteredImages())) {
+      if (reconstruction.ok()) report.live_model = "not used: the mapper from scratch registered more photos";
+      reconstruction = std::move(scratch);
+      report.mapper = std::move(scratch_report);
+      other_models = std::move(scratch_others);
+    } else if (!reconstruction.ok()) {
+      reconstruction = std::move(scratch);
+      report.mapper = std::move(scratch_report);
+    }
+  }
   if (progress) progress->Finish();
   if (!reconstruction.ok()) return reconstruction.status();
   if (options.tags.enabled) {
@@ -220,6 +281,7 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("rmse_focal_ratio").Double(sfm.rmse_focal_ratio);
   json->Key("focal_35mm_equivalent_mm").Double(sfm.focal_35mm_equivalent);
   json->Key("initial_pair").String(m.initial_pair);
+  if (!sfm.live_model.empty()) json->Key("live_model").String(sfm.live_model);
   json->Key("initial_pair_relaxations").Int(m.init_relaxations);
   json->Key("initial_pairs_scored").Int(m.init_pairs_scored);
   json->Key("initial_starts").Int(m.init_starts);

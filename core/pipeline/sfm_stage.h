@@ -31,6 +31,13 @@ struct SfmStageOptions {
   MapperOptions mapper;
   SfmTagOptions tags;
   bool show_progress = true;
+  // When PROJECT/live/ holds the model a capture grew (live_reconstruction.h), the mapper continues
+  // from it (ContinueIncrementalMapper: its poses and cameras, every track triangulated again, the
+  // other photos registered, the tags added, the final adjustment) instead of starting over. It is
+  // passed over, with the reason in the report, when it cannot be read or names a photo that is not
+  // the project's; and when the continued model holds under half the photos, the mapper also runs
+  // from scratch and the larger model is kept.
+  bool continue_from_live = true;
 };
 
 struct SfmStageReport {
@@ -44,6 +51,8 @@ struct SfmStageReport {
   double seconds_mapping = 0.0;
   double seconds_colour = 0.0;
   double seconds_write = 0.0;
+  // "continued": the mapper continued from the live model; "not used: REASON"; empty: none there.
+  std::string live_model;
   bool tags_used = false;             // options.tags.enabled
   TagRegistrationReport tags;         // also written to PROJECT/tags.json
 };

@@ -250,6 +250,7 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
   ASSERT_EQ(sfm.exit_code, 0) << sfm.output;
   EXPECT_NE(sfm.output.find("features  reused"), std::string::npos) << sfm.output;
   EXPECT_NE(sfm.output.find("matching  reused"), std::string::npos) << sfm.output;
+  EXPECT_NE(sfm.output.find("continued from the capture's live model"), std::string::npos) << sfm.output;
   auto tags = ReadJsonFile((project / "tags.json").string());
   ASSERT_TRUE(tags.ok()) << tags.status().ToString();
   ASSERT_TRUE(tags->Find("metric")->bool_value()) << sfm.output;
@@ -269,6 +270,20 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
     const std::string features = "features/" + keyframe.filename().string() + ".rfeat";
     EXPECT_EQ(ReadBytes(project / features), ReadBytes(root / "offline" / features)) << features;
   }
+
+  // A damaged live model is passed over with the reason, and the mapper starts over.
+  {
+    std::ofstream damaged(project / "live" / "images.txt", std::ios::app);
+    damaged << "9 not a pose\n";
+  }
+  fs::remove(project / "sparse" / "report.json");  // so that the mapping stage runs again
+  const CommandRun again = RunReconar("sfm " + (project / "images").string() + " " + project.string() + " --threads 2");
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_NE(again.output.find("live model not used: " + (project / "live" / "images.txt").string()), std::string::npos)
+      << again.output;
+  auto report = ReadJsonFile((project / "sparse" / "report.json").string());
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  EXPECT_EQ(Number(*report, "registered"), keyframes);
   fs::remove_all(root);
 }
 
@@ -443,14 +458,22 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
     return it == frame_of_keyframe.end() ? std::string() : it->second;
   });
 
-  // `sfm` run offline on the same keyframes (reusing the capture's features and matches).
-  const CommandRun offline_run =
-      RunReconar("sfm " + (project / "images").string() + " " + project.string() + " --threads 2");
-  ASSERT_EQ(offline_run.exit_code, 0) << offline_run.output;
-  const ModelScore offline = ScoreAgainstTruth(project / "sparse", *truth, [&](const std::string& name) {
+  const auto frame_of = [&](const std::string& name) {
     const auto it = frame_of_keyframe.find(name);
     return it == frame_of_keyframe.end() ? std::string() : it->second;
-  });
+  };
+  // `sfm` in the capture's project continues from the live model (and reuses its features and
+  // matches); run offline on the same keyframes in a project of its own, it starts over.
+  const CommandRun continued_run =
+      RunReconar("sfm " + (project / "images").string() + " " + project.string() + " --threads 2");
+  ASSERT_EQ(continued_run.exit_code, 0) << continued_run.output;
+  EXPECT_NE(continued_run.output.find("continued from the capture's live model"), std::string::npos)
+      << continued_run.output;
+  const ModelScore continued = ScoreAgainstTruth(project / "sparse", *truth, frame_of);
+  const CommandRun offline_run =
+      RunReconar("sfm " + (project / "images").string() + " " + (root / "offline").string() + " --threads 2");
+  ASSERT_EQ(offline_run.exit_code, 0) << offline_run.output;
+  const ModelScore offline = ScoreAgainstTruth(root / "offline" / "sparse", *truth, frame_of);
 
   // Every k-th frame, k giving as many frames as the capture took keyframes.
   const int k = std::max(1, static_cast<int>(std::lround(static_cast<double>(walk.frames) / keyframes)));
@@ -490,10 +513,17 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
       "%.3f deg\n",
       offline.registered, 100.0 * offline.errors.centre_mean / walk_length,
       100.0 * offline.errors.centre_max / walk_length, offline.errors.rotation_mean_deg);
+  std::printf(
+      "sfm continued from the live model: %d registered, centre error mean %.3f %% (max %.3f %%), rotation mean "
+      "%.3f deg\n",
+      continued.registered, 100.0 * continued.errors.centre_mean / walk_length,
+      100.0 * continued.errors.centre_max / walk_length, continued.errors.rotation_mean_deg);
   EXPECT_GE(live.registered, static_cast<int>(std::ceil(0.95 * keyframes)));
   // The live model, grown one keyframe at a time, is as good as the offline one (within half again).
   EXPECT_GE(live.registered, offline.registered);
   EXPECT_LE(live.errors.centre_mean, 1.5 * offline.errors.centre_mean);
+  EXPECT_GE(continued.registered, offline.registered);
+  EXPECT_LE(continued.errors.centre_mean, 1.5 * offline.errors.centre_mean);
   // Compared only when every k-th frame registered all its frames (else the capture is better already).
   if (kth.registered == static_cast<int>(every_kth.size())) {
     EXPECT_LE(live.errors.centre_mean, kth.errors.centre_mean);
