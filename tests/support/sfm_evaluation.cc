@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/base/atomic_file.h"
+#include "core/sfm/model_io.h"
 
 namespace reconar::testing {
 
@@ -41,6 +42,23 @@ double Max(const std::vector<double>& values) {
 }  // namespace
 
 CameraPose PoseOf(const GroundTruthCamera& camera) { return {camera.cam_from_world_rotation, camera.Centre()}; }
+
+Result<ModelScore> ScoreModelAgainstTruth(const std::string& model_dir, const GroundTruthByName& truth,
+                                          const std::function<std::string(const std::string&)>& truth_name) {
+  RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(model_dir));
+  ModelScore score;
+  std::vector<CameraPose> estimated, reference;
+  for (const SfmImage& image : model.images) {
+    if (!image.registered) continue;
+    ++score.registered;
+    const auto gt = truth.find(truth_name(image.name));
+    if (gt == truth.end()) return NotFound(model_dir + ": " + image.name + " has no ground truth");
+    estimated.push_back({image.cam_from_world.rotation, image.Center()});
+    reference.push_back(PoseOf(gt->second));
+  }
+  RECONAR_ASSIGN_OR_RETURN(score.errors, CameraCenterErrors(estimated, reference));
+  return score;
+}
 
 Result<CameraPoseErrors> CameraCenterErrors(const std::vector<CameraPose>& estimated,
                                             const std::vector<CameraPose>& ground_truth) {

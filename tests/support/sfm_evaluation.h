@@ -2,11 +2,11 @@
 // Accuracy of estimated camera poses against ground truth, for the SfM tests and benchmarks:
 // a 7-DoF similarity aligns the estimated camera centres to the true ones, then each camera gets
 // a centre error (ground-truth units) and a rotation error (degrees). Test support only.
+#include <Eigen/Core>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/base/status.h"
 #include "core/math/sim3.h"
@@ -52,6 +52,16 @@ Result<CameraPoseErrors> CameraCenterErrors(const std::vector<CameraPose>& estim
 
 // Ground truth by image name ("0000.jpg", "templeR0001.png").
 using GroundTruthByName = std::map<std::string, GroundTruthCamera>;
+
+// The registered cameras of the COLMAP text model in `model_dir` against the truth (7-DoF
+// aligned), each image's truth found under truth_name(its name). NotFound naming an image without
+// truth; the reader's error for an unreadable model; CameraCenterErrors' for fewer than 3 cameras.
+struct ModelScore {
+  int registered = 0;
+  CameraPoseErrors errors;
+};
+Result<ModelScore> ScoreModelAgainstTruth(const std::string& model_dir, const GroundTruthByName& truth,
+                                          const std::function<std::string(const std::string&)>& truth_name);
 
 // Every NAME.camera in `dir` (Strecha gt_cameras/), keyed by NAME.
 Result<GroundTruthByName> ReadStrechaGroundTruth(const std::string& dir);

@@ -371,34 +371,12 @@ TEST(CaptureCli, AFullDiskEndsWithAClearErrorAndNoHalfFile) {
   fs::remove_all(root);
 }
 
-// A model's registered cameras against the truth (7-DoF aligned), each image's truth found by
-// `truth_name` of its name ("" for none: a failure).
-struct ModelScore {
-  int registered = 0;
-  testing::CameraPoseErrors errors;
-};
-ModelScore ScoreAgainstTruth(const fs::path& model_dir, const testing::GroundTruthByName& truth,
-                             const std::function<std::string(const std::string&)>& truth_name) {
-  ModelScore score;
-  auto model = ReadColmapTextModel(model_dir.string());
-  EXPECT_TRUE(model.ok()) << model.status().ToString();
-  if (!model.ok()) return score;
-  std::vector<testing::CameraPose> estimated, reference;
-  for (const SfmImage& image : model->images) {
-    if (!image.registered) continue;
-    ++score.registered;
-    const auto gt = truth.find(truth_name(image.name));
-    if (gt == truth.end()) {
-      ADD_FAILURE() << image.name << " has no ground truth";
-      continue;
-    }
-    estimated.push_back({image.cam_from_world.rotation, image.Center()});
-    reference.push_back(testing::PoseOf(gt->second));
-  }
-  auto errors = testing::CameraCenterErrors(estimated, reference);
-  EXPECT_TRUE(errors.ok()) << errors.status().ToString();
-  if (errors.ok()) score.errors = *errors;
-  return score;
+// A model's registered cameras against the truth (sfm_evaluation.h); a failure when unreadable.
+testing::ModelScore ScoreAgainstTruth(const fs::path& model_dir, const testing::GroundTruthByName& truth,
+                                      const std::function<std::string(const std::string&)>& truth_name) {
+  auto score = testing::ScoreModelAgainstTruth(model_dir.string(), truth, truth_name);
+  EXPECT_TRUE(score.ok()) << score.status().ToString();
+  return score.ok() ? *score : testing::ModelScore();
 }
 
 // A hand-held video with known poses: a slow walk down the rendered corridor (corridor_walk.h: its
@@ -453,7 +431,7 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
   }
   const int keyframes = static_cast<int>(frame_of_keyframe.size());
   ASSERT_GE(keyframes, 5);
-  const ModelScore live = ScoreAgainstTruth(project / "live", *truth, [&](const std::string& name) {
+  const testing::ModelScore live = ScoreAgainstTruth(project / "live", *truth, [&](const std::string& name) {
     const auto it = frame_of_keyframe.find(name);
     return it == frame_of_keyframe.end() ? std::string() : it->second;
   });
@@ -469,11 +447,11 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
   ASSERT_EQ(continued_run.exit_code, 0) << continued_run.output;
   EXPECT_NE(continued_run.output.find("continued from the capture's live model"), std::string::npos)
       << continued_run.output;
-  const ModelScore continued = ScoreAgainstTruth(project / "sparse", *truth, frame_of);
+  const testing::ModelScore continued = ScoreAgainstTruth(project / "sparse", *truth, frame_of);
   const CommandRun offline_run =
       RunReconar("sfm " + (project / "images").string() + " " + (root / "offline").string() + " --threads 2");
   ASSERT_EQ(offline_run.exit_code, 0) << offline_run.output;
-  const ModelScore offline = ScoreAgainstTruth(root / "offline" / "sparse", *truth, frame_of);
+  const testing::ModelScore offline = ScoreAgainstTruth(root / "offline" / "sparse", *truth, frame_of);
 
   // Every k-th frame, k giving as many frames as the capture took keyframes.
   const int k = std::max(1, static_cast<int>(std::lround(static_cast<double>(walk.frames) / keyframes)));
@@ -483,7 +461,7 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
   const fs::path kth_dir = testing::LinkFiles((root / "every_kth").string(), video.string(), every_kth);
   const CommandRun sfm =
       RunReconar("sfm " + kth_dir.string() + " " + (root / "every_kth_project").string() + " --threads 2");
-  ModelScore kth;
+  testing::ModelScore kth;
   if (sfm.exit_code == 0) {
     kth =
         ScoreAgainstTruth(root / "every_kth_project" / "sparse", *truth, [](const std::string& name) { return name; });

@@ -1,0 +1,115 @@
+// bench_live_model OUT_DIR [frames=300] [step_m=0.05]: how the capture's live model keeps up as a
+// capture grows. A walk down the rendered corridor (tests/support/corridor_walk.h, exact poses) is
+// replayed through `reconar capture`'s loop at 30 frames per second, as a camera would deliver it;
+// printed: the keyframes and how many registered, the time from a keyframe being written to its
+// registration over the first and the last quarter of the keyframes, the worker's time per step,
+// the final adjustment, and the live model's cameras against the truth beside `sfm` run offline on
+// the same keyframes.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/base/median.h"
+#include "core/pipeline/reconstruct.h"
+#include "render/ar/capture_session.h"
+#include "tests/support/corridor_walk.h"
+#include "tests/support/sfm_evaluation.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+int Fail(const reconar::Status& status) {
+  std::fprintf(stderr, "bench_live_model: %s\n", status.ToString().c_str());
+  return 1;
+}
+
+// Latency (taken -> registered) of keyframes [from, to): median and maximum, seconds.
+void PrintLatency(const char* what, const std::vector<reconar::LiveKeyframe>& keyframes, size_t from, size_t to) {
+  std::vector<double> latency;
+  for (size_t k = from; k < to && k < keyframes.size(); ++k) {
+    if (keyframes[k].registered_seconds >= 0.0)
+      latency.push_back(keyframes[k].registered_seconds - keyframes[k].taken_seconds);
+  }
+  const double max = latency.empty() ? 0.0 : *std::max_element(latency.begin(), latency.end());
+  std::printf("  %s (keyframes %zu-%zu): %zu registered, latency median %.2f s, max %.2f s\n", what, from + 1,
+              std::min(to, keyframes.size()), latency.size(), reconar::Median(latency), max);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: bench_live_model OUT_DIR [frames=300] [step_m=0.05]\n");
+    return 2;
+  }
+  const fs::path out = argv[1];
+  reconar::testing::CorridorWalkOptions walk;
+  walk.frames = argc > 2 ? std::max(30, std::atoi(argv[2])) : 300;
+  walk.step_m = argc > 3 ? std::atof(argv[3]) : 0.05;
+  walk.length_m = std::max(walk.length_m, walk.frames * walk.step_m + 4.0);
+  std::error_code error;
+  fs::remove_all(out, error);
+  const fs::path video = out / "video";
+  fs::create_directories(video, error);
+  if (error) return Fail(reconar::IoError(video.string() + ": cannot create the directory: " + error.message()));
+  std::printf("rendering %d frames of a %.2f m walk...\n", walk.frames, walk.step_m * (walk.frames - 1));
+  auto truth = reconar::testing::RenderCorridorWalk(video.string(), walk);
+  if (!truth.ok()) return Fail(truth.status());
+  std::vector<std::string> names;
+  for (const auto& entry : *truth) names.push_back(entry.first);
+  std::sort(names.begin(), names.end());
+
+  reconar::CaptureOptions capture;
+  capture.source = video.string();
+  capture.project_dir = (out / "capture").string();
+  capture.replay_in_real_time = true;
+  std::map<std::string, std::string> frame_of_keyframe;
+  auto report = reconar::RunCapture(capture, [&](const reconar::CaptureEvent& event) {
+    if (event.kind != reconar::CaptureEvent::Kind::kKeyframe) return;
+    frame_of_keyframe[fs::path(event.path).filename().string()] = names[static_cast<size_t>(event.frame_index)];
+  });
+  if (!report.ok()) return Fail(report.status());
+  const reconar::LiveReconstructionReport& live = report->live_model;
+  const size_t n = live.keyframes.size();
+  std::printf("%d frames at 30 fps: %zu keyframes, %d registered in the live model (%d points)\n", report->frames, n,
+              live.registered, live.points);
+  PrintLatency("first quarter", live.keyframes, 0, n / 4);
+  PrintLatency("last quarter ", live.keyframes, n - n / 4, n);
+  std::printf("  latency over all: median %.2f s, p95 %.2f s\n", live.median_latency_seconds, live.p95_latency_seconds);
+  std::printf("  worker: features %.2f s, matching %.2f s, mapping %.2f s; final adjustment %.2f s\n",
+              live.seconds_features, live.seconds_matching, live.seconds_mapping, live.seconds_final_adjustment);
+
+  const auto frame_of = [&](const std::string& name) {
+    const auto it = frame_of_keyframe.find(name);
+    return it == frame_of_keyframe.end() ? std::string() : it->second;
+  };
+  const double path = walk.step_m * (walk.frames - 1);
+  auto live_score = reconar::testing::ScoreModelAgainstTruth(capture.project_dir + "/live", *truth, frame_of);
+  if (!live_score.ok()) return Fail(live_score.status());
+  reconar::ReconstructOptions offline;
+  offline.run_dense = offline.run_mesh = false;
+  offline.show_progress = false;
+  std::vector<std::string> keyframe_paths = report->keyframe_files;
+  const auto offline_start = std::chrono::steady_clock::now();
+  auto offline_report = reconar::RunReconstruct(keyframe_paths, reconar::Project((out / "offline").string()), offline);
+  if (!offline_report.ok()) return Fail(offline_report.status());
+  const double offline_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - offline_start).count();
+  auto offline_score =
+      reconar::testing::ScoreModelAgainstTruth((out / "offline" / "sparse").string(), *truth, frame_of);
+  if (!offline_score.ok()) return Fail(offline_score.status());
+  std::printf("live model:  %d registered, centre error mean %.4f %% of the %.2f m walk, rotation mean %.3f deg\n",
+              live_score->registered, 100.0 * live_score->errors.centre_mean / path, path,
+              live_score->errors.rotation_mean_deg);
+  std::printf("offline sfm: %d registered, centre error mean %.4f %%, rotation mean %.3f deg (%.1f s)\n",
+              offline_score->registered, 100.0 * offline_score->errors.centre_mean / path,
+              offline_score->errors.rotation_mean_deg, offline_seconds);
+  return 0;
+}
