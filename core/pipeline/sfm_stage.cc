@@ -70,9 +70,11 @@ void FocalStatistics(const Reconstruction& rec, SfmStageReport* report) {
   report->focal_35mm_equivalent = 36.0 * mean;  // the long side of a 36 x 24 mm frame
 }
 
-// The capture's live model (PROJECT/live/) when options allow and it can seed the mapper; else an
+// The capture's live model (PROJECT/live/) when options allow and it can seed the mapper, without
+// the photos the project no longer holds (`index_of`: the project's photos by name); else an
 // error, with *note saying why ("not used: ...") when there is a model.
-Result<Reconstruction> LiveModel(const Project& project, const SfmStageOptions& options, std::string* note) {
+Result<Reconstruction> LiveModel(const Project& project, const SfmStageOptions& options,
+                                 const std::map<std::string, int>& index_of, std::string* note) {
   note->clear();
   const std::string dir = project.LiveDir();
   std::error_code error;
@@ -83,8 +85,9 @@ Result<Reconstruction> LiveModel(const Project& project, const SfmStageOptions& 
     *note = "not used: " + live.status().message();
     return live.status();
   }
+  for (SfmImage& image : live->images) image.registered = image.registered && index_of.count(image.name) > 0;
   if (live->NumRegisteredImages() < 2) {
-    *note = "not used: " + dir + " holds fewer than two photos";
+    *note = "not used: " + dir + " holds fewer than two of the photos";
     return FailedPrecondition(*note);
   }
   return live;
@@ -200,7 +203,7 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   };
   std::vector<Reconstruction> other_models;
   Result<Reconstruction> reconstruction = InvalidArgument("not mapped");
-  Result<Reconstruction> live = LiveModel(project, options, &report.live_model);
+  Result<Reconstruction> live = LiveModel(project, options, index_of, &report.live_model);
   if (live.ok()) {
     reconstruction = ContinueFromLiveModel(*live, images, pairs, options.mapper, on_progress, &report);
   }

@@ -33,10 +33,11 @@ struct SfmStageOptions {
   bool show_progress = true;
   // When PROJECT/live/ holds the model a capture grew (live_reconstruction.h), the mapper continues
   // from it (ContinueIncrementalMapper: its poses and cameras, every track triangulated again, the
-  // other photos registered, the tags added, the final adjustment) instead of starting over. It is
-  // passed over, with the reason in the report, when it cannot be read or names a photo that is not
-  // the project's; and when the continued model holds under half the photos, the mapper also runs
-  // from scratch and the larger model is kept.
+  // other photos registered, the tags added, the final adjustment) instead of starting over. Its
+  // photos the project no longer holds are left out. It is passed over, with the reason in the
+  // report, when it cannot be read, holds fewer than two of the photos, or has one of another size;
+  // and when the continued model holds under half the photos, the mapper also runs from scratch and
+  // the larger model is kept.
   bool continue_from_live = true;
 };
 

@@ -271,6 +271,20 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
     EXPECT_EQ(ReadBytes(project / features), ReadBytes(root / "offline" / features)) << features;
   }
 
+  // Two keyframes taken out of the photos: the mapping still continues from the live model, without them.
+  const std::vector<fs::path> all_keyframes = Keyframes(project);
+  ASSERT_GE(all_keyframes.size(), 4u);
+  std::vector<std::string> kept;
+  for (size_t k = 0; k + 2 < all_keyframes.size(); ++k) kept.push_back(all_keyframes[k].filename().string());
+  const std::string subset = testing::LinkFiles((root / "subset_photos").string(), (project / "images").string(), kept);
+  fs::copy(project, root / "subset", fs::copy_options::recursive);
+  const CommandRun fewer = RunReconar("sfm " + subset + " " + (root / "subset").string() + " --threads 2");
+  ASSERT_EQ(fewer.exit_code, 0) << fewer.output;
+  EXPECT_NE(fewer.output.find("continued from the capture's live model"), std::string::npos) << fewer.output;
+  auto fewer_report = ReadJsonFile((root / "subset" / "sparse" / "report.json").string());
+  ASSERT_TRUE(fewer_report.ok()) << fewer_report.status().ToString();
+  EXPECT_EQ(Number(*fewer_report, "registered"), static_cast<double>(kept.size()));
+
   // A damaged live model is passed over with the reason, and the mapper starts over.
   {
     std::ofstream damaged(project / "live" / "images.txt", std::ios::app);
