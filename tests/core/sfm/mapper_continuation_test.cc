@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -57,8 +56,8 @@ SceneOptions Ring() {
 }
 
 // A photo at a time, grown with local adjustments and adjusted as a whole once at the end: as
-// accurate as the mapper's run over all the photos at once, with far fewer global adjustments than
-// adjusting the whole model after every photo (each continuation final).
+// accurate as the mapper's run over all the photos at once, with a global adjustment only at growth
+// milestones, not at every photo (bench_live_model measures the time this saves).
 TEST(MapperContinuationTest, AModelGrownAPhotoAtATimeMatchesTheWholeRun) {
   const SceneOptions options = Ring();
   const Scene scene = MakeScene(options);
@@ -66,70 +65,52 @@ TEST(MapperContinuationTest, AModelGrownAPhotoAtATimeMatchesTheWholeRun) {
   const int n = static_cast<int>(scene.images.size());
 
   int first = 2;
-  Result<Reconstruction> start = InvalidArgument("no initial pair yet");
-  while (!start.ok() && first < n) {
+  Result<Reconstruction> model = InvalidArgument("no initial pair yet");
+  while (!model.ok() && first < n) {
     ++first;
     const Prefix prefix = FirstImages(scene, first);
-    start = RunIncrementalMapper(prefix.images, prefix.pairs, mapper, nullptr);
+    model = RunIncrementalMapper(prefix.images, prefix.pairs, mapper, nullptr);
   }
-  ASSERT_TRUE(start.ok()) << start.status().ToString();
-
-  struct Grown {
-    Reconstruction model;
-    int global_adjustments = 0;
-    double seconds = 0.0;
-  };
-  // Each photo continued with local adjustments (growth) or with the final adjustment every time.
-  const auto grow = [&](bool final_each_time) -> Grown {
-    Grown grown;
-    grown.model = *start;
-    MapperContinuation growth;
-    growth.final_adjustment = final_each_time;
-    growth.registered_at_last_global = start->NumRegisteredImages();
-    const auto begin = std::chrono::steady_clock::now();
-    for (int size = first + 1; size <= n; ++size) {
-      const Prefix prefix = FirstImages(scene, size);
-      MapperReport report;
-      Result<Reconstruction> model =
-          ContinueIncrementalMapper(prefix.images, prefix.pairs, mapper, grown.model, &growth, &report);
-      EXPECT_TRUE(model.ok()) << "at " << size << ": " << model.status().ToString();
-      if (!model.ok()) return grown;
-      EXPECT_EQ(model->NumRegisteredImages(), size) << "the new photo registers at once";
-      grown.global_adjustments += report.num_global_ba;
-      grown.model = std::move(model).value();
-    }
-    if (!final_each_time) {
-      MapperReport report;
-      Result<Reconstruction> model = ContinueIncrementalMapper(scene.images, scene.pairs, mapper, grown.model);
-      EXPECT_TRUE(model.ok()) << model.status().ToString();
-      if (model.ok()) grown.model = std::move(model).value();
-    }
-    grown.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    return grown;
-  };
-  const Grown growing = grow(false);
-  const Grown final_each_time = grow(true);
-  ASSERT_EQ(growing.model.NumRegisteredImages(), n);
-  ASSERT_EQ(final_each_time.model.NumRegisteredImages(), n);
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+  MapperContinuation growth;
+  growth.final_adjustment = false;
+  growth.registered_at_last_global = model->NumRegisteredImages();
+  int global_adjustments = 0;
+  for (int size = first + 1; size <= n; ++size) {
+    const Prefix prefix = FirstImages(scene, size);
+    MapperReport report;
+    model = ContinueIncrementalMapper(prefix.images, prefix.pairs, mapper, *model, &growth, &report);
+    ASSERT_TRUE(model.ok()) << "at " << size << ": " << model.status().ToString();
+    EXPECT_EQ(model->NumRegisteredImages(), size) << "the new photo registers at once";
+    global_adjustments += report.num_global_ba;
+  }
+  model = ContinueIncrementalMapper(scene.images, scene.pairs, mapper, *model);
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+  ASSERT_EQ(model->NumRegisteredImages(), n);
 
   Result<Reconstruction> whole = RunIncrementalMapper(scene.images, scene.pairs, mapper, nullptr);
   ASSERT_TRUE(whole.ok()) << whole.status().ToString();
-  const testing::CameraPoseErrors grown = ErrorsAgainstTruth(growing.model, scene);
-  const testing::CameraPoseErrors adjusted_each_time = ErrorsAgainstTruth(final_each_time.model, scene);
+  const testing::CameraPoseErrors grown = ErrorsAgainstTruth(*model, scene);
   const testing::CameraPoseErrors at_once = ErrorsAgainstTruth(*whole, scene);
   std::printf(
-      "  from %d photos on: growing %d global adjustments, %.2f s, centre error mean %.5f max %.5f, rotation max "
-      "%.4f deg; final adjustment each time %d, %.2f s, mean %.5f; all at once: mean %.5f max %.5f\n",
-      first, growing.global_adjustments, growing.seconds, grown.centre_mean, grown.centre_max, grown.rotation_max_deg,
-      final_each_time.global_adjustments, final_each_time.seconds, adjusted_each_time.centre_mean, at_once.centre_mean,
-      at_once.centre_max);
-  EXPECT_LT(2 * growing.global_adjustments, final_each_time.global_adjustments);
+      "  grown from %d photos: %d global adjustments; centre error mean %.5f max %.5f, rotation max %.4f deg, "
+      "relative %.4f deg; all at once: mean %.5f max %.5f, rotation max %.4f deg, relative %.4f deg\n",
+      first, global_adjustments, grown.centre_mean, grown.centre_max, grown.rotation_max_deg,
+      grown.relative_rotation_mean_deg, at_once.centre_mean, at_once.centre_max, at_once.rotation_max_deg,
+      at_once.relative_rotation_mean_deg);
+  // A global refinement is two adjustments (mapper.cc); one per photo would be 2 (n - first).
+  EXPECT_LT(global_adjustments, 2 * (n - first));
   // The bound of the mapper's ring test (1 % of the radius; see mapper_test.cc), and no worse than
   // the run over all photos by more than half again.
   EXPECT_LT(grown.centre_max, 0.01 * options.ring_radius);
   EXPECT_LE(grown.centre_mean, 1.5 * at_once.centre_mean + 1e-4 * options.ring_radius);
-  EXPECT_LT(grown.rotation_max_deg, 0.25);
-  EXPECT_NEAR(growing.model.cameras[0].focal, scene.camera.focal, 0.01 * scene.camera.focal);
+  // Orientation, as in mapper_test.cc: the principal point trades against a rotation of every
+  // camera (1 px ~ 0.064 degrees) and is found to a few pixels (aarch64: 0.35 degrees of common
+  // rotation here); the relative rotations are free of that. A wrongly registered camera is off by
+  // degrees.
+  EXPECT_LT(grown.rotation_max_deg, 0.5);
+  EXPECT_LT(grown.relative_rotation_mean_deg, 0.25);
+  EXPECT_NEAR(model->cameras[0].focal, scene.camera.focal, 0.01 * scene.camera.focal);
 }
 
 // A model is found by its images' names: continued over the images in another order, with more
@@ -169,17 +150,25 @@ TEST(MapperContinuationTest, TheSeedIsFoundByNameInAnyOrder) {
 }
 
 TEST(MapperContinuationTest, ASeedOfOtherImagesIsInvalidArgument) {
-  const Scene scene = MakeScene(Ring());
+  SceneOptions small = Ring();
+  small.num_cameras = 6;
+  small.num_points = 600;
+  const Scene scene = MakeScene(small);
   const MapperOptions mapper = testing::SingleThreaded();
   Result<Reconstruction> seed = RunIncrementalMapper(scene.images, scene.pairs, mapper, nullptr);
   ASSERT_TRUE(seed.ok()) << seed.status().ToString();
 
+  const auto registered = std::find_if(seed->images.begin(), seed->images.end(),
+                                       [](const SfmImage& image) { return image.registered; });
+  ASSERT_NE(registered, seed->images.end());
+  const size_t renamed_image = static_cast<size_t>(registered - seed->images.begin());
   std::vector<MapperImage> renamed = scene.images;
-  renamed[3].name = "another.jpg";
+  renamed[renamed_image].name = "another.jpg";
   Result<Reconstruction> other = ContinueIncrementalMapper(renamed, scene.pairs, mapper, *seed);
   ASSERT_FALSE(other.ok());
   EXPECT_EQ(other.status().code(), StatusCode::kInvalidArgument);
-  EXPECT_NE(other.status().message().find(scene.images[3].name), std::string::npos) << other.status().ToString();
+  EXPECT_NE(other.status().message().find(scene.images[renamed_image].name), std::string::npos)
+      << other.status().ToString();
 
   std::vector<MapperImage> resized = scene.images;
   for (MapperImage& image : resized) image.width *= 2;
