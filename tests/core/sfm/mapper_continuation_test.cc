@@ -104,12 +104,13 @@ TEST(MapperContinuationTest, AModelGrownAPhotoAtATimeMatchesTheWholeRun) {
   // the run over all photos by more than half again.
   EXPECT_LT(grown.centre_max, 0.01 * options.ring_radius);
   EXPECT_LE(grown.centre_mean, 1.5 * at_once.centre_mean + 1e-4 * options.ring_radius);
-  // Orientation, as in mapper_test.cc: the principal point trades against a rotation of every
-  // camera (1 px ~ 0.064 degrees) and is found to a few pixels (aarch64: 0.35 degrees of common
-  // rotation here); the relative rotations are free of that. A wrongly registered camera is off by
-  // degrees.
-  EXPECT_LT(grown.rotation_max_deg, 0.5);
-  EXPECT_LT(grown.relative_rotation_mean_deg, 0.25);
+  // Orientation, against the run over all photos: the principal point, found to a few pixels, trades
+  // against a rotation of every camera (1 px ~ 0.064 degrees; see mapper_test.cc), and how well
+  // depends on the platform's arithmetic (the whole run: 0.15 degrees at most on x86-64, 0.35 on
+  // aarch64). A wrongly registered camera is off by degrees.
+  EXPECT_LE(grown.rotation_max_deg, 1.5 * at_once.rotation_max_deg + 0.05);
+  EXPECT_LE(grown.relative_rotation_mean_deg, 1.5 * at_once.relative_rotation_mean_deg + 0.05);
+  EXPECT_LT(grown.rotation_max_deg, 1.0);
   EXPECT_NEAR(model->cameras[0].focal, scene.camera.focal, 0.01 * scene.camera.focal);
 }
 
