@@ -275,7 +275,7 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
   const std::vector<fs::path> all_keyframes = Keyframes(project);
   ASSERT_GE(all_keyframes.size(), 4u);
   std::vector<std::string> kept;
-  for (size_t k = 0; k + 2 < all_keyframes.size(); ++k) kept.push_back(all_keyframes[k].filename().string());
+  for (size_t i = 0; i + 2 < all_keyframes.size(); ++i) kept.push_back(all_keyframes[i].filename().string());
   const std::string subset = testing::LinkFiles((root / "subset_photos").string(), (project / "images").string(), kept);
   fs::copy(project, root / "subset", fs::copy_options::recursive);
   const CommandRun fewer = RunReconar("sfm " + subset + " " + (root / "subset").string() + " --threads 2");
