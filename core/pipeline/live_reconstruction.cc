@@ -81,6 +81,7 @@ LiveReconstructionOptions::LiveReconstructionOptions() {
 
 LiveReconstruction::LiveReconstruction(const Project& project, const LiveReconstructionOptions& options)
     : project_(project), options_(options), start_(Clock::now()), extractor_(options.features) {
+  growth_.final_adjustment = false;
   worker_ = std::thread([this] { Work(); });
 }
 
@@ -206,19 +207,17 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   seconds_matching_ += SecondsBetween(matching_start, mapping_start);
 
   // The new keyframe gets the local adjustment; the whole model a global one at growth milestones.
-  MapperContinuation growth;
-  growth.final_adjustment = false;
-  growth.registered_at_last_global = registered_at_last_global_;
   Result<Reconstruction> grown =
-      has_model_ ? ContinueIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), model_, &growth)
+      has_model_ ? ContinueIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), model_, &growth_)
                  : RunIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), nullptr);
+  bool started_afresh = !has_model_;
   if (has_model_ && grown.ok() && 2 * grown->NumRegisteredImages() < static_cast<int>(images_.size())) {
     // A model that holds under half the keyframes may have started from a poor pair (the first two
     // keyframes of a walk forward): the mapper from scratch chooses its pair among all of them.
     Result<Reconstruction> fresh = RunIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), nullptr);
     if (fresh.ok() && fresh->NumRegisteredImages() > grown->NumRegisteredImages()) {
       grown = std::move(fresh);
-      growth.registered_at_last_global = grown->NumRegisteredImages();
+      started_afresh = true;
     }
   }
   seconds_mapping_ += SecondsBetween(mapping_start, Clock::now());
@@ -227,8 +226,8 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
     if (grown.status().code() == StatusCode::kFailedPrecondition) return Status::Ok();
     return grown.status();
   }
-  if (!has_model_) growth.registered_at_last_global = grown->NumRegisteredImages();
-  registered_at_last_global_ = growth.registered_at_last_global;
+  // A model from scratch has had its global adjustments: the milestones count from it.
+  if (started_afresh) growth_.registered_at_last_global = grown->NumRegisteredImages();
   model_ = std::move(grown).value();
   has_model_ = true;
   model_final_ = false;

@@ -123,7 +123,7 @@ class LiveReconstruction {
   Reconstruction model_;
   bool has_model_ = false;
   bool model_final_ = false;           // model_ has had its final adjustment
-  int registered_at_last_global_ = 0;  // MapperContinuation's milestone count
+  MapperContinuation growth_;          // local adjustments; global ones at growth milestones
   double seconds_features_ = 0.0, seconds_matching_ = 0.0, seconds_mapping_ = 0.0, seconds_final_adjustment_ = 0.0;
 
   std::thread worker_;

@@ -202,25 +202,20 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     shown = std::max(shown, done);
   };
   std::vector<Reconstruction> other_models;
-  Result<Reconstruction> reconstruction = InvalidArgument("not mapped");
-  Result<Reconstruction> live = LiveModel(project, options, index_of, &report.live_model);
-  if (live.ok()) {
-    reconstruction = ContinueFromLiveModel(*live, images, pairs, options.mapper, on_progress, &report);
+  Result<Reconstruction> reconstruction = LiveModel(project, options, index_of, &report.live_model);
+  if (reconstruction.ok()) {
+    reconstruction = ContinueFromLiveModel(*reconstruction, images, pairs, options.mapper, on_progress, &report);
   }
-  if (!live.ok() || !reconstruction.ok() ||
-      2 * reconstruction->NumRegisteredImages() < static_cast<int>(images.size())) {
+  if (!reconstruction.ok() || 2 * reconstruction->NumRegisteredImages() < static_cast<int>(images.size())) {
     MapperReport scratch_report;
     std::vector<Reconstruction> scratch_others;
     auto scratch = RunIncrementalMapper(images, pairs, options.mapper, &scratch_report, on_progress, &scratch_others);
-    if (scratch.ok() &&
-        (!reconstruction.ok() || scratch->NumRegisteredImages() > reconstruction->NumRegisteredImages())) {
+    if (!reconstruction.ok() ||
+        (scratch.ok() && scratch->NumRegisteredImages() > reconstruction->NumRegisteredImages())) {
       if (reconstruction.ok()) report.live_model = "not used: the mapper from scratch registered more photos";
       reconstruction = std::move(scratch);
       report.mapper = std::move(scratch_report);
       other_models = std::move(scratch_others);
-    } else if (!reconstruction.ok()) {
-      reconstruction = std::move(scratch);
-      report.mapper = std::move(scratch_report);
     }
   }
   if (progress) progress->Finish();
