@@ -18,7 +18,7 @@ constexpr char kHelp[] =
     "matches consistent with a fundamental matrix (normalised 8-point in LO-RANSAC, threshold\n"
     "0.6 % of the larger image side) and screens for planar/rotation-only pairs with a homography.\n"
     "  --pairs OUT.txt   write the verified matches, one 'xa ya xb yb' per line (pixels)\n"
-    "  --project DIR     match all pairs of a project made by `reconar features --project DIR`;\n"
+    "  --project DIR     match the pairs of a project made by `reconar features --project DIR`;\n"
     "                    writes DIR/matches/matches.txt\n"
     "  --memory-budget SIZE  with --project: memory for features and kd-forests (MiB, or 512K, 1500M,\n"
     "                    1G; default 2560M); when all images do not fit, blocks of images are matched two\n"
@@ -28,7 +28,10 @@ constexpr char kHelp[] =
     "  --f-threshold T   F inlier threshold as a fraction of the larger image side (default 0.006)\n"
     "  --threads N       worker threads (default: one per core)\n"
     "  --json            print the result as JSON on stdout\n"
-    "  plus the SIFT options of `reconar features` for the two-image form\n";
+    "  plus the SIFT options of `reconar features` for the two-image form; with --project, the pairs:\n"
+    "  --exhaustive-up-to N  every pair of the first N images (default 50); each later image is\n"
+    "  --window W            matched with the W before it (default 10) and the R earlier images most\n"
+    "  --retrieved R         like it by vocabulary-tree retrieval (default 40)\n";
 
 }  // namespace
 
@@ -40,6 +43,10 @@ Status ReadMatchArgs(const Args& args, MatchStageOptions* options) {
                            args.GetInt("min-inliers", options->two_view.min_inliers, 8, 1 << 20));
   RECONAR_ASSIGN_OR_RETURN(options->two_view.f_threshold_fraction,
                            args.GetDouble("f-threshold", options->two_view.f_threshold_fraction, 1e-5, 0.1));
+  PairSelectionOptions& pairs = options->pairs;
+  RECONAR_ASSIGN_OR_RETURN(pairs.exhaustive_up_to, args.GetInt("exhaustive-up-to", pairs.exhaustive_up_to, 2, 1 << 24));
+  RECONAR_ASSIGN_OR_RETURN(pairs.sequential_window, args.GetInt("window", pairs.sequential_window, 0, 1 << 24));
+  RECONAR_ASSIGN_OR_RETURN(pairs.retrieved, args.GetInt("retrieved", pairs.retrieved, 0, 1 << 24));
   RECONAR_ASSIGN_OR_RETURN(options->num_threads, args.GetThreads());
   options->match.num_threads = options->num_threads;
   return Status::Ok();
@@ -59,6 +66,7 @@ int MatchProject(const Args& args, MatchStageOptions options) {
     json.BeginObject().Key("images").Int(report->num_images).Key("pairs").Int(report->num_pairs);
     json.Key("verified").Int(report->num_verified).Key("planar").Int(report->num_planar);
     json.Key("rejected").Int(report->num_rejected).Key("blocks").Int(report->num_blocks);
+    json.Key("seconds_pair_selection").Double(report->seconds_pair_selection);
     json.Key("seconds").Double(report->seconds).Key("matches").String(project.MatchesPath()).EndObject();
     std::printf("%s\n", json.str().c_str());
     return 0;

@@ -28,6 +28,8 @@ constexpr char kHelp[] =
     "  --principal-point fixed|auto|refine, --fixed-distortion, --max-error PX, --merge-models\n"
     "                        as `reconar sfm`\n"
     "  --ratio R, --min-inliers N, --checks N, --f-threshold T   matching (defaults 0.8, 30, 200, 0.006)\n"
+    "  --exhaustive-up-to N, --window W, --retrieved R   the pairs matched, as `reconar match`\n"
+    "                        (defaults 50, 10, 40)\n"
     "  --level 0|1|2|auto    dense image resolution (default auto: the finest that fits the budget\n"
     "                        with the longest side at most --max-image-size)\n"
     "  --max-image-size N    dense: longest image side of the auto level (default 2400; 0: no limit)\n"

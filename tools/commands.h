@@ -43,10 +43,11 @@ inline const std::set<std::string> kSiftValuedOptions = {"first-octave",        
 // texture_poor_features; 0: off) and --texture-poor-contrast C.
 Result<FeatureStageOptions> FeatureStageOptionsFromArgs(const Args& args, int texture_poor_features = 0);
 
-// --ratio, --checks, --min-inliers, --f-threshold and --threads over the values `options` holds.
+// --ratio, --checks, --min-inliers, --f-threshold, --exhaustive-up-to, --window, --retrieved and
+// --threads over the values `options` holds.
 Status ReadMatchArgs(const Args& args, MatchStageOptions* options);
-inline const std::set<std::string> kMatchValuedOptions = {"ratio", "checks", "min-inliers", "f-threshold",
-                                                            "threads"};
+inline const std::set<std::string> kMatchValuedOptions = {
+    "ratio", "checks", "min-inliers", "f-threshold", "exhaustive-up-to", "window", "retrieved", "threads"};
 
 // --level 0|1|2|auto, --max-image-size N, --method pmvs|patchmatch and the flag --no-fill, shared by dense and
 // reconstruct (reconstruct_command.cc).

@@ -66,7 +66,7 @@ Status IndexError(const std::string& what, const std::string& reason) {
 // words with a non-zero tf-idf weight and their L1-normalised weights (weights holds count
 // floats). Returns how many were kept. Database images and queries both go through here, so equal
 // word lists give bit-equal vectors.
-int BagOfWords(int32_t* words, int count, const float* idf, float* weights) {
+int NormaliseBagOfWords(int32_t* words, int count, const float* idf, float* weights) {
   std::sort(words, words + count);
   int kept = 0;
   double total = 0.0;
@@ -475,6 +475,58 @@ Result<VocabularyTree> VocabularyTree::Deserialize(ByteReader* reader, const std
 }
 
 // ---------------------------------------------------------------------------------------------
+// Bags of words
+
+std::vector<float> InverseDocumentFrequency(int num_words, const std::vector<std::vector<int32_t>>& document_words) {
+  std::vector<int32_t> document_frequency(static_cast<size_t>(std::max(0, num_words)), 0);
+  std::vector<int32_t> words;
+  for (const std::vector<int32_t>& document : document_words) {
+    words = document;
+    std::sort(words.begin(), words.end());
+    const auto end = std::unique(words.begin(), words.end());
+    for (auto it = words.begin(); it != end; ++it) {
+      if (*it >= 0 && *it < num_words) ++document_frequency[static_cast<size_t>(*it)];
+    }
+  }
+  const double num_images = static_cast<double>(document_words.size());
+  std::vector<float> idf(document_frequency.size(), 0.0f);
+  for (size_t w = 0; w < idf.size(); ++w) {
+    const int32_t n = document_frequency[w];
+    if (n > 0) idf[w] = static_cast<float>(std::log(num_images / static_cast<double>(n)));
+  }
+  return idf;
+}
+
+BagOfWords MakeBagOfWords(std::vector<int32_t> words, const std::vector<float>& idf) {
+  const int32_t num_words = static_cast<int32_t>(idf.size());
+  words.erase(std::remove_if(words.begin(), words.end(), [num_words](int32_t w) { return w < 0 || w >= num_words; }),
+              words.end());
+  BagOfWords bag;
+  bag.weights.resize(words.size());
+  const int kept = NormaliseBagOfWords(words.data(), static_cast<int>(words.size()), idf.data(), bag.weights.data());
+  words.resize(static_cast<size_t>(kept));
+  bag.weights.resize(static_cast<size_t>(kept));
+  bag.words = std::move(words);
+  return bag;
+}
+
+float BagOfWordsScore(const BagOfWords& a, const BagOfWords& b) {
+  // The sum InvertedFile::Query accumulates over the postings, here by merging two sorted lists.
+  float score = 0.0f;
+  size_t i = 0, j = 0;
+  while (i < a.words.size() && j < b.words.size()) {
+    if (a.words[i] < b.words[j]) {
+      ++i;
+    } else if (b.words[j] < a.words[i]) {
+      ++j;
+    } else {
+      score += 2.0f * std::min(a.weights[i++], b.weights[j++]);
+    }
+  }
+  return score;
+}
+
+// ---------------------------------------------------------------------------------------------
 // Inverted file
 
 void RetrievalScratch::Reserve(int max_query_words, int num_images) {
@@ -496,40 +548,25 @@ Result<InvertedFile> InvertedFile::Build(int num_words, const std::vector<std::v
                            std::to_string(kMaxImages));
   }
   const int num_images = static_cast<int>(document_words.size());
-  // Document frequencies n_w.
-  std::vector<int32_t> document_frequency(static_cast<size_t>(num_words), 0);
-  std::vector<int32_t> words;
   for (int i = 0; i < num_images; ++i) {
-    words = document_words[static_cast<size_t>(i)];
-    for (const int32_t w : words) {
+    for (const int32_t w : document_words[static_cast<size_t>(i)]) {
       if (w < 0 || w >= num_words) {
         return InvalidArgument("InvertedFile: image " + std::to_string(i) + " has word " + std::to_string(w) +
                                " outside 0.." + std::to_string(num_words - 1));
       }
     }
-    std::sort(words.begin(), words.end());
-    const auto end = std::unique(words.begin(), words.end());
-    for (auto it = words.begin(); it != end; ++it) ++document_frequency[static_cast<size_t>(*it)];
   }
   InvertedFile file;
   file.num_images_ = num_images;
-  file.idf_.resize(static_cast<size_t>(num_words));
-  for (int w = 0; w < num_words; ++w) {
-    const int32_t n = document_frequency[static_cast<size_t>(w)];
-    file.idf_[static_cast<size_t>(w)] =
-        n > 0 ? static_cast<float>(std::log(static_cast<double>(num_images) / static_cast<double>(n))) : 0.0f;
-  }
+  file.idf_ = InverseDocumentFrequency(num_words, document_words);
   // Each image's bag of words, then the postings grouped by word in image order.
   std::vector<int32_t> bag_words;
   std::vector<float> bag_weights;
   std::vector<size_t> bag_begin(static_cast<size_t>(num_images) + 1, 0);
-  std::vector<float> weights;
   for (int i = 0; i < num_images; ++i) {
-    words = document_words[static_cast<size_t>(i)];
-    weights.resize(words.size());
-    const int kept = BagOfWords(words.data(), static_cast<int>(words.size()), file.idf_.data(), weights.data());
-    bag_words.insert(bag_words.end(), words.begin(), words.begin() + kept);
-    bag_weights.insert(bag_weights.end(), weights.begin(), weights.begin() + kept);
+    const BagOfWords bag = MakeBagOfWords(document_words[static_cast<size_t>(i)], file.idf_);
+    bag_words.insert(bag_words.end(), bag.words.begin(), bag.words.end());
+    bag_weights.insert(bag_weights.end(), bag.weights.begin(), bag.weights.end());
     bag_begin[static_cast<size_t>(i) + 1] = bag_words.size();
   }
   if (bag_words.size() > UINT32_MAX) return InvalidArgument("InvertedFile: more than 2^32 postings");
@@ -556,8 +593,8 @@ void InvertedFile::Query(const int32_t* words, int count, int top_k, RetrievalSc
     if (words[i] >= 0 && words[i] < num_words) scratch->words_.push_back(words[i]);
   }
   scratch->weights_.resize(scratch->words_.size());
-  const int distinct = BagOfWords(scratch->words_.data(), static_cast<int>(scratch->words_.size()), idf_.data(),
-                                  scratch->weights_.data());
+  const int distinct = NormaliseBagOfWords(scratch->words_.data(), static_cast<int>(scratch->words_.size()),
+                                           idf_.data(), scratch->weights_.data());
   if (scratch->accumulators_.size() < static_cast<size_t>(num_images_)) {
     scratch->accumulators_.resize(static_cast<size_t>(num_images_), 0.0f);
   }

@@ -66,6 +66,24 @@ class VocabularyTree {
   std::vector<uint8_t> centroids_;  // 128 bytes per node (the root's unused)
 };
 
+// An image's bag of words: its distinct words, ascending, with their L1-normalised tf-idf weights
+// (words of zero weight left out).
+struct BagOfWords {
+  std::vector<int32_t> words;
+  std::vector<float> weights;
+};
+
+// Per word, log(N / n_w) over N images' word lists (n_w: the images holding the word); 0 for a
+// word in no image. Words outside 0..num_words-1 are ignored.
+std::vector<float> InverseDocumentFrequency(int num_words, const std::vector<std::vector<int32_t>>& document_words);
+
+// An image's bag of words from its words (any order, repeats count) under `idf`; words outside
+// the idf table are ignored. Equal word lists give bit-equal bags.
+BagOfWords MakeBagOfWords(std::vector<int32_t> words, const std::vector<float>& idf);
+
+// 2 - |a - b|_1, as InvertedFile::Query scores a database image: 0 (nothing shared) .. 2 (equal).
+float BagOfWordsScore(const BagOfWords& a, const BagOfWords& b);
+
 // A database image's score against a query.
 struct RetrievalCandidate {
   int image = -1;

@@ -172,6 +172,9 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
     MatchOptions one_thread = options_.matching.match;
     one_thread.num_threads = 1;
     RECONAR_ASSIGN_OR_RETURN(matcher_, Matcher::Create(one_thread));
+    PairSelectionOptions pairs_on_one_thread = options_.matching.pairs;
+    pairs_on_one_thread.vocabulary.num_threads = 1;
+    RECONAR_ASSIGN_OR_RETURN(pair_selector_, PairSelector::Create(pairs_on_one_thread));
   }
   const int image = static_cast<int>(images_.size());
   RECONAR_RETURN_IF_ERROR(
@@ -187,9 +190,14 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   const auto matching_start = Clock::now();
   seconds_features_ += SecondsBetween(start, matching_start);
 
-  // Against every earlier keyframe, in the match stage's order (the earlier image queries).
+  // Against the earlier keyframes the pair rule chooses, as the match stage matches them (the
+  // earlier image queries).
+  RECONAR_ASSIGN_OR_RETURN(
+      const std::vector<int> partners,
+      pair_selector_->Add(features_.back().descriptors.data(), static_cast<int>(features_.back().keypoints.size())));
+  pairs_matched_ += static_cast<int>(partners.size());
   const ProjectImage& mine = images_.back();
-  for (int other = 0; other < image; ++other) {
+  for (const int other : partners) {
     RECONAR_ASSIGN_OR_RETURN(const std::vector<FeatureMatch> putative, matcher_->Match(other, image));
     const ProjectImage& theirs = images_[static_cast<size_t>(other)];
     Result<VerifiedPair> verified =
@@ -292,6 +300,8 @@ Result<LiveReconstructionReport> LiveReconstruction::Finish() {
   report.seconds_matching = seconds_matching_;
   report.seconds_mapping = seconds_mapping_;
   report.seconds_final_adjustment = seconds_final_adjustment_;
+  report.seconds_vocabulary = pair_selector_ ? pair_selector_->seconds_training() : 0.0;
+  report.pairs_matched = pairs_matched_;
   std::vector<double> latencies;
   for (const LiveKeyframe& keyframe : report.keyframes) {
     if (keyframe.registered_seconds >= 0.0) latencies.push_back(keyframe.registered_seconds - keyframe.taken_seconds);
@@ -330,6 +340,8 @@ Result<LiveReconstructionReport> LiveReconstruction::Finish() {
   json.Key("seconds_matching").Double(report.seconds_matching);
   json.Key("seconds_mapping").Double(report.seconds_mapping);
   json.Key("seconds_final_adjustment").Double(report.seconds_final_adjustment);
+  json.Key("seconds_vocabulary").Double(report.seconds_vocabulary);
+  json.Key("pairs_matched").Int(report.pairs_matched);
   json.Key("images").BeginArray();
   for (const LiveKeyframe& keyframe : report.keyframes) {
     json.BeginObject().Key("path").String(keyframe.path).Key("taken_s").Double(keyframe.taken_seconds);

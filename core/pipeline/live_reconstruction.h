@@ -2,8 +2,9 @@
 // A sparse model that grows while photos arrive (`reconar capture`, issue 18). A worker thread
 // takes the keyframes in the order they were taken, one at a time:
 //   1. features, as the feature stage extracts them, written to PROJECT/features/ at once;
-//   2. matches against every earlier keyframe, verified as the match stage verifies them (the
-//      same pairs, in the same order: a capture holds tens of keyframes, not thousands);
+//   2. matches against the earlier keyframes PairSelector chooses (every one up to its exhaustive
+//      limit, then a sequential window plus retrieval), verified as the match stage verifies them:
+//      the same pairs, as the rule depends only on the keyframes so far;
 //   3. the model grown by ContinueIncrementalMapper (core/sfm/mapper.h) from the last one, or
 //      started once two keyframes make an initial pair: the new keyframe gets a local bundle
 //      adjustment, the whole model a global one when it has grown by a quarter, and the final
@@ -19,12 +20,14 @@
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "core/base/status.h"
 #include "core/features/matcher.h"
+#include "core/features/pair_selection.h"
 #include "core/pipeline/feature_stage.h"
 #include "core/pipeline/match_stage.h"
 #include "core/pipeline/project.h"
@@ -57,6 +60,8 @@ struct LiveReconstructionReport {
   double median_latency_seconds = 0.0;  // taken -> registered, over the keyframes that registered
   double p95_latency_seconds = 0.0;
   double seconds_features = 0.0, seconds_matching = 0.0, seconds_mapping = 0.0;  // the worker's time
+  double seconds_vocabulary = 0.0;  // of seconds_matching: training the pair rule's vocabulary
+  int pairs_matched = 0;
   double seconds_final_adjustment = 0.0;                                         // in Finish()
   std::string error;  // a failure that stopped the worker (the keyframes stay on disk)
 };
@@ -114,6 +119,7 @@ class LiveReconstruction {
   // The worker's own state.
   PhotoFeatureExtractor extractor_;
   std::unique_ptr<Matcher> matcher_;
+  std::optional<PairSelector> pair_selector_;
   std::vector<ProjectImage> images_;
   std::vector<SiftFeatures> features_;
   std::vector<size_t> keyframe_of_image_;  // images_[i] is queued_[keyframe_of_image_[i]]
@@ -125,6 +131,7 @@ class LiveReconstruction {
   bool model_final_ = false;           // model_ has had its final adjustment
   MapperContinuation growth_;          // local adjustments; global ones at growth milestones
   double seconds_features_ = 0.0, seconds_matching_ = 0.0, seconds_mapping_ = 0.0, seconds_final_adjustment_ = 0.0;
+  int pairs_matched_ = 0;
 
   std::thread worker_;
 };

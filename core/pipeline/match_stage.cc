@@ -29,6 +29,37 @@ std::vector<Eigen::Vector2d> Positions(const SiftFeatures& features, const std::
   return points;
 }
 
+// Every pair of a project no larger than the exhaustive limit; beyond, PairSelector's choice, fed
+// the images in order (read from their files where the memory budget left them unloaded).
+Result<std::vector<std::pair<int, int>>> ChoosePairs(const Project& project, const std::vector<ProjectImage>& images,
+                                                     const std::vector<FeatureFile>& files, bool loaded,
+                                                     const PairSelectionOptions& options, int threads) {
+  const int n = static_cast<int>(images.size());
+  std::vector<std::pair<int, int>> pairs;
+  if (n <= options.exhaustive_up_to) {
+    for (int i = 0; i < n; ++i) {
+      for (int j = i + 1; j < n; ++j) pairs.emplace_back(i, j);
+    }
+    return pairs;
+  }
+  PairSelectionOptions on_threads = options;
+  on_threads.vocabulary.num_threads = threads;
+  RECONAR_ASSIGN_OR_RETURN(PairSelector selector, PairSelector::Create(on_threads));
+  for (int j = 0; j < n; ++j) {
+    const SiftFeatures* features = &files[static_cast<size_t>(j)].features;
+    FeatureFile read;
+    if (!loaded) {
+      RECONAR_ASSIGN_OR_RETURN(read, ReadFeatureFile(project.FeaturePath(images[static_cast<size_t>(j)].name)));
+      features = &read.features;
+    }
+    RECONAR_ASSIGN_OR_RETURN(const std::vector<int> partners,
+                             selector.Add(features->descriptors.data(), static_cast<int>(features->keypoints.size())));
+    for (const int i : partners) pairs.emplace_back(i, j);
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
 }  // namespace
 
 double MatchBytesPerFeature(const MatchOptions& match, int workers) {
@@ -54,7 +85,8 @@ std::string MatchStageSettings(const MatchStageOptions& options) {
   return StageRecord::Settings({{"ratio", options.match.max_ratio},
                                 {"checks", options.match.max_leaf_checks},
                                 {"min_inliers", options.two_view.min_inliers},
-                                {"f_threshold", options.two_view.f_threshold_fraction}});
+                                {"f_threshold", options.two_view.f_threshold_fraction}}) +
+         " pairs=" + options.pairs.Describe();
 }
 
 Status WriteMatchesFile(const Project& project, const std::vector<ProjectImage>& images,
@@ -88,6 +120,7 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
     return InvalidArgument(project.ImageListPath() + ": matching needs at least two images, the project has " +
                            std::to_string(images.size()));
   }
+  RECONAR_RETURN_IF_ERROR(options.pairs.Check());
   const int n = static_cast<int>(images.size());
   const int threads = std::min<int>(ThreadPool::ResolveThreadCount(options.num_threads), n * (n - 1) / 2);
   ThreadPool pool(threads);
@@ -143,14 +176,16 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
     std::sort(bytes_of_block.rbegin(), bytes_of_block.rend());
     peak_bytes = bytes_of_block[0] + (bytes_of_block.size() > 1 ? bytes_of_block[1] : 0.0);
   }
-  // The pairs in the usual order, grouped by the pair of blocks they fall in.
-  std::vector<std::pair<int, int>> pairs;
+  // The chosen pairs in the usual order (image_a < image_b), grouped by the pair of blocks they fall in.
+  const auto selection_start = Clock::now();
+  using ImagePairs = std::vector<std::pair<int, int>>;
+  RECONAR_ASSIGN_OR_RETURN(const ImagePairs pairs,
+                           ChoosePairs(project, images, files, all_loaded, options.pairs, pool.num_threads()));
+  const double seconds_pair_selection = std::chrono::duration<double>(Clock::now() - selection_start).count();
   std::vector<std::vector<size_t>> pairs_of_blocks(static_cast<size_t>(num_blocks * num_blocks));
-  for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) {
-      pairs_of_blocks[static_cast<size_t>(block_of[i] * num_blocks + block_of[j])].push_back(pairs.size());
-      pairs.emplace_back(i, j);
-    }
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    pairs_of_blocks[static_cast<size_t>(block_of[pairs[p].first] * num_blocks + block_of[pairs[p].second])].push_back(
+        p);
   }
 
   MatchOptions per_worker = options.match;
@@ -219,6 +254,7 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
   report.num_images = static_cast<int>(images.size());
   report.num_pairs = static_cast<int>(pairs.size());
   report.num_blocks = num_blocks;
+  report.seconds_pair_selection = seconds_pair_selection;
   report.estimated_peak_bytes = peak_bytes;
   for (auto& result : results) {
     switch (result->geometry.config) {

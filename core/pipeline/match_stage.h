@@ -1,6 +1,8 @@
 #pragma once
-// Match stage: kd-forest matching with Lowe's ratio test between every pair of a project's
-// images (exhaustive), then two-view verification (F by LO-RANSAC, H screening). Pairs with at
+// Match stage: kd-forest matching with Lowe's ratio test between the pairs of a project's images
+// that PairSelector chooses (every pair of a small project; beyond, a sequential window plus
+// vocabulary-tree retrieval: core/features/pair_selection.h), then two-view verification (F by
+// LO-RANSAC, H screening). Pairs with at
 // least TwoViewOptions::min_inliers F-inliers go to <project>/matches/matches.txt:
 //   # reconar matches v1
 //   pair NAME_A NAME_B CONFIG NUM_INLIERS f11 f12 ... f33     (x_b^T F x_a = 0, pixels;
@@ -9,13 +11,13 @@
 // Under a memory budget too small for every image's features and kd-forests at once, the images
 // are cut into consecutive blocks and each pair of blocks is matched with only its two blocks in
 // memory; the pairs and the file are the same either way.
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "core/base/status.h"
 #include "core/features/matcher.h"
+#include "core/features/pair_selection.h"
 #include "core/features/sift/sift.h"
 #include "core/geometry/two_view.h"
 #include "core/pipeline/project.h"
@@ -24,6 +26,7 @@ namespace reconar {
 
 struct MatchStageOptions {
   MatchOptions match;
+  PairSelectionOptions pairs;
   TwoViewOptions two_view;
   int num_threads = 0;  // pairs in parallel; <= 0: one per core
   bool show_progress = true;
@@ -40,12 +43,13 @@ struct VerifiedPair {
 
 struct MatchStageReport {
   int num_images = 0;
-  int num_pairs = 0;
+  int num_pairs = 0;      // matched (chosen by PairSelector)
   int num_verified = 0;   // kVerified
   int num_planar = 0;     // kPlanarOrRotation (kept: good matches, low parallax)
   int num_rejected = 0;   // kTooFewInliers
   int num_blocks = 1;     // image blocks matched a pair of blocks at a time (1: all images at once)
   double estimated_peak_bytes = 0;  // features and forests held at once
+  double seconds_pair_selection = 0;  // of which training the vocabulary
   double seconds = 0;
   std::vector<VerifiedPair> pairs;  // kept pairs only, without per-pair rejects
 };

@@ -490,6 +490,27 @@ TEST(InvertedFileTest, ScoreIsTheL1Formula) {
   }
 }
 
+TEST(InvertedFileTest, BagOfWordsScoreIsTheQueryScore) {
+  // The pair rule scores bags of words pairwise (BagOfWordsScore); the inverted file accumulates
+  // the same terms in the same word order, so the two agree bit for bit.
+  const auto documents = RandomDocuments(12, 40, 15, 6);
+  const InvertedFile file = BuildOrDie(40, documents);
+  const std::vector<float> idf = InverseDocumentFrequency(40, documents);
+  const std::vector<int32_t> query = {2, 3, 3, 8, 11, 17, 17, 30, 39, 45, -1};  // 45, -1: outside
+  const BagOfWords query_bag = MakeBagOfWords(query, idf);
+  EXPECT_EQ(query_bag.words.size(), query_bag.weights.size());
+  EXPECT_TRUE(std::is_sorted(query_bag.words.begin(), query_bag.words.end()));
+  const auto out = Query(file, query, 12);
+  ASSERT_EQ(out.size(), 12u);
+  for (const RetrievalCandidate& c : out) {
+    const BagOfWords document = MakeBagOfWords(documents[static_cast<size_t>(c.image)], idf);
+    EXPECT_EQ(BagOfWordsScore(query_bag, document), c.score) << c.image;
+    EXPECT_EQ(BagOfWordsScore(document, query_bag), c.score) << c.image;
+  }
+  EXPECT_FLOAT_EQ(BagOfWordsScore(query_bag, query_bag), 2.0f);
+  EXPECT_EQ(BagOfWordsScore(query_bag, BagOfWords{}), 0.0f);
+}
+
 TEST(InvertedFileTest, NoSharedWordTiesAndOutOfRangeWords) {
   // Images 0 and 2 are equal; image 1 shares nothing with them; word 3 is in every image (idf 0).
   const InvertedFile file = BuildOrDie(10, {{0, 1, 3}, {4, 5, 3}, {0, 1, 3}, {6, 3}});
