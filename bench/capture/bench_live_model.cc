@@ -1,10 +1,10 @@
-// bench_live_model OUT_DIR [frames=300] [step_m=0.05]: how the capture's live model keeps up as a
+// bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40]: how the capture's live model keeps up as a
 // capture grows. A walk down the rendered corridor (tests/support/corridor_walk.h, exact poses) is
 // replayed through `reconar capture`'s loop at 30 frames per second, as a camera would deliver it;
 // printed: the keyframes and how many registered, the time from a keyframe being written to its
 // registration over the first and the last quarter of the keyframes, the worker's time per step,
-// the final adjustment, and the live model's cameras against the truth beside `sfm` run offline on
-// the same keyframes.
+// the final adjustment, and the live model's cameras against the truth; twice, with the pair rule's
+// defaults and with every pair matched; then `sfm` run offline on the first run's keyframes.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -46,7 +46,8 @@ void PrintLatency(const char* what, const std::vector<reconar::LiveKeyframe>& ke
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_live_model OUT_DIR [frames=300] [step_m=0.05]\n");
+    std::fprintf(stderr, "usage: bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40]\n"
+                         "  pairs: the pair rule's exhaustive limit, window and retrieved count\n");
     return 2;
   }
   const fs::path out = argv[1];
@@ -54,6 +55,12 @@ int main(int argc, char** argv) {
   walk.frames = argc > 2 ? std::max(30, std::atoi(argv[2])) : 300;
   walk.step_m = argc > 3 ? std::atof(argv[3]) : 0.05;
   walk.length_m = std::max(walk.length_m, walk.frames * walk.step_m + 4.0);
+  reconar::PairSelectionOptions pair_rule;
+  if (argc > 4 && std::sscanf(argv[4], "%d,%d,%d", &pair_rule.exhaustive_up_to, &pair_rule.sequential_window,
+                              &pair_rule.retrieved) != 3) {
+    std::fprintf(stderr, "bench_live_model: pairs must be N,W,M, got '%s'\n", argv[4]);
+    return 2;
+  }
   std::error_code error;
   fs::remove_all(out, error);
   const fs::path video = out / "video";
@@ -66,37 +73,61 @@ int main(int argc, char** argv) {
   for (const auto& entry : *truth) names.push_back(entry.first);
   std::sort(names.begin(), names.end());
 
-  reconar::CaptureOptions capture;
-  capture.source = video.string();
-  capture.project_dir = (out / "capture").string();
-  capture.replay_in_real_time = true;
-  std::map<std::string, std::string> frame_of_keyframe;
-  auto report = reconar::RunCapture(capture, [&](const reconar::CaptureEvent& event) {
-    if (event.kind != reconar::CaptureEvent::Kind::kKeyframe) return;
-    frame_of_keyframe[fs::path(event.path).filename().string()] = names[static_cast<size_t>(event.frame_index)];
-  });
-  if (!report.ok()) return Fail(report.status());
-  const reconar::LiveReconstructionReport& live = report->live_model;
-  const size_t n = live.keyframes.size();
-  std::printf("%d frames at 30 fps: %zu keyframes, %d registered in the live model (%d points)\n", report->frames, n,
-              live.registered, live.points);
-  PrintLatency("first quarter", live.keyframes, 0, n / 4);
-  PrintLatency("last quarter ", live.keyframes, n - n / 4, n);
-  std::printf("  latency over all: median %.2f s, p95 %.2f s\n", live.median_latency_seconds, live.p95_latency_seconds);
-  std::printf("  worker: features %.2f s, matching %.2f s, mapping %.2f s; final adjustment %.2f s\n",
-              live.seconds_features, live.seconds_matching, live.seconds_mapping, live.seconds_final_adjustment);
-
+  // The capture twice over the same video: with the pair rule's defaults (retrieval beyond its
+  // exhaustive limit), and matching every pair, so that the two are measured side by side.
+  std::map<std::string, std::string> frame_of_keyframe, frame_of_default_keyframe;
   const auto frame_of = [&](const std::string& name) {
     const auto it = frame_of_keyframe.find(name);
     return it == frame_of_keyframe.end() ? std::string() : it->second;
   };
   const double path = walk.step_m * (walk.frames - 1);
-  auto live_score = reconar::testing::ScoreModelAgainstTruth(capture.project_dir + "/live", *truth, frame_of);
-  if (!live_score.ok()) return Fail(live_score.status());
+  std::vector<std::string> keyframe_paths;
+  for (const bool every_pair : {false, true}) {
+    reconar::CaptureOptions capture;
+    capture.source = video.string();
+    capture.project_dir = (out / (every_pair ? "capture_every_pair" : "capture")).string();
+    capture.replay_in_real_time = true;
+    capture.live.matching.pairs = pair_rule;
+    if (every_pair) capture.live.matching.pairs.exhaustive_up_to = 1 << 24;
+    frame_of_keyframe.clear();
+    auto report = reconar::RunCapture(capture, [&](const reconar::CaptureEvent& event) {
+      if (event.kind != reconar::CaptureEvent::Kind::kKeyframe) return;
+      frame_of_keyframe[fs::path(event.path).filename().string()] = names[static_cast<size_t>(event.frame_index)];
+    });
+    if (!report.ok()) return Fail(report.status());
+    const reconar::LiveReconstructionReport& live = report->live_model;
+    const size_t n = live.keyframes.size();
+    std::printf("%s: %d frames at 30 fps: %zu keyframes, %d registered in the live model (%d points)\n",
+                every_pair ? "every pair matched" : "pair rule", report->frames, n, live.registered,
+                live.points);
+    PrintLatency("first quarter", live.keyframes, 0, n / 4);
+    PrintLatency("last quarter ", live.keyframes, n - n / 4, n);
+    std::printf("  latency over all: median %.2f s, p95 %.2f s\n", live.median_latency_seconds,
+                live.p95_latency_seconds);
+    std::printf(
+        "  worker: features %.2f s, matching %.2f s (%d pairs; vocabulary %.2f s), mapping %.2f s; final "
+        "adjustment %.2f s\n",
+        live.seconds_features, live.seconds_matching, live.pairs_matched, live.seconds_vocabulary, live.seconds_mapping,
+        live.seconds_final_adjustment);
+    auto live_score = reconar::testing::ScoreModelAgainstTruth(capture.project_dir + "/live", *truth, frame_of);
+    if (!live_score.ok()) return Fail(live_score.status());
+    std::printf("  live model: %d registered, centre error mean %.4f %% of the %.2f m walk, rotation mean %.3f deg\n",
+                live_score->registered, 100.0 * live_score->errors.centre_mean / path, path,
+                live_score->errors.rotation_mean_deg);
+    if (every_pair && report->keyframe_files.size() != keyframe_paths.size()) {
+      std::printf("  (the two captures took different keyframes: %zu and %zu)\n", keyframe_paths.size(),
+                  report->keyframe_files.size());
+    }
+    if (!every_pair) {
+      keyframe_paths = report->keyframe_files;
+      frame_of_default_keyframe = frame_of_keyframe;
+    }
+  }
+  frame_of_keyframe = frame_of_default_keyframe;  // the offline run is on the default capture's keyframes
   reconar::ReconstructOptions offline;
   offline.run_dense = offline.run_mesh = false;
   offline.show_progress = false;
-  std::vector<std::string> keyframe_paths = report->keyframe_files;
+  offline.matching.pairs = pair_rule;
   const auto offline_start = std::chrono::steady_clock::now();
   auto offline_report = reconar::RunReconstruct(keyframe_paths, reconar::Project((out / "offline").string()), offline);
   if (!offline_report.ok()) return Fail(offline_report.status());
@@ -105,9 +136,6 @@ int main(int argc, char** argv) {
   auto offline_score =
       reconar::testing::ScoreModelAgainstTruth((out / "offline" / "sparse").string(), *truth, frame_of);
   if (!offline_score.ok()) return Fail(offline_score.status());
-  std::printf("live model:  %d registered, centre error mean %.4f %% of the %.2f m walk, rotation mean %.3f deg\n",
-              live_score->registered, 100.0 * live_score->errors.centre_mean / path, path,
-              live_score->errors.rotation_mean_deg);
   std::printf("offline sfm: %d registered, centre error mean %.4f %%, rotation mean %.3f deg (%.1f s)\n",
               offline_score->registered, 100.0 * offline_score->errors.centre_mean / path,
               offline_score->errors.rotation_mean_deg, offline_seconds);
