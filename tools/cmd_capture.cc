@@ -4,11 +4,16 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/base/json_writer.h"
 #include "render/ar/capture_session.h"
+#ifdef RECONAR_HAVE_VIEW
+#include "render/ar/capture_window.h"
+#endif
 #include "tools/ar_args.h"
 #include "tools/args.h"
 #include "tools/commands.h"
@@ -24,8 +29,9 @@ constexpr char kHelp[] =
     "it (docs/capture.md gives the rules). Each keyframe is written as\n"
     "PROJECT_DIR/images/keyframe_NNNNN.jpg with EXIF, atomically. A status line each second of\n"
     "video says what to do (\"too fast\", \"too dark\", \"move sideways\", \"go back: lost\").\n"
-    "q is not read: stop with Ctrl-C (the keyframes taken stay). Re-running on a folder or a\n"
-    "recording replays it and keeps the keyframes already written; on a camera it adds to them.\n"
+    "Stop with Ctrl-C, or q or Escape in the window (the keyframes taken stay). Re-running on a\n"
+    "folder or a recording replays it and keeps the keyframes already written; on a camera it adds\n"
+    "to them.\n"
     "SOURCE: /dev/videoN, libcamera[:N], a folder of images, or a .frames recording.\n"
     "  --intrinsics K        fx,fy,cx,cy[,k1,k2] or a file from `reconar calibrate`: the focal goes\n"
     "                        into each keyframe's EXIF (a 35 mm equivalent)\n"
@@ -40,6 +46,8 @@ constexpr char kHelp[] =
     "                        coverage ring (directions the object has been seen from) and the\n"
     "                        tags in view (--tag-family, tag36h11 by default), as\n"
     "                        DIR/preview_FFFFFF.png each keyframe and second, and DIR/latest.png\n"
+    "  --window auto|x11|gbm|none  the same view live, every frame: auto (default) an X11 window\n"
+    "                        when DISPLAY is set, else none; gbm full screen through DRM/KMS\n"
     "  --reconstruct         then run `reconar reconstruct PROJECT_DIR/images PROJECT_DIR`\n"
     "  --tag-size M --tag-family F  passed on to `reconstruct` (metres, tag36h11 by default)\n"
     "  --json                one JSON object per event on stdout (status, keyframe, warning, end)\n";
@@ -97,7 +105,7 @@ void PrintEvent(const CaptureEvent& event, bool json) {
 }  // namespace
 
 int RunCapture(int argc, char** argv, int first) {
-  Args args({"intrinsics", "max-keyframes", "width", "height", "tag-size", "tag-family", "out-preview"},
+  Args args({"intrinsics", "max-keyframes", "width", "height", "tag-size", "tag-family", "out-preview", "window"},
             {"json", "reconstruct", "no-live", "realtime"});
   if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
   CaptureOptions options;
@@ -122,6 +130,28 @@ int RunCapture(int argc, char** argv, int first) {
   if (args.Has("out-preview")) options.preview_dir = args.Get("out-preview");
   if (args.Has("tag-family")) options.preview_tag_family = args.Get("tag-family");
   const bool json = args.Has("json");
+  const std::string window_kind = args.Get("window", "auto");
+  if (window_kind != "auto" && window_kind != "x11" && window_kind != "gbm" && window_kind != "none") {
+    return Fail(InvalidArgument("--window: '" + window_kind + "' is not auto, x11, gbm or none"));
+  }
+  const char* display = std::getenv("DISPLAY");
+  const bool want_window = window_kind == "x11" || window_kind == "gbm" ||
+                           (window_kind == "auto" && display != nullptr && display[0] != '\0');
+#ifdef RECONAR_HAVE_VIEW
+  std::unique_ptr<CaptureWindow> window;
+  if (want_window) {
+    auto opened = CaptureWindow::Open(window_kind == "gbm" ? EglContextKind::kGbm : EglContextKind::kX11Window,
+                                      options.source_options.width, options.source_options.height);
+    if (!opened.ok()) return Fail(opened.status());
+    window = std::move(opened).value();
+    std::fprintf(stderr, "reconar capture: showing the view in %s\n", window->Describe().c_str());
+    options.show_preview = [&window](const Image<uint8_t>& rgb) { return window->Show(rgb); };
+  }
+#else
+  if (want_window && window_kind != "auto") {
+    return Fail(Unsupported("--window: this build has no display support (RECONAR_WITH_GLES=OFF)"));
+  }
+#endif
   std::signal(SIGINT, OnInterrupt);
   auto report = reconar::RunCapture(
       options, [json](const CaptureEvent& event) { PrintEvent(event, json); }, &g_stop);
@@ -159,7 +189,7 @@ int RunCapture(int argc, char** argv, int first) {
           live.p95_latency_seconds);
     }
   }
-  if (report->source_failed) {
+  if (report->source_failed || report->window_failed) {
     std::fprintf(stderr, "reconar: error: %s (the %d keyframes taken are kept)\n", report->stop_reason.c_str(),
                  report->keyframes);
     return 1;

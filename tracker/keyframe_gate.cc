@@ -325,27 +325,27 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
   const bool fast = report->frame_motion > options_.max_frame_motion;
   if (!exposed) {
     report->verdict = GateVerdict::kBadExposure;
-    report->advice = too_dark ? "too dark" : too_bright ? "too bright" : "light too harsh: highlights burnt out";
+    report->advice = too_dark ? GateAdvice::kTooDark : too_bright ? GateAdvice::kTooBright : GateAdvice::kHarshLight;
   } else if (report->sharpness < report->sharpness_threshold) {
     report->verdict = GateVerdict::kBlurred;
-    report->advice = fast ? "too fast" : "hold steady: blurred";
+    report->advice = fast ? GateAdvice::kTooFast : GateAdvice::kBlurred;
   } else if (!have_keyframe_) {
     report->verdict = GateVerdict::kKeyframe;
-    report->advice = "move sideways";
+    report->advice = GateAdvice::kMoveSideways;
   } else if (report->overlap < options_.lost_overlap) {
     report->verdict = GateVerdict::kLost;
-    report->advice = "go back: lost";
+    report->advice = GateAdvice::kLost;
     if (++lost_frames_ >= options_.lost_frames_to_restart) {
       report->verdict = GateVerdict::kKeyframe;
       report->restarted = true;
-      report->advice = "started again: go back to join the earlier views";
+      report->advice = GateAdvice::kRestarted;
     }
   } else if (report->parallax >= options_.keyframe_parallax || report->overlap < options_.keyframe_overlap) {
     report->verdict = GateVerdict::kKeyframe;
-    report->advice = fast ? "too fast" : "move sideways";
+    report->advice = fast ? GateAdvice::kTooFast : GateAdvice::kMoveSideways;
   } else {
     report->verdict = GateVerdict::kTooClose;
-    report->advice = fast ? "too fast" : "move sideways";
+    report->advice = fast ? GateAdvice::kTooFast : GateAdvice::kMoveSideways;
   }
   if (report->verdict == GateVerdict::kKeyframe) TakeKeyframe();
   if (report->verdict != GateVerdict::kLost) lost_frames_ = 0;

@@ -67,6 +67,20 @@ enum class GateVerdict : uint8_t {
 };
 const char* GateVerdictName(GateVerdict verdict);
 
+// Every advice GateFrameReport::advice can hold, for a display that has to be able to show them.
+struct GateAdvice {
+  static constexpr const char* kTooDark = "too dark";
+  static constexpr const char* kTooBright = "too bright";
+  static constexpr const char* kHarshLight = "light too harsh: highlights burnt out";
+  static constexpr const char* kTooFast = "too fast";
+  static constexpr const char* kBlurred = "hold steady: blurred";
+  static constexpr const char* kMoveSideways = "move sideways";
+  static constexpr const char* kLost = "go back: lost";
+  static constexpr const char* kRestarted = "started again: go back to join the earlier views";
+  static constexpr std::array<const char*, 8> kAll = {kTooDark, kTooBright,    kHarshLight, kTooFast,
+                                                      kBlurred, kMoveSideways, kLost,       kRestarted};
+};
+
 struct GateFrameReport {
   GateVerdict verdict = GateVerdict::kTooClose;
   const char* advice = "";           // plain words for the person: "too fast", "too dark", "move sideways", ...

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
+#include <vector>
+
+#include "render/ar/bitmap_text.h"
 
 namespace reconar {
 namespace {
@@ -15,6 +19,8 @@ constexpr Colour kRed = {230, 40, 40};
 constexpr Colour kGrey = {170, 170, 170};
 constexpr Colour kDark = {50, 50, 50};
 constexpr Colour kYellow = {255, 220, 0};
+constexpr Colour kWhite = {255, 255, 255};
+constexpr Colour kBlack = {0, 0, 0};
 
 // `alpha` of `colour` over the pixel.
 void Blend(Image<uint8_t>* rgb, int x, int y, const Colour& colour, double alpha) {
@@ -39,6 +45,21 @@ void DrawLine(Image<uint8_t>* rgb, const Eigen::Vector2d& a, const Eigen::Vector
     FillRect(rgb, x - thickness / 2, y - thickness / 2, x - thickness / 2 + thickness, y - thickness / 2 + thickness,
              colour, 1.0);
   }
+}
+
+// `text` cut at spaces into lines of at most `width` characters (a longer word is cut).
+std::vector<std::string> WrapWords(const std::string& text, size_t width) {
+  std::vector<std::string> lines;
+  if (width == 0) return lines;
+  std::string rest = text;
+  while (rest.size() > width) {
+    size_t cut = rest.rfind(' ', width);
+    if (cut == std::string::npos || cut == 0) cut = width;
+    lines.push_back(rest.substr(0, cut));
+    rest = rest.substr(cut + (rest[cut] == ' ' ? 1 : 0));
+  }
+  if (!rest.empty()) lines.push_back(rest);
+  return lines;
 }
 
 }  // namespace
@@ -67,6 +88,25 @@ void DrawCapturePreview(const CapturePreviewState& state, Image<uint8_t>* rgb) {
     const int x0 = 2 * unit + static_cast<int>(k) * step;
     if (x0 + step > w - 2 * unit) break;
     FillRect(rgb, x0, y0, x0 + step - unit / 2, y1, state.keyframe_registered[k] ? kGreen : kGrey, 0.9);
+  }
+
+  // The words, top left, clear of the coverage ring, wrapped at spaces to fit.
+  const int registered =
+      static_cast<int>(std::count(state.keyframe_registered.begin(), state.keyframe_registered.end(), true));
+  const std::string counts =
+      std::to_string(state.keyframe_registered.size()) + " keyframes, " + std::to_string(registered) + " registered";
+  const int scale = std::max(1, unit / 4);
+  const int line_height = (kGlyphHeight + 3) * scale;
+  const int text_x = 2 * unit, text_y = 2 * unit;
+  const int max_chars = std::max(0, (w - 2 * unit - 14 * unit - text_x) / (kGlyphAdvance * scale));
+  std::vector<std::string> lines = WrapWords(state.advice, static_cast<size_t>(max_chars));
+  for (std::string& line : WrapWords(counts, static_cast<size_t>(max_chars))) lines.push_back(std::move(line));
+  int line_y = text_y;
+  for (const std::string& line : lines) {
+    FillRect(rgb, text_x - scale, line_y - scale, text_x + TextWidthPx(line, scale) + scale,
+             line_y + (kGlyphHeight + 1) * scale, kBlack, 0.55);
+    DrawText(line, text_x, line_y, scale, kWhite, rgb);
+    line_y += line_height;
   }
 
   // Coverage ring, counter-clockwise from the right as ViewCoverage's azimuths.

@@ -7,10 +7,12 @@
 //    until then;
 //  - top right, the coverage ring: the directions from which the live model has seen the object
 //    (ViewCoverage), green where a registered keyframe stands, dark where none does yet;
-//  - the tags in view, outlined in yellow.
-// The words (advice, counts) are on the status line; the picture needs none.
+//  - the tags in view, outlined in yellow;
+//  - top left, on a dark band, the gate's advice ("move sideways", "too fast", ...) and the count
+//    of keyframes taken and registered, in the built-in font (bitmap_text.h).
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 #include "core/base/image.h"
@@ -23,6 +25,7 @@ struct CapturePreviewState {
   std::vector<bool> keyframe_registered;  // one per keyframe taken, in order
   std::vector<bool> coverage;             // sectors counter-clockwise, sector 0 centred on the right
   std::vector<std::array<Eigen::Vector2d, 4>> tags;  // corners of the tags in view, pixels
+  std::string advice;                                // GateFrameReport::advice
 };
 
 // Draws onto `rgb` (3 channels, interleaved) in place.

@@ -108,7 +108,8 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
   std::unique_ptr<TagDetector> tag_detector;
   TagDetectionList tags_in_view(16);
   std::vector<std::array<Eigen::Vector2d, 4>> last_tags;
-  if (!options.preview_dir.empty() && !options.preview_tag_family.empty()) {
+  const bool previewing = !options.preview_dir.empty() || options.show_preview;
+  if (previewing && !options.preview_tag_family.empty()) {
     RECONAR_ASSIGN_OR_RETURN(const TagFamily family, ParseTagFamily(options.preview_tag_family));
     TagDetectorOptions detector_options;
     detector_options.family = family;
@@ -116,36 +117,59 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
   }
   Image<uint8_t> last_view, preview;  // the last frame previewed, and with the overlay drawn
   GateVerdict last_verdict = GateVerdict::kTooClose;
-  // The overlay on the last frame previewed, as `name` and as latest.png.
-  const auto draw_preview = [&](const char* name) -> Status {
+  const char* last_advice = "";
+  const auto draw_overlay = [&]() {
     preview = last_view;
     CapturePreviewState state;
     state.verdict = last_verdict;
+    state.advice = last_advice;
     state.keyframe_registered = keyframe_registered;
     if (live) state.coverage = live->Coverage();
     state.tags = last_tags;
     DrawCapturePreview(state, &preview);
+  };
+  // The overlay on the last frame previewed, as `name` and as latest.png.
+  const auto draw_preview = [&](const char* name) -> Status {
+    draw_overlay();
     if (name != nullptr)
       RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options.preview_dir) / name).string(), preview.view(), 3));
     RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options.preview_dir) / "latest.png").string(), preview.view(), 3));
     ++report.previews;
     return Status::Ok();
   };
-  const auto write_preview = [&](const Frame& frame, GateVerdict verdict) -> Status {
-    if (options.preview_dir.empty() || frame.rgb.data == nullptr) return Status::Ok();
+  const auto take_view = [&](const Frame& frame, const GateFrameReport& gate, bool find_tags) {
     if (last_view.width() != frame.width || last_view.height() != frame.height)
       last_view = Image<uint8_t>(frame.width, frame.height, 3);
     for (int y = 0; y < frame.height; ++y)
       std::copy(frame.rgb.row(y), frame.rgb.row(y) + 3 * frame.width, last_view.row(y));
-    last_verdict = verdict;
+    last_verdict = gate.verdict;
+    last_advice = gate.advice;
+    if (!find_tags) return;
     last_tags.clear();
     if (tag_detector && tag_detector->Detect(frame.gray, &tags_in_view).ok()) {
       for (const TagDetection& tag : tags_in_view)
         last_tags.push_back({tag.corners[0], tag.corners[1], tag.corners[2], tag.corners[3]});
     }
+  };
+  // Each keyframe and one frame per second: the tags found again, the picture written.
+  const auto write_preview = [&](const Frame& frame, const GateFrameReport& gate) -> Status {
+    if (!previewing || frame.rgb.data == nullptr) return Status::Ok();
+    take_view(frame, gate, /*find_tags=*/true);
+    if (options.preview_dir.empty()) return Status::Ok();
     char name[40];
     std::snprintf(name, sizeof(name), "preview_%06lld.png", static_cast<long long>(frame.index));
     return draw_preview(name);
+  };
+  // Every frame in the window, with the tags last found; false: stop (the reason is set).
+  const auto show_preview = [&](const Frame& frame, const GateFrameReport& gate, bool taken) -> bool {
+    if (!options.show_preview || frame.rgb.data == nullptr) return true;
+    if (!taken) take_view(frame, gate, /*find_tags=*/false);
+    draw_overlay();
+    const Result<bool> shown = options.show_preview(preview);
+    if (shown.ok() && *shown) return true;
+    report.stop_reason = shown.ok() ? "window closed" : "the window failed: " + shown.status().message();
+    report.window_failed = !shown.ok();
+    return false;
   };
 
   KeyframeGate gate(options.gate);
@@ -236,7 +260,8 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
       }
       keyframe_registered.push_back(false);
       emit(event);
-      RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate.verdict));
+      RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate));
+      if (!show_preview(frame, event.gate, /*taken=*/true)) break;
       if (options.max_keyframes > 0 && ordinal >= options.max_keyframes) {
         report.stop_reason = "--max-keyframes reached";
         break;
@@ -244,12 +269,15 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
       continue;
     }
     const int second = static_cast<int>(event.video_seconds);
+    bool taken = false;
     if (second != last_status_second) {
       last_status_second = second;
       event.kind = CaptureEvent::Kind::kStatus;
       emit(event);
-      RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate.verdict));
+      RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate));
+      taken = previewing;
     }
+    if (!show_preview(frame, event.gate, taken)) break;
   }
   report.median_gate_ms = Median(gate_ms);
   if (live) {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base/image.h"
 #include "core/base/status.h"
 #include "core/pipeline/live_reconstruction.h"
 #include "platform/camera/frame_source.h"
@@ -42,6 +43,11 @@ struct CaptureOptions {
   // written there as preview_FFFFFF.png (F the frame index) and latest.png.
   std::string preview_dir;
   std::string preview_tag_family = "tag36h11";  // tags outlined in the preview; "" none
+  // Set: the preview of every frame is shown through it (a window: render/ar/capture_window.h), on
+  // the capturing thread. It returns false when the person asked to stop (the capture then ends as
+  // on SIGINT), an error when it can no longer show (the capture ends as when a camera
+  // disconnects: what was captured stays).
+  std::function<Result<bool>(const Image<uint8_t>& rgb)> show_preview;
 
   Status Check() const;
 };
@@ -66,8 +72,11 @@ struct CaptureReport {
   int keyframes_kept = 0;  // of which already there from an earlier run
   int blurred = 0, bad_exposure = 0, too_close = 0, lost = 0, corrupt = 0;
   double median_gate_ms = 0.0;
-  std::string stop_reason;     // "end of the recording", "--max-keyframes reached", "stopped", or the source's error
+  // "end of the recording", "--max-keyframes reached", "stopped", "window closed", or the source's
+  // or the window's error.
+  std::string stop_reason;
   bool source_failed = false;  // the source ended with an error (a camera that disconnected)
+  bool window_failed = false;  // CaptureOptions::show_preview ended with an error (a display that went away)
   std::vector<std::string> keyframe_files;
   int previews = 0;   // pictures written to CaptureOptions::preview_dir
   bool live = false;  // CaptureOptions::reconstruct_live: `live_model` holds the live model's report

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -529,6 +530,38 @@ TEST(CaptureCli, AProjectThatCannotBeWrittenIsNamed) {
   const CommandRun run = RunReconar("capture " + Frames() + " " + (root / "a_file" / "project").string());
   EXPECT_NE(run.exit_code, 0);
   EXPECT_NE(run.output.find("a_file/project/images"), std::string::npos) << run.output;
+  fs::remove_all(root);
+}
+
+TEST(CaptureCli, TheWindowShowsTheViewOrIsRefusedBeforeAnythingIsWritten) {
+  const fs::path root = testing::MakeTestDirectory("capture_window");
+  const char* saved = std::getenv("DISPLAY");
+  const std::string display = saved != nullptr ? saved : "";
+  unsetenv("DISPLAY");
+  const CommandRun refused = RunReconar("capture " + Frames() + " " + (root / "refused").string() + " --window x11");
+  if (!display.empty()) setenv("DISPLAY", display.c_str(), 1);
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.output.find("no display for the capture's window"), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(root / "refused")) << "nothing may be written when the window cannot open";
+  const CommandRun bad_kind = RunReconar("capture " + Frames() + " " + (root / "bad").string() + " --window tv");
+  EXPECT_NE(bad_kind.exit_code, 0);
+  EXPECT_NE(bad_kind.output.find("--window: 'tv' is not auto, x11, gbm or none"), std::string::npos) << bad_kind.output;
+
+  if (display.empty()) GTEST_SKIP() << "DISPLAY is not set: the window itself is not shown";
+  const CommandRun shown =
+      RunReconar("capture " + Frames() + " " + (root / "shown").string() + " --no-live --max-keyframes 3");
+  ASSERT_EQ(shown.exit_code, 0) << shown.output;
+  EXPECT_NE(shown.output.find("showing the view in x11"), std::string::npos) << shown.output;
+  EXPECT_EQ(Keyframes(root / "shown").size(), 3u);
+  const CommandRun hidden = RunReconar("capture " + Frames() + " " + (root / "hidden").string() +
+                                       " --no-live --max-keyframes 3 --window none");
+  ASSERT_EQ(hidden.exit_code, 0) << hidden.output;
+  EXPECT_EQ(hidden.output.find("showing the view"), std::string::npos) << hidden.output;
+  // The window changes nothing of what is captured.
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(ReadBytes(Keyframes(root / "shown")[static_cast<size_t>(k)]),
+              ReadBytes(Keyframes(root / "hidden")[static_cast<size_t>(k)]));
+  }
   fs::remove_all(root);
 }
 

@@ -1,0 +1,36 @@
+#pragma once
+// The capture's preview shown live (`reconar capture --window`): each picture the capture draws
+// (render/ar/capture_preview.h) letterboxed into an X11 window, or full screen through DRM/KMS
+// (platform/egl/egl_context.h), on the capturing thread. 'q', Escape or the window's close button
+// ask the capture to stop; it then ends as on SIGINT.
+#include <memory>
+#include <string>
+
+#include "core/base/image.h"
+#include "core/base/status.h"
+#include "platform/egl/egl_context.h"
+#include "render/overlay_renderer.h"
+
+namespace reconar {
+
+class CaptureWindow {
+ public:
+  // Opens the display now, so that a missing one is reported before the capture starts:
+  // FailedPrecondition "no display for the capture's window: ..." (EglContext::Create's reason),
+  // also for kAuto on a machine with neither DISPLAY nor a DRM device. `width` x `height`: the X11
+  // window's first size (the picture is letterboxed into whatever size it has).
+  static Result<std::unique_ptr<CaptureWindow>> Open(EglContextKind kind, int width = 640, int height = 480);
+
+  // Shows a 3-channel picture; the drawing target follows its size. False once the person asked to
+  // stop. Errors: GL or presentation failures (a display that went away).
+  Result<bool> Show(const Image<uint8_t>& rgb);
+
+  std::string Describe() const;  // "x11 window (llvmpipe ...)"
+
+ private:
+  explicit CaptureWindow(std::unique_ptr<EglContext> context) : context_(std::move(context)) {}
+  std::unique_ptr<EglContext> context_;
+  std::unique_ptr<OverlayRenderer> renderer_;  // sized to the last picture
+};
+
+}  // namespace reconar
