@@ -307,10 +307,10 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     const MapperOptions& mapper = sfm.mapper;
     const auto run_mapping = [&](StageSummary* summary) -> Status {
       RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
-      if (r.live_model == "continued") {
+      if (r.live_model == SfmStageReport::LiveModel::kContinued) {
         summary->note = "continued from the capture's live model";
-      } else if (!r.live_model.empty()) {
-        summary->note = "the capture's live model " + r.live_model;
+      } else if (r.live_model == SfmStageReport::LiveModel::kNotUsed) {
+        summary->note = "the capture's live model not used: " + r.live_model_reason;
       }
       if (with_tags && !r.tags.metric)
         summary->note += std::string(summary->note.empty() ? "" : "; ") + "no metric registration: " + r.tags.reason;

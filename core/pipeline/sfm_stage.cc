@@ -70,25 +70,31 @@ void FocalStatistics(const Reconstruction& rec, SfmStageReport* report) {
   report->focal_35mm_equivalent = 36.0 * mean;  // the long side of a 36 x 24 mm frame
 }
 
+void LiveModelNotUsed(SfmStageReport* report, const std::string& reason) {
+  report->live_model = SfmStageReport::LiveModel::kNotUsed;
+  report->live_model_reason = reason;
+}
+
 // The capture's live model (PROJECT/live/) when options allow and it can seed the mapper, without
 // the photos the project no longer holds (`index_of`: the project's photos by name); else an
-// error, with *note saying why ("not used: ...") when there is a model.
+// error, with the report saying why when there is a model.
 Result<Reconstruction> LiveModel(const Project& project, const SfmStageOptions& options,
-                                 const std::map<std::string, int>& index_of, std::string* note) {
-  note->clear();
+                                 const std::map<std::string, int>& index_of, SfmStageReport* report) {
+  report->live_model = SfmStageReport::LiveModel::kNone;
+  report->live_model_reason.clear();
   const std::string dir = project.LiveDir();
   std::error_code error;
   if (!options.continue_from_live || !std::filesystem::exists(dir + "/points3D.txt", error))
     return NotFound(dir + ": no live model");
   Result<Reconstruction> live = ReadColmapTextModel(dir);
   if (!live.ok()) {
-    *note = "not used: " + live.status().message();
+    LiveModelNotUsed(report, live.status().message());
     return live.status();
   }
   for (SfmImage& image : live->images) image.registered = image.registered && index_of.count(image.name) > 0;
   if (live->NumRegisteredImages() < 2) {
-    *note = "not used: " + dir + " holds fewer than two of the photos";
-    return FailedPrecondition(*note);
+    LiveModelNotUsed(report, dir + " holds fewer than two of the photos");
+    return FailedPrecondition(report->live_model_reason);
   }
   return live;
 }
@@ -99,10 +105,10 @@ Result<Reconstruction> ContinueFromLiveModel(const Reconstruction& live, const s
   Result<Reconstruction> continued =
       ContinueIncrementalMapper(images, pairs, options, live, nullptr, &report->mapper, progress);
   if (!continued.ok()) {
-    report->live_model = "not used: " + continued.status().message();
+    LiveModelNotUsed(report, continued.status().message());
     return continued;
   }
-  report->live_model = "continued";
+  report->live_model = SfmStageReport::LiveModel::kContinued;
   MapperReport::Model summary;
   for (const SfmImage& image : continued->images) {
     if (image.registered) summary.images.push_back(image.name);
@@ -202,7 +208,7 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     shown = std::max(shown, done);
   };
   std::vector<Reconstruction> other_models;
-  Result<Reconstruction> reconstruction = LiveModel(project, options, index_of, &report.live_model);
+  Result<Reconstruction> reconstruction = LiveModel(project, options, index_of, &report);
   if (reconstruction.ok()) {
     reconstruction = ContinueFromLiveModel(*reconstruction, images, pairs, options.mapper, on_progress, &report);
   }
@@ -212,7 +218,7 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     auto scratch = RunIncrementalMapper(images, pairs, options.mapper, &scratch_report, on_progress, &scratch_others);
     if (!reconstruction.ok() ||
         (scratch.ok() && scratch->NumRegisteredImages() > reconstruction->NumRegisteredImages())) {
-      if (reconstruction.ok()) report.live_model = "not used: the mapper from scratch registered more photos";
+      if (reconstruction.ok()) LiveModelNotUsed(&report, "the mapper from scratch registered more photos");
       reconstruction = std::move(scratch);
       report.mapper = std::move(scratch_report);
       other_models = std::move(scratch_others);
@@ -279,7 +285,10 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("rmse_focal_ratio").Double(sfm.rmse_focal_ratio);
   json->Key("focal_35mm_equivalent_mm").Double(sfm.focal_35mm_equivalent);
   json->Key("initial_pair").String(m.initial_pair);
-  if (!sfm.live_model.empty()) json->Key("live_model").String(sfm.live_model);
+  if (sfm.live_model == SfmStageReport::LiveModel::kContinued) json->Key("live_model").String("continued");
+  if (sfm.live_model == SfmStageReport::LiveModel::kNotUsed) {
+    json->Key("live_model").String("not used: " + sfm.live_model_reason);
+  }
   json->Key("initial_pair_relaxations").Int(m.init_relaxations);
   json->Key("initial_pairs_scored").Int(m.init_pairs_scored);
   json->Key("initial_starts").Int(m.init_starts);

@@ -52,8 +52,12 @@ struct SfmStageReport {
   double seconds_mapping = 0.0;
   double seconds_colour = 0.0;
   double seconds_write = 0.0;
-  // "continued": the mapper continued from the live model; "not used: REASON"; empty: none there.
-  std::string live_model;
+  // The capture's live model (PROJECT/live/): none there, continued by the mapper, or there but not
+  // used (live_model_reason says why: unreadable, too few of the photos, the mapper from scratch
+  // registered more).
+  enum class LiveModel { kNone, kContinued, kNotUsed };
+  LiveModel live_model = LiveModel::kNone;
+  std::string live_model_reason;
   bool tags_used = false;             // options.tags.enabled
   TagRegistrationReport tags;         // also written to PROJECT/tags.json
 };
