@@ -130,6 +130,14 @@ TEST(PairSelectionRing, LiveCaptureAndMatchStageChooseTheSamePairs) {
   ASSERT_TRUE(report.ok()) << report.status().ToString();
   EXPECT_EQ(report->num_pairs, 15 + 5 * (keyframes - 6));
   EXPECT_EQ(ReadOrEmpty(project.MatchesPath()), live_matches) << "the match stage chose or matched other pairs";
+
+  // Under a memory budget for a few images at a time, the pairs are chosen from the feature files
+  // read in order: the same file again.
+  matching.memory_budget_bytes = 3u << 20;
+  auto in_blocks = RunMatchStage(project, matching);
+  ASSERT_TRUE(in_blocks.ok()) << in_blocks.status().ToString();
+  EXPECT_GT(in_blocks->num_blocks, 2);
+  EXPECT_EQ(ReadOrEmpty(project.MatchesPath()), live_matches) << "matching in blocks chose or matched other pairs";
 }
 
 }  // namespace
