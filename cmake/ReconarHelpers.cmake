@@ -35,7 +35,9 @@ endfunction()
 # A GoogleTest executable; each TEST becomes a CTest case (discovered through the cross emulator too).
 # Label "unit" for fast self-contained tests, "e2e" for tests on ../shared/data.
 function(reconar_add_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT;COST" "SOURCES;LINKS;LABELS" ${ARGN})
+  # RESOURCE_LOCK: tests holding the same lock never run at the same time (x_screen: they show
+  # windows on, or read back, the one X server's screen under xvfb-run).
+  cmake_parse_arguments(ARG "" "TIMEOUT;COST;RESOURCE_LOCK" "SOURCES;LINKS;LABELS" ${ARGN})
   if(NOT ARG_LABELS)
     set(ARG_LABELS unit)
   endif()
@@ -56,7 +58,11 @@ function(reconar_add_test name)
   if(NOT ARG_COST)
     set(ARG_COST 0)
   endif()
+  set(lock)
+  if(ARG_RESOURCE_LOCK)
+    set(lock RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+  endif()
   gtest_discover_tests(${name}
-      PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST}
+      PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST} ${lock}
       DISCOVERY_TIMEOUT 120)
 endfunction()

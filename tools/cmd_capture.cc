@@ -4,7 +4,6 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -130,25 +129,17 @@ int RunCapture(int argc, char** argv, int first) {
   if (args.Has("out-preview")) options.preview_dir = args.Get("out-preview");
   if (args.Has("tag-family")) options.preview_tag_family = args.Get("tag-family");
   const bool json = args.Has("json");
-  const std::string window_kind = args.Get("window", "auto");
-  if (window_kind != "auto" && window_kind != "x11" && window_kind != "gbm" && window_kind != "none") {
-    return Fail(InvalidArgument("--window: '" + window_kind + "' is not auto, x11, gbm or none"));
-  }
-  const char* display = std::getenv("DISPLAY");
-  const bool want_window = window_kind == "x11" || window_kind == "gbm" ||
-                           (window_kind == "auto" && display != nullptr && display[0] != '\0');
+  const std::string window_name = args.Get("window", "auto");
 #ifdef RECONAR_HAVE_VIEW
-  std::unique_ptr<CaptureWindow> window;
-  if (want_window) {
-    auto opened = CaptureWindow::Open(window_kind == "gbm" ? EglContextKind::kGbm : EglContextKind::kX11Window,
-                                      options.source_options.width, options.source_options.height);
-    if (!opened.ok()) return Fail(opened.status());
-    window = std::move(opened).value();
-    std::fprintf(stderr, "reconar capture: showing the view in %s\n", window->Describe().c_str());
-    options.show_preview = [&window](const Image<uint8_t>& rgb) { return window->Show(rgb); };
+  auto window = CaptureWindow::OpenByName(window_name, options.source_options.width, options.source_options.height,
+                                          "reconar capture: " + options.project_dir);
+  if (!window.ok()) return Fail(window.status());
+  if (*window) {
+    std::fprintf(stderr, "reconar capture: showing the view in %s\n", (*window)->Describe().c_str());
+    options.show_preview = [&window](const Image<uint8_t>& rgb) { return (*window)->Show(rgb); };
   }
 #else
-  if (want_window && window_kind != "auto") {
+  if (window_name != "auto" && window_name != "none") {
     return Fail(Unsupported("--window: this build has no display support (RECONAR_WITH_GLES=OFF)"));
   }
 #endif

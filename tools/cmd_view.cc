@@ -104,13 +104,6 @@ Result<ModelPlacement> PlacementFromArgs(const Args& args, const Mesh& mesh, dou
   return placement;
 }
 
-Result<EglContextKind> WindowFromArg(const std::string& window) {
-  if (window == "auto") return EglContextKind::kAuto;
-  if (window == "x11") return EglContextKind::kX11Window;
-  if (window == "gbm") return EglContextKind::kGbm;
-  return InvalidArgument("--window: '" + window + "' is not auto, x11 or gbm");
-}
-
 }  // namespace
 
 int RunView(int argc, char** argv, int first) {
@@ -162,7 +155,7 @@ int RunView(int argc, char** argv, int first) {
   options.out_dir = args.Get("out");
   const bool to_files = args.Has("out");
   if (!to_files) {
-    auto window = WindowFromArg(args.Get("window", "auto"));
+    auto window = OnScreenKindFromName(args.Get("window", "auto"));
     if (!window.ok()) return Fail(window.status());
     options.window = *window;
   }

@@ -22,8 +22,7 @@ bool DirectoryExists(const char* path) {
 
 EglContextKind ResolveKind(EglContextKind kind) {
   if (kind != EglContextKind::kAuto) return kind;
-  const char* display = std::getenv("DISPLAY");
-  if (display != nullptr && display[0] != '\0') return EglContextKind::kX11Window;
+  if (HasX11Display()) return EglContextKind::kX11Window;
   if (DirectoryExists("/dev/dri")) return EglContextKind::kGbm;
   return EglContextKind::kSurfaceless;
 }
@@ -76,6 +75,18 @@ const char* EglContextKindName(EglContextKind kind) {
   return "unknown";
 }
 
+Result<EglContextKind> OnScreenKindFromName(const std::string& name) {
+  if (name == "auto") return EglContextKind::kAuto;
+  if (name == "x11") return EglContextKind::kX11Window;
+  if (name == "gbm") return EglContextKind::kGbm;
+  return InvalidArgument("--window: '" + name + "' is not auto, x11 or gbm");
+}
+
+bool HasX11Display() {
+  const char* display = std::getenv("DISPLAY");
+  return display != nullptr && display[0] != '\0';
+}
+
 Status EglContextOptions::Check() const {
   if (gles_version != 2 && gles_version != 3) {
     return InvalidArgument("EglContextOptions.gles_version must be 2 or 3, got " + std::to_string(gles_version));
@@ -107,6 +118,16 @@ EglContext::EglContext() : egl_(new Egl) {}
 EglContext::~EglContext() {
   egl_.reset();  // the surface before the native window it draws into
   output_.reset();
+}
+
+Result<std::unique_ptr<EglContext>> EglContext::CreateOnScreen(const Options& options) {
+  if (options.kind == EglContextKind::kSurfaceless) {
+    return InvalidArgument("an on-screen EGL context cannot be surfaceless");
+  }
+  if (ResolveKind(options.kind) == EglContextKind::kSurfaceless) {
+    return FailedPrecondition("DISPLAY is not set and there is no DRM device under /dev/dri");
+  }
+  return Create(options);
 }
 
 Result<std::unique_ptr<EglContext>> EglContext::Create(const Options& options) {

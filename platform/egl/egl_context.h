@@ -19,6 +19,11 @@ namespace reconar {
 enum class EglContextKind { kAuto, kSurfaceless, kGbm, kX11Window };
 
 const char* EglContextKindName(EglContextKind kind);
+// The on-screen routes a user names on a command line: "auto", "x11", "gbm".
+// InvalidArgument "--window: 'tv' is not auto, x11 or gbm" otherwise.
+Result<EglContextKind> OnScreenKindFromName(const std::string& name);
+// True when DISPLAY names an X server, i.e. kAuto would pick kX11Window.
+bool HasX11Display();
 
 struct EglContextOptions {
   EglContextKind kind = EglContextKind::kAuto;
@@ -58,6 +63,10 @@ class EglContext {
   // Unsupported when the route was not compiled in (no gbm/libdrm or x11 at build time) or the
   // EGL implementation lacks the platform extension; InvalidArgument for bad options.
   static Result<std::unique_ptr<EglContext>> Create(const Options& options);
+  // Create for a context that must show something: kAuto on a machine with neither DISPLAY nor a
+  // DRM device is FailedPrecondition "DISPLAY is not set and there is no DRM device under /dev/dri"
+  // instead of falling back to kSurfaceless; kSurfaceless is InvalidArgument.
+  static Result<std::unique_ptr<EglContext>> CreateOnScreen(const Options& options);
 
   ~EglContext();
   EglContext(const EglContext&) = delete;

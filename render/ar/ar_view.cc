@@ -45,16 +45,11 @@ Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const
   egl_options.kind = to_files ? EglContextKind::kSurfaceless : options.window;
   egl_options.width = session->width();
   egl_options.height = session->height();
-  auto context = EglContext::Create(egl_options);
+  auto context = to_files ? EglContext::Create(egl_options) : EglContext::CreateOnScreen(egl_options);
   if (!context.ok()) {
     Status status = context.status();
     if (!to_files) status = status.WithContext("no display for the live view (use --out DIR to write PNGs instead)");
     return status;
-  }
-  if (!to_files && !(*context)->has_surface()) {
-    return FailedPrecondition(
-        "no display for the live view: DISPLAY is not set and there is no DRM device under /dev/dri "
-        "(use --out DIR to write PNGs instead)");
   }
   OverlayRendererOptions render_options;
   render_options.width = session->width();

@@ -2,23 +2,31 @@
 
 namespace reconar {
 
-Result<std::unique_ptr<CaptureWindow>> CaptureWindow::Open(EglContextKind kind, int width, int height) {
+Result<std::unique_ptr<CaptureWindow>> CaptureWindow::Open(EglContextKind kind, int width, int height,
+                                                           const std::string& title) {
   EglContextOptions options;
   options.kind = kind;
   options.width = width;
   options.height = height;
-  options.title = "reconar capture";
-  Result<std::unique_ptr<EglContext>> context = EglContext::Create(options);
+  options.title = title;
+  Result<std::unique_ptr<EglContext>> context = EglContext::CreateOnScreen(options);
   if (!context.ok()) {
     return FailedPrecondition("no display for the capture's window: " + context.status().message() +
                               " (--out-preview DIR writes the pictures instead)");
   }
-  if (!(*context)->has_surface()) {
-    return FailedPrecondition(
-        "no display for the capture's window: DISPLAY is not set and there is no DRM device under /dev/dri "
-        "(--out-preview DIR writes the pictures instead)");
-  }
   return std::unique_ptr<CaptureWindow>(new CaptureWindow(std::move(context).value()));
+}
+
+Result<std::unique_ptr<CaptureWindow>> CaptureWindow::OpenByName(const std::string& name, int width, int height,
+                                                                 const std::string& title) {
+  if (name == "none") return std::unique_ptr<CaptureWindow>();
+  Result<EglContextKind> kind = OnScreenKindFromName(name);
+  if (!kind.ok()) return InvalidArgument("--window: '" + name + "' is not auto, x11, gbm or none");
+  if (*kind == EglContextKind::kAuto) {
+    if (!HasX11Display()) return std::unique_ptr<CaptureWindow>();
+    kind = EglContextKind::kX11Window;
+  }
+  return Open(*kind, width, height, title);
 }
 
 Result<bool> CaptureWindow::Show(const Image<uint8_t>& rgb) {

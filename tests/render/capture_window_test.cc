@@ -5,6 +5,7 @@
 #include "render/ar/capture_window.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -112,7 +113,9 @@ TEST(CaptureWindow, ThePictureIsOnTheScreenUprightAndQStops) {
   if (!HaveDisplay()) GTEST_SKIP() << "DISPLAY is not set";
   Display* display = XOpenDisplay(nullptr);
   ASSERT_NE(display, nullptr);
-  auto window = CaptureWindow::Open(EglContextKind::kX11Window, 400, 300);
+  // A title of its own: 'q' must reach this window, not another test's on the same X server.
+  const std::string title = "reconar capture test " + std::to_string(::getpid());
+  auto window = CaptureWindow::Open(EglContextKind::kX11Window, 400, 300, title);
   ASSERT_TRUE(window.ok()) << window.status().ToString();
   EXPECT_NE((*window)->Describe().find("x11"), std::string::npos) << (*window)->Describe();
 
@@ -130,8 +133,8 @@ TEST(CaptureWindow, ThePictureIsOnTheScreenUprightAndQStops) {
   EXPECT_LT(colours.red_mean_y, colours.blue_mean_y);
 
   // 'q' pressed in the window: the next Show says stop.
-  const Window target = FindWindowNamed(display, DefaultRootWindow(display), "reconar capture");
-  ASSERT_NE(target, 0u) << "no window named 'reconar capture'";
+  const Window target = FindWindowNamed(display, DefaultRootWindow(display), title);
+  ASSERT_NE(target, 0u) << "no window named '" << title << "'";
   XKeyEvent key = {};
   key.type = KeyPress;
   key.display = display;
