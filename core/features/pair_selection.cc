@@ -75,7 +75,6 @@ Status PairSelector::Train() {
   idf_ = InverseDocumentFrequency(vocabulary_.num_words(), words);
   for (std::vector<int32_t>& image_words : words) bags_.push_back(MakeBagOfWords(std::move(image_words), idf_));
   untrained_descriptors_ = {};
-  trained_ = true;
   seconds_training_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::Ok();
 }
@@ -93,7 +92,7 @@ Result<std::vector<int>> PairSelector::Add(const uint8_t* descriptors, int count
     ++num_images_;
     return partners;
   }
-  if (!trained_) RECONAR_RETURN_IF_ERROR(Train());
+  if (image == options_.exhaustive_up_to) RECONAR_RETURN_IF_ERROR(Train());
   bags_.push_back(MakeBagOfWords(Words(Subsample(descriptors, count)), idf_));
   ++num_images_;
 

@@ -47,7 +47,7 @@ class PairSelector {
   Result<std::vector<int>> Add(const uint8_t* descriptors, int count);
 
   int num_images() const { return num_images_; }
-  bool trained() const { return trained_; }
+  bool trained() const { return num_images_ > options_.exhaustive_up_to; }
   double seconds_training() const { return seconds_training_; }
 
  private:
@@ -58,7 +58,6 @@ class PairSelector {
 
   PairSelectionOptions options_;
   int num_images_ = 0;
-  bool trained_ = false;
   double seconds_training_ = 0.0;
   std::vector<std::vector<uint8_t>> untrained_descriptors_;  // the first images', until training
   VocabularyTree vocabulary_;
