@@ -82,6 +82,12 @@ void PrintEvent(const CaptureEvent& event, bool json) {
           .Double(g.frame_motion);
     }
     if (event.kind == CaptureEvent::Kind::kKeyframe) out.Key("path").String(event.path).Key("kept").Bool(event.kept);
+    if ((event.kind == CaptureEvent::Kind::kStatus || event.kind == CaptureEvent::Kind::kKeyframe) &&
+        event.map_version > 0) {
+      out.Key("map").BeginObject().Key("version").Int(event.map_version);
+      out.Key("state").String(MapTrackingStateName(event.map_state)).Key("inliers").Int(event.map_inliers);
+      out.EndObject();
+    }
     out.EndObject();
     std::printf("%s\n", out.str().c_str());
     std::fflush(stdout);
@@ -95,9 +101,14 @@ void PrintEvent(const CaptureEvent& event, bool json) {
     std::fprintf(stderr, "%7.1f s  keyframe %d: %s%s\n", event.video_seconds, event.keyframes, event.path.c_str(),
                  event.kept ? " (already there)" : "");
   } else {
-    std::fprintf(stderr, "%7.1f s  %d keyframes, %d registered  %-14s  parallax %4.1f %%  overlap %3.0f %%  %s\n",
-                 event.video_seconds, event.keyframes, event.registered, GateVerdictName(g.verdict), 100.0 * g.parallax,
-                 100.0 * g.overlap, g.advice);
+    char map[48] = "";
+    if (event.map_version > 0) {
+      std::snprintf(map, sizeof(map), "  model: %s",
+                    event.map_pose_found ? "posed" : MapTrackingStateName(event.map_state));
+    }
+    std::fprintf(stderr, "%7.1f s  %d keyframes, %d registered%s  %-14s  parallax %4.1f %%  overlap %3.0f %%  %s\n",
+                 event.video_seconds, event.keyframes, event.registered, map, GateVerdictName(g.verdict),
+                 100.0 * g.parallax, 100.0 * g.overlap, g.advice);
   }
 }
 
@@ -161,6 +172,8 @@ int RunCapture(int argc, char** argv, int first) {
       out.Key("live").BeginObject().Key("registered").Int(live.registered).Key("points").Int(live.points);
       out.Key("median_latency_s").Double(live.median_latency_seconds);
       out.Key("p95_latency_s").Double(live.p95_latency_seconds).EndObject();
+      out.Key("map").BeginObject().Key("maps").Int(report->maps_used).Key("frames_posed").Int(report->frames_map_posed);
+      out.Key("median_track_ms").Double(report->median_map_track_ms).EndObject();
     }
     out.EndObject();
     std::printf("%s\n", out.str().c_str());
@@ -178,6 +191,13 @@ int RunCapture(int argc, char** argv, int first) {
           "(median), %.1f s (95th percentile)\n",
           live.registered, live.keyframes.size(), live.points, options.project_dir.c_str(), live.median_latency_seconds,
           live.p95_latency_seconds);
+      if (report->maps_used > 0) {
+        std::printf(
+            "followed against the live model: %d of %d frames posed, %d maps (built in %.1f s), %.1f ms per frame "
+            "(median)\n",
+            report->frames_map_posed, report->frames, report->maps_used, live.seconds_maps,
+            report->median_map_track_ms);
+      }
     }
   }
   if (report->source_failed || report->window_failed) {

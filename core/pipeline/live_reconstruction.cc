@@ -127,6 +127,26 @@ int LiveReconstruction::NumProcessed() const {
   return static_cast<int>(done_);
 }
 
+LiveMap LiveReconstruction::LatestMap() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return maps_.empty() ? LiveMap() : maps_.back();
+}
+
+int LiveReconstruction::MapVersion() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return maps_.empty() ? 0 : maps_.back().version;
+}
+
+LiveMap LiveReconstruction::MapAsOf(int keyframes) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const size_t wanted = std::min(static_cast<size_t>(std::max(keyframes, 0)), queued_.size());
+  wake_.wait(lock, [&] { return done_ >= wanted || stopping_ || worker_stopped_; });
+  for (auto map = maps_.rbegin(); map != maps_.rend(); ++map) {
+    if (map->keyframes <= keyframes) return *map;
+  }
+  return LiveMap();
+}
+
 int LiveReconstruction::NumRegistered() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return registered_now_;
@@ -142,12 +162,16 @@ void LiveReconstruction::Work() {
       index = done_;
     }
     const Status status = ProcessKeyframe(index);
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++done_;
-    if (!status.ok()) {
-      worker_error_ = status;
-      return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++done_;
+      if (!status.ok()) {
+        worker_error_ = status;
+        worker_stopped_ = true;
+      }
     }
+    wake_.notify_all();  // MapAsOf waits for done_
+    if (!status.ok()) return;
   }
 }
 
@@ -215,6 +239,7 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   seconds_matching_ += SecondsBetween(matching_start, mapping_start);
 
   // The new keyframe gets the local adjustment; the whole model a global one at growth milestones.
+  const int registered_at_last_global = growth_.registered_at_last_global;
   Result<Reconstruction> grown =
       has_model_ ? ContinueIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), model_, &growth_)
                  : RunIncrementalMapper(mapper_images_, mapper_pairs_, MapperOnOneThread(), nullptr);
@@ -240,7 +265,38 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   has_model_ = true;
   model_final_ = false;
   PublishModel();
+  if (options_.publish_map && (started_afresh || growth_.registered_at_last_global != registered_at_last_global)) {
+    PublishMap();
+  }
   return Status::Ok();
+}
+
+void LiveReconstruction::PublishMap() {
+  const auto start = Clock::now();
+  const ImageDescriptorLoader load = [this](const SfmImage& image) -> Result<std::vector<uint8_t>> {
+    for (size_t i = 0; i < images_.size(); ++i) {
+      if (images_[i].name == image.name) return features_[i].descriptors;
+    }
+    return NotFound("live model: no features of " + image.name);
+  };
+  MapBuildOptions map_options = options_.map;
+  map_options.num_threads = 1;
+  Result<LocalizationMap> map = BuildLocalizationMap(model_, load, "arbitrary", false, map_options);
+  const double seconds = SecondsBetween(start, Clock::now());
+  seconds_maps_ += seconds;
+  if (!map.ok()) return;  // a model without points yet: the capture keeps the last map
+  LiveMap published;
+  published.map = std::make_shared<const LocalizationMap>(std::move(map).value());
+  published.intrinsics = model_.cameras.front().Intrinsics();
+  published.version = ++maps_published_;
+  published.seconds_to_build = seconds;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    published.keyframes = static_cast<int>(done_) + 1;
+    maps_.push_back(std::move(published));
+    if (maps_.size() > kMapsKept) maps_.pop_front();
+  }
+  wake_.notify_all();
 }
 
 MapperOptions LiveReconstruction::MapperOnOneThread() const {
@@ -302,6 +358,8 @@ Result<LiveReconstructionReport> LiveReconstruction::Finish() {
   report.seconds_final_adjustment = seconds_final_adjustment_;
   report.seconds_vocabulary = pair_selector_ ? pair_selector_->seconds_training() : 0.0;
   report.pairs_matched = pairs_matched_;
+  report.maps_published = maps_published_;
+  report.seconds_maps = seconds_maps_;
   std::vector<double> latencies;
   for (const LiveKeyframe& keyframe : report.keyframes) {
     if (keyframe.registered_seconds >= 0.0) latencies.push_back(keyframe.registered_seconds - keyframe.taken_seconds);
@@ -342,6 +400,7 @@ Result<LiveReconstructionReport> LiveReconstruction::Finish() {
   json.Key("seconds_final_adjustment").Double(report.seconds_final_adjustment);
   json.Key("seconds_vocabulary").Double(report.seconds_vocabulary);
   json.Key("pairs_matched").Int(report.pairs_matched);
+  json.Key("maps_published").Int(report.maps_published).Key("seconds_maps").Double(report.seconds_maps);
   json.Key("images").BeginArray();
   for (const LiveKeyframe& keyframe : report.keyframes) {
     json.BeginObject().Key("path").String(keyframe.path).Key("taken_s").Double(keyframe.taken_seconds);

@@ -18,6 +18,7 @@
 // (COLMAP text) with PROJECT/live/report.json (when each keyframe registered).
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -28,9 +29,11 @@
 #include "core/base/status.h"
 #include "core/features/matcher.h"
 #include "core/features/pair_selection.h"
+#include "core/math/camera_intrinsics.h"
 #include "core/pipeline/feature_stage.h"
 #include "core/pipeline/match_stage.h"
 #include "core/pipeline/project.h"
+#include "core/sfm/localization_map.h"
 #include "core/sfm/mapper.h"
 #include "core/sfm/reconstruction.h"
 
@@ -43,6 +46,21 @@ struct LiveReconstructionOptions {
   FeatureStageOptions features;
   MatchStageOptions matching;
   MapperOptions mapper;
+  // Publish the model as a localisation map (LatestMap) when it starts and at each of its global
+  // adjustments, for following the camera against it while it grows.
+  bool publish_map = false;
+  MapBuildOptions map;  // num_threads is the worker's one
+};
+
+// The live model as a localisation map (core/sfm/localization_map.h) for tracking the camera
+// against it (tracker/map_tracker.h). Between two maps only the newest keyframes' local
+// adjustments changed the model; a map is built from all of it.
+struct LiveMap {
+  std::shared_ptr<const LocalizationMap> map;  // null before the first model
+  CameraIntrinsics intrinsics;                 // the model's camera, at the keyframes' size
+  int version = 0;                             // maps published so far
+  int keyframes = 0;                           // keyframes processed when it was built
+  double seconds_to_build = 0.0;
 };
 
 struct LiveKeyframe {
@@ -63,6 +81,8 @@ struct LiveReconstructionReport {
   double seconds_vocabulary = 0.0;  // of seconds_matching: training the pair rule's vocabulary
   int pairs_matched = 0;
   double seconds_final_adjustment = 0.0;                                         // in Finish()
+  int maps_published = 0;     // LiveReconstructionOptions::publish_map
+  double seconds_maps = 0.0;  // the worker's time building them
   std::string error;  // a failure that stopped the worker (the keyframes stay on disk)
 };
 
@@ -89,6 +109,14 @@ class LiveReconstruction {
   int NumKeyframes() const;
   int NumProcessed() const;  // taken by the worker and finished
   int NumRegistered() const;
+  // The newest map (LiveReconstructionOptions::publish_map); a null map before the first one.
+  LiveMap LatestMap() const;
+  int MapVersion() const;  // LatestMap().version, without copying it
+  // The newest map built from at most the first `keyframes` keyframes, once the worker has
+  // processed that many (or stopped): it waits. For a replay, whose frames must meet the same map
+  // on every run however far the worker lags. The last kMapsKept maps are kept for it.
+  LiveMap MapAsOf(int keyframes);
+  static constexpr size_t kMapsKept = 8;
 
   // Waits for the queue to drain, writes the outputs above; errors name the file.
   Result<LiveReconstructionReport> Finish();
@@ -99,6 +127,8 @@ class LiveReconstruction {
   MapperOptions MapperOnOneThread() const;
   // Makes model_ the one the capture sees: registered count, coverage, newly registered keyframes.
   void PublishModel();
+  // Builds and publishes the localisation map of model_; a failure leaves the last map.
+  void PublishMap();
   // The final global adjustment of the live model, once (Finish()).
   Status AdjustFinally();
 
@@ -115,6 +145,8 @@ class LiveReconstruction {
   int registered_now_ = 0;             // guarded by mutex_
   std::vector<bool> coverage_;         // guarded by mutex_
   Status worker_error_;                // guarded by mutex_
+  bool worker_stopped_ = false;        // guarded by mutex_: by an error
+  std::deque<LiveMap> maps_;           // guarded by mutex_: the newest last
 
   // The worker's own state.
   PhotoFeatureExtractor extractor_;
@@ -132,6 +164,8 @@ class LiveReconstruction {
   MapperContinuation growth_;          // local adjustments; global ones at growth milestones
   double seconds_features_ = 0.0, seconds_matching_ = 0.0, seconds_mapping_ = 0.0, seconds_final_adjustment_ = 0.0;
   int pairs_matched_ = 0;
+  double seconds_maps_ = 0.0;
+  int maps_published_ = 0;
 
   std::thread worker_;
 };

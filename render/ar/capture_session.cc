@@ -41,6 +41,13 @@ bool IsReplay(const std::string& source) {
 
 }  // namespace
 
+CaptureOptions::CaptureOptions() {
+  // The map lags the person: frames beyond it are the usual case, not a failure to recover from
+  // at once. A relocalisation (SIFT on the frame) costs ~40 ms at 640x480; once every ten frames
+  // keeps the capture at video rate while it waits for the map to reach the view.
+  map_tracker.lost_relocalise_interval = 10;
+}
+
 Status CaptureOptions::Check() const {
   if (source.empty()) return InvalidArgument("capture: no source");
   if (project_dir.empty()) return InvalidArgument("capture: no project directory");
@@ -48,6 +55,7 @@ Status CaptureOptions::Check() const {
   if (jpeg_quality < 1 || jpeg_quality > 100) return InvalidArgument("capture: jpeg_quality must be in [1, 100]");
   if (!(focal_px >= 0.0)) return InvalidArgument("capture: focal_px < 0");
   if (max_corrupt_frames_in_a_row < 1) return InvalidArgument("capture: max_corrupt_frames_in_a_row < 1");
+  if (map_lag_keyframes < 0) return InvalidArgument("capture: map_lag_keyframes < 0");
   return gate.Check();
 }
 
@@ -86,7 +94,41 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
   std::unique_ptr<LiveReconstruction> live;
   std::vector<std::string> live_paths;  // in the order given to `live`
   std::vector<bool> keyframe_registered;  // in the same order
-  if (options.reconstruct_live) live = std::make_unique<LiveReconstruction>(Project(options.project_dir), options.live);
+  if (options.reconstruct_live) {
+    LiveReconstructionOptions live_options = options.live;
+    live_options.publish_map = live_options.publish_map || options.track_map;
+    live = std::make_unique<LiveReconstruction>(Project(options.project_dir), live_options);
+  }
+  // The camera followed against the live model's newest map.
+  LiveMap map;
+  std::unique_ptr<MapTracker> map_tracker;
+  MapTrackerFrameReport map_report;
+  std::vector<double> map_track_ms;
+  const auto track_map = [&](const Frame& frame, CaptureEvent* event) -> Status {
+    if (!live || !options.track_map) return Status::Ok();
+    LiveMap newest = replay ? live->MapAsOf(live->NumKeyframes() - options.map_lag_keyframes) : LiveMap();
+    if (!replay && live->MapVersion() != map.version) newest = live->LatestMap();
+    if (newest.version != map.version && newest.map) {
+      map_tracker.reset();  // it borrows the old map
+      map = std::move(newest);
+      MapTrackerOptions tracker_options = options.map_tracker;
+      tracker_options.intrinsics = ScaledIntrinsics(map.intrinsics, frame.width, frame.height);
+      Result<std::unique_ptr<MapTracker>> created = MapTracker::Create(map.map.get(), tracker_options);
+      if (!created.ok()) return created.status().WithContext("following the live model");
+      map_tracker = std::move(created).value();
+      ++report.maps_used;
+    }
+    if (!map_tracker) return Status::Ok();
+    RECONAR_RETURN_IF_ERROR(map_tracker->Track(frame.gray, nullptr, &map_report));
+    map_track_ms.push_back(map_report.track_ms);
+    event->map_version = map.version;
+    event->map_state = map_report.state;
+    event->map_pose_found = map_report.found;
+    event->cam_from_world = map_report.cam_from_world;
+    event->map_inliers = map_report.inliers;
+    if (map_report.found) ++report.frames_map_posed;
+    return Status::Ok();
+  };
   const auto emit_registered = [&](int64_t frame_index, double video_seconds) {
     if (!live) return;
     for (const int k : live->TakeNewlyRegistered()) {
@@ -221,6 +263,9 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     const Status judged = gate.Process(frame.gray, &event.gate);
     gate_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     if (!judged.ok()) return Status(judged.code(), std::string(frame.name) + ": " + judged.message());
+    if (const Status tracked = track_map(frame, &event); !tracked.ok()) {
+      return Status(tracked.code(), std::string(frame.name) + ": " + tracked.message());
+    }
     switch (event.gate.verdict) {
       case GateVerdict::kBlurred:
         ++report.blurred;
@@ -276,10 +321,14 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
       emit(event);
       RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate));
       taken = previewing;
+    } else if (options.frame_events) {
+      event.kind = CaptureEvent::Kind::kFrame;
+      emit(event);
     }
     if (!show_preview(frame, event.gate, taken)) break;
   }
   report.median_gate_ms = Median(gate_ms);
+  report.median_map_track_ms = Median(map_track_ms);
   if (live) {
     // The worker finishes the keyframes it has not reached; its events still reach the caller.
     RECONAR_ASSIGN_OR_RETURN(report.live_model, live->Finish());

@@ -20,10 +20,12 @@
 #include "core/pipeline/live_reconstruction.h"
 #include "platform/camera/frame_source.h"
 #include "tracker/keyframe_gate.h"
+#include "tracker/map_tracker.h"
 
 namespace reconar {
 
 struct CaptureOptions {
+  CaptureOptions();
   std::string source;  // OpenFrameSource specification
   FrameSourceOptions source_options;
   std::string project_dir;
@@ -36,6 +38,17 @@ struct CaptureOptions {
   // The sparse model grown in the background from the keyframes (live_reconstruction.h).
   bool reconstruct_live = true;
   LiveReconstructionOptions live;
+  // Follow the camera against the live model (its localisation map, rebuilt when the model starts
+  // and at its global adjustments: LiveReconstructionOptions::publish_map): each frame's pose in
+  // the model's frame. map_tracker.intrinsics is the model's camera, scaled to the frame. A live
+  // camera is followed against the newest map; a replay against the newest built from all
+  // keyframes but the last map_lag_keyframes, waiting for the worker to get there, so that its
+  // frames meet the same maps, and get the same poses, on every run.
+  bool track_map = true;
+  int map_lag_keyframes = 1;
+  MapTrackerOptions map_tracker;
+  // A kFrame event for every frame no other event reports (for a caller that wants every pose).
+  bool frame_events = false;
   // A folder or recording replayed at the pace of its timestamps, as a camera would deliver it
   // (for measuring the live model's latency); false: as fast as the gate goes.
   bool replay_in_real_time = false;
@@ -53,7 +66,7 @@ struct CaptureOptions {
 };
 
 struct CaptureEvent {
-  enum class Kind { kStatus, kKeyframe, kRegistered, kWarning };
+  enum class Kind { kStatus, kKeyframe, kRegistered, kWarning, kFrame };
   Kind kind = Kind::kStatus;
   int64_t frame_index = 0;
   double video_seconds = 0.0;  // the frame's timestamp since the first frame
@@ -63,6 +76,12 @@ struct CaptureEvent {
   std::string message;         // kWarning
   int frames = 0, keyframes = 0;
   int registered = 0;  // keyframes in the live model
+  // The frame against the live model's map (kStatus, kKeyframe, kFrame; map_version 0: no map yet).
+  int map_version = 0;
+  MapTrackingState map_state = MapTrackingState::kLost;
+  bool map_pose_found = false;
+  Rigid3 cam_from_world;  // in the live model's frame, when map_pose_found
+  int map_inliers = 0;
 };
 
 struct CaptureReport {
@@ -79,6 +98,11 @@ struct CaptureReport {
   bool window_failed = false;  // CaptureOptions::show_preview ended with an error (a display that went away)
   std::vector<std::string> keyframe_files;
   int previews = 0;   // pictures written to CaptureOptions::preview_dir
+  // Following the live model's map (CaptureOptions::track_map): frames posed, maps used, the
+  // median time per frame tracked (relocalisations included).
+  int frames_map_posed = 0;
+  int maps_used = 0;
+  double median_map_track_ms = 0.0;
   bool live = false;  // CaptureOptions::reconstruct_live: `live_model` holds the live model's report
   LiveReconstructionReport live_model;
 };

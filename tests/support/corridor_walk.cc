@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <random>
 
@@ -181,6 +182,19 @@ Result<GroundTruthByName> RenderCorridorWalk(const std::string& out_dir, const C
     truth[name] = camera;
   }
   return truth;
+}
+
+Result<CorridorVideo> RenderCorridorVideo(const std::string& out_dir) {
+  CorridorVideo video;
+  video.walk.frames = 90;
+  video.walk.step_m = 0.05;
+  std::error_code error;
+  std::filesystem::create_directories(out_dir, error);
+  if (error) return IoError(out_dir + ": cannot create the directory: " + error.message());
+  RECONAR_ASSIGN_OR_RETURN(video.truth, RenderCorridorWalk(out_dir, video.walk));
+  for (const auto& [name, camera] : video.truth) video.names.push_back(name);
+  std::sort(video.names.begin(), video.names.end());
+  return video;
 }
 
 }  // namespace reconar::testing

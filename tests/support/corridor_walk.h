@@ -5,6 +5,7 @@
 // sways, bobs and turns a little as a person walking does. Test support only.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/base/status.h"
 #include "tests/support/sfm_evaluation.h"
@@ -32,5 +33,15 @@ struct CorridorWalkOptions {
 // Renders the walk into `out_dir` as walk_NN.png and returns each view's true camera by file
 // name. InvalidArgument for unusable options; the PNG writer's error for a file it cannot write.
 Result<GroundTruthByName> RenderCorridorWalk(const std::string& out_dir, const CorridorWalkOptions& options = {});
+
+// The capture tests' hand-held video: a slow walk of 90 frames 5 cm apart, rendered into `out_dir`
+// (created).
+struct CorridorVideo {
+  CorridorWalkOptions walk;
+  GroundTruthByName truth;
+  std::vector<std::string> names;  // the frames' file names, in order
+  double length_m() const { return walk.step_m * (walk.frames - 1); }
+};
+Result<CorridorVideo> RenderCorridorVideo(const std::string& out_dir);
 
 }  // namespace reconar::testing

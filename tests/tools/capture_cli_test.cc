@@ -414,14 +414,11 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
   const fs::path root = testing::MakeTestDirectory("capture_hand_held");
   const fs::path video = root / "video";
   fs::create_directories(video);
-  testing::CorridorWalkOptions walk;
-  walk.frames = 90;
-  walk.step_m = 0.05;
-  auto truth = testing::RenderCorridorWalk(video.string(), walk);
-  ASSERT_TRUE(truth.ok()) << truth.status().ToString();
-  std::vector<std::string> names;
-  for (const auto& [name, camera] : *truth) names.push_back(name);
-  std::sort(names.begin(), names.end());
+  auto rendered = testing::RenderCorridorVideo(video.string());
+  ASSERT_TRUE(rendered.ok()) << rendered.status().ToString();
+  const testing::CorridorWalkOptions& walk = rendered->walk;
+  const testing::GroundTruthByName* truth = &rendered->truth;
+  const std::vector<std::string>& names = rendered->names;
   ASSERT_EQ(names.size(), 90u);
   std::set<int> blurred;
   for (int i = 0; i < walk.frames; ++i) {
@@ -491,7 +488,7 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
     kth =
         ScoreAgainstTruth(root / "every_kth_project" / "sparse", *truth, [](const std::string& name) { return name; });
   }
-  const double walk_length = walk.step_m * (walk.frames - 1);
+  const double walk_length = rendered->length_m();
   std::printf(
       "%d frames, %zu blurred, 15 darker: %d keyframes (passed over: %g judged blurred, %g badly exposed, %g too "
       "close, %g lost); live model %d of %d registered, centre error mean %.3f %% of the %.2f m walk "
