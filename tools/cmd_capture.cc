@@ -173,7 +173,8 @@ int RunCapture(int argc, char** argv, int first) {
       out.Key("median_latency_s").Double(live.median_latency_seconds);
       out.Key("p95_latency_s").Double(live.p95_latency_seconds).EndObject();
       out.Key("map").BeginObject().Key("maps").Int(report->maps_used).Key("frames_posed").Int(report->frames_map_posed);
-      out.Key("median_track_ms").Double(report->median_map_track_ms).EndObject();
+      out.Key("median_track_ms").Double(report->median_map_track_ms);
+      out.Key("frames_baseline_from_map").Int(report->frames_map_motion).EndObject();
     }
     out.EndObject();
     std::printf("%s\n", out.str().c_str());
@@ -194,9 +195,9 @@ int RunCapture(int argc, char** argv, int first) {
       if (report->maps_used > 0) {
         std::printf(
             "followed against the live model: %d of %d frames posed, %d maps (built in %.1f s), %.1f ms per frame "
-            "(median)\n",
-            report->frames_map_posed, report->frames, report->maps_used, live.seconds_maps,
-            report->median_map_track_ms);
+            "(median); baseline from the poses for %d frames\n",
+            report->frames_map_posed, report->frames, report->maps_used, live.seconds_maps, report->median_map_track_ms,
+            report->frames_map_motion);
       }
     }
   }

@@ -49,6 +49,8 @@ Status KeyframeGateOptions::Check() const {
   if (!(min_bright_level >= 0.0 && max_dark_level <= 255.0))
     return InvalidArgument("KeyframeGateOptions: need min_bright_level >= 0 and max_dark_level <= 255");
   if (!(keyframe_parallax > 0.0)) return InvalidArgument("KeyframeGateOptions: keyframe_parallax <= 0");
+  if (!(keyframe_angle_deg > 0.0 && keyframe_angle_deg < 90.0))
+    return InvalidArgument("KeyframeGateOptions: keyframe_angle_deg must be in (0, 90)");
   if (!(lost_overlap >= 0.0 && keyframe_overlap > lost_overlap && keyframe_overlap <= 1.0))
     return InvalidArgument("KeyframeGateOptions: need 0 <= lost_overlap < keyframe_overlap <= 1");
   if (!(max_frame_motion > 0.0)) return InvalidArgument("KeyframeGateOptions: max_frame_motion <= 0");
@@ -141,10 +143,31 @@ void KeyframeGate::RememberSharpness(double sharpness) {
   sharpness_max_ = std::max(sharpness_max_, sharpness);
 }
 
+double KeyframeGate::TriangulationAngleDeg(const GateMapPose& map_pose) {
+  const Eigen::Vector3d centre = map_pose.cam_from_world.Inverse().translation;
+  const int count = std::min(map_pose.num_points, kMaxAnglePoints);
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector3d from_keyframe = keyframe_centre_ - map_pose.points[i];
+    const Eigen::Vector3d from_frame = centre - map_pose.points[i];
+    angles_[static_cast<size_t>(i)] = std::atan2(from_keyframe.cross(from_frame).norm(), from_keyframe.dot(from_frame));
+  }
+  double* middle = angles_.data() + count / 2;
+  std::nth_element(angles_.data(), middle, angles_.data() + count);
+  return *middle * 180.0 / M_PI;
+}
+
+void KeyframeGate::MoveKeyframeToMap(int map_version, const Sim3& new_from_old) {
+  if (keyframe_map_version_ == 0) return;
+  keyframe_centre_ = new_from_old.Apply(keyframe_centre_);
+  keyframe_map_version_ = map_version;
+}
+
 // Corners of the newest frame: per grid cell the pixel with the largest smaller eigenvalue of the
 // 3x3 structure tensor (Shi & Tomasi, "Good Features to Track", CVPR 1994), when it is textured
 // enough for the flow.
-void KeyframeGate::TakeKeyframe() {
+void KeyframeGate::TakeKeyframe(const GateMapPose* map_pose) {
+  keyframe_map_version_ = map_pose != nullptr ? map_pose->map_version : 0;
+  if (keyframe_map_version_ > 0) keyframe_centre_ = map_pose->cam_from_world.Inverse().translation;
   const int w = small_.width(), h = small_.height();
   const int margin = flow_options_.window_radius + 2;
   num_corners_ = 0;
@@ -294,7 +317,7 @@ Status KeyframeGate::FollowCorners(GateFrameReport* report) {
   return Status::Ok();
 }
 
-Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* report) {
+Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* report, const GateMapPose* map_pose) {
   *report = GateFrameReport();
   if (gray.data == nullptr || gray.width <= 0 || gray.height <= 0)
     return InvalidArgument("keyframe gate: an empty frame");
@@ -316,6 +339,14 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
   RECONAR_RETURN_IF_ERROR(pyramids_[current_].Build(small_.view(), kPyramidLevels));
   MeasureImage(gray, report);
   if (have_keyframe_) RECONAR_RETURN_IF_ERROR(FollowCorners(report));
+  if (!options_.use_map_poses) map_pose = nullptr;
+  if (have_keyframe_ && map_pose != nullptr && map_pose->map_version > 0 &&
+      map_pose->map_version == keyframe_map_version_ && map_pose->num_points >= kMinAnglePoints) {
+    report->triangulation_angle_deg = TriangulationAngleDeg(*map_pose);
+  }
+  const bool enough_baseline = report->triangulation_angle_deg >= 0.0
+                                   ? report->triangulation_angle_deg >= options_.keyframe_angle_deg
+                                   : report->parallax >= options_.keyframe_parallax;
 
   const bool too_dark = report->bright_level < options_.min_bright_level;
   const bool too_bright = report->dark_level > options_.max_dark_level;
@@ -340,14 +371,14 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
       report->restarted = true;
       report->advice = GateAdvice::kRestarted;
     }
-  } else if (report->parallax >= options_.keyframe_parallax || report->overlap < options_.keyframe_overlap) {
+  } else if (enough_baseline || report->overlap < options_.keyframe_overlap) {
     report->verdict = GateVerdict::kKeyframe;
     report->advice = fast ? GateAdvice::kTooFast : GateAdvice::kMoveSideways;
   } else {
     report->verdict = GateVerdict::kTooClose;
     report->advice = fast ? GateAdvice::kTooFast : GateAdvice::kMoveSideways;
   }
-  if (report->verdict == GateVerdict::kKeyframe) TakeKeyframe();
+  if (report->verdict == GateVerdict::kKeyframe) TakeKeyframe(map_pose);
   if (report->verdict != GateVerdict::kLost) lost_frames_ = 0;
   return Status::Ok();
 }

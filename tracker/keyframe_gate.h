@@ -17,7 +17,11 @@
 //    best homography of the keyframe puts them: a camera turning on the spot, or a plane, gives
 //    none, depth seen from a new place does), the share still followed (the overlap with the
 //    keyframe), and the median displacement since the previous frame (how fast the view moves).
-// A sharp, well-exposed frame becomes a keyframe when it has enough parallax to triangulate
+// With the frame's pose against the live model (GateMapPose, from the capture's map tracking) and
+// the last keyframe's in the same map, the baseline is measured in 3D instead of by the parallax:
+// the median, over the map points the pose rests on, of the angle between their rays from the
+// last keyframe and from this frame (the triangulation angle a point seen in both would get).
+// A sharp, well-exposed frame becomes a keyframe when it has enough baseline to triangulate
 // from, or when the overlap has fallen so low that the next one would not register
 // (docs/capture.md gives the rules and the reasons for their defaults). Steady state makes no heap allocation: every
 // buffer is sized on the first frame (tests/tracker/keyframe_gate_allocation_test.cc).
@@ -30,6 +34,8 @@
 #include "core/base/status.h"
 #include "core/features/optical_flow.h"
 #include "core/geometry/correspondence.h"
+#include "core/math/rigid3.h"
+#include "core/math/sim3.h"
 
 namespace reconar {
 
@@ -52,6 +58,12 @@ struct KeyframeGateOptions {
   double keyframe_overlap = 0.6;         // ... or fewer than this share of its corners are still followed
   double lost_overlap = 0.25;            // fewer than this: lost (the next keyframe would not register)
   double max_frame_motion = 0.06;        // more per frame: "too fast"
+  // With map poses: a keyframe once the median triangulation angle to the last keyframe reaches
+  // this, instead of keyframe_parallax. The mapper's own minimum for triangulating a point
+  // (MapperOptions::min_triangulation_angle_deg, COLMAP's too): half the points the new keyframe
+  // shares with the last one reach it, most of those it shares with the one before.
+  double keyframe_angle_deg = 1.5;
+  bool use_map_poses = true;
   int grid_columns = 10, grid_rows = 8;  // one corner per cell
   int lost_frames_to_restart = 30;       // after this many lost frames in a row, start again from a new keyframe
 
@@ -81,6 +93,15 @@ struct GateAdvice {
                                                       kBlurred, kMoveSideways, kLost,       kRestarted};
 };
 
+// A frame's pose against a map (the capture's live model), for the motion test. map_version tells
+// maps apart (each has a frame of its own); 0: no pose. The points are borrowed for the call.
+struct GateMapPose {
+  int map_version = 0;
+  Rigid3 cam_from_world;
+  const Eigen::Vector3d* points = nullptr;  // the map points the pose rests on (its inliers)
+  int num_points = 0;
+};
+
 struct GateFrameReport {
   GateVerdict verdict = GateVerdict::kTooClose;
   const char* advice = "";           // plain words for the person: "too fast", "too dark", "move sideways", ...
@@ -94,6 +115,9 @@ struct GateFrameReport {
   double parallax = 0.0;      // median distance from the keyframe's homography / analysis width
   double frame_motion = 0.0;  // median displacement since the previous frame / analysis width
   double overlap = 1.0;       // share of the keyframe's corners still followed
+  // Median triangulation angle to the last keyframe from the map poses (degrees); < 0 when not
+  // measured (no pose for this frame or the keyframe in the same map): the parallax decides then.
+  double triangulation_angle_deg = -1.0;
   int corners = 0;            // corners found in the last keyframe
   bool restarted = false;     // a keyframe taken after being lost for lost_frames_to_restart frames
   bool recovered = false;     // the corners were found again from the keyframe after being lost
@@ -105,18 +129,26 @@ class KeyframeGate {
 
   // Judges the next frame (8-bit grey, any size; every frame the same size).
   // InvalidArgument for an empty frame, a frame of another size than the first, or bad options.
-  Status Process(ImageView<const uint8_t> gray, GateFrameReport* report);
+  // map_pose: the frame's pose against the live model, when known (may be null).
+  Status Process(ImageView<const uint8_t> gray, GateFrameReport* report, const GateMapPose* map_pose = nullptr);
 
   int keyframes() const { return keyframes_; }
+  // The map of the last keyframe's pose (0: none), and that pose carried into a newer map:
+  // new_from_old takes the old map's frame into the new one's (the maps' shared keyframes give it).
+  int keyframe_map_version() const { return keyframe_map_version_; }
+  void MoveKeyframeToMap(int map_version, const Sim3& new_from_old);
 
  private:
   static constexpr int kMaxCorners = 256;
+  static constexpr int kMaxAnglePoints = 1024;  // of a map pose's points, the first this many
+  static constexpr int kMinAnglePoints = 12;
 
   void Downscale(ImageView<const uint8_t> gray);
   void MeasureImage(ImageView<const uint8_t> gray, GateFrameReport* report) const;
   double SharpnessReference() const;
   void RememberSharpness(double sharpness);
-  void TakeKeyframe();
+  void TakeKeyframe(const GateMapPose* map_pose);
+  double TriangulationAngleDeg(const GateMapPose& map_pose);
   Status FollowCorners(GateFrameReport* report);
   double Parallax(int count);
   Status ConsistentFlow(const ImagePyramid& previous, const ImagePyramid& next, const Eigen::Vector2f* from);
@@ -142,6 +174,9 @@ class KeyframeGate {
   std::array<Correspondence, kMaxCorners> inlier_pairs_{};
   std::array<double, kMaxCorners> residuals_{};
   int num_corners_ = 0;
+  int keyframe_map_version_ = 0;  // of the last keyframe's pose; 0: none
+  Eigen::Vector3d keyframe_centre_ = Eigen::Vector3d::Zero();
+  std::array<double, kMaxAnglePoints> angles_{};
   std::array<double, 64> sharpness_history_{};
   int history_count_ = 0, history_next_ = 0;
   double sharpness_max_ = 0.0;

@@ -7,7 +7,9 @@
 //   - the live model's cameras against the rendered poses (7-DoF aligned);
 //   - `sfm` run afterwards on the same keyframes;
 //   - `sfm` on every k-th frame, k giving as many frames as the capture kept.
-//   bench_capture_handheld PROJECT OUT_DIR [frames=150]
+//   bench_capture_handheld PROJECT OUT_DIR [frames=150] [map|parallax]
+// (the gate's baseline: from the live model's poses where it has them, the default, or from the
+// parallax alone)
 // PROJECT holds mesh/mesh.ply (with vertex colours) and sparse/ (COLMAP text). OUT_DIR is
 // replaced.
 #include <Eigen/Geometry>
@@ -116,12 +118,16 @@ reconar::Status SparseOnly(const std::vector<std::string>& photos, const std::st
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: bench_capture_handheld PROJECT OUT_DIR [frames=150]\n");
+    std::fprintf(stderr, "usage: bench_capture_handheld PROJECT OUT_DIR [frames=150] [map|parallax]\n");
     return 2;
   }
   const std::string project = argv[1];
   const fs::path out = argv[2];
   const int frames = argc > 3 ? std::max(20, std::atoi(argv[3])) : 150;
+  const std::string baseline = argc > 4 ? argv[4] : "map";
+  if (baseline != "map" && baseline != "parallax") {
+    return Fail(reconar::InvalidArgument("the baseline must be map or parallax, not " + baseline));
+  }
   auto mesh = reconar::ReadMeshFile(project + "/mesh/mesh.ply");
   if (!mesh.ok()) return Fail(mesh.status());
   auto model = reconar::ReadColmapTextModel(project + "/sparse");
@@ -200,6 +206,7 @@ int main(int argc, char** argv) {
   reconar::CaptureOptions capture;
   capture.source = video.string();
   capture.project_dir = (out / "capture").string();
+  capture.gate.use_map_poses = baseline == "map";
   std::map<std::string, std::string> frame_of_keyframe;
   int blurred_taken = 0;
   auto report = reconar::RunCapture(capture, [&](const reconar::CaptureEvent& event) {
@@ -234,9 +241,11 @@ int main(int argc, char** argv) {
               frames, project.c_str(), keys.size(), extent, blurred.size(), frames * 11 / 20 - frames * 2 / 5);
   std::printf(
       "capture: %d keyframes, %d of them blurred; passed over %d judged blurred, %d badly exposed, %d too "
-      "close, %d lost; gate %.2f ms per frame\n",
+      "close, %d lost; gate %.2f ms per frame; baseline from %s (from the map poses for %d frames; %d of %d "
+      "frames posed, %.2f ms per frame)\n",
       keyframes, blurred_taken, report->blurred, report->bad_exposure, report->too_close, report->lost,
-      report->median_gate_ms);
+      report->median_gate_ms, baseline.c_str(), report->frames_map_motion, report->frames_map_posed, report->frames,
+      report->median_map_track_ms);
   std::printf(
       "live model:        %d of %d registered (%.1f %%), centre error mean %.4f %% of the path, rotation mean "
       "%.3f deg; keyframe to registration %.2f s median, %.2f s p95\n",

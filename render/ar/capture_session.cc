@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "core/base/atomic_file.h"
@@ -19,6 +21,25 @@ namespace reconar {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The similarity taking map `from`'s frame into map `to`'s, from the centres of the keyframes both
+// hold (by name). Unset with fewer than 3 shared (or all on one spot).
+std::optional<Sim3> MapFromMap(const LocalizationMap& to, const LocalizationMap& from) {
+  std::map<std::string, Eigen::Vector3d> from_centres;
+  for (const MapKeyframe& keyframe : from.keyframes)
+    from_centres[keyframe.name] = keyframe.cam_from_world.Inverse().translation;
+  std::vector<Eigen::Vector3d> from_points, to_points;
+  for (const MapKeyframe& keyframe : to.keyframes) {
+    const auto found = from_centres.find(keyframe.name);
+    if (found == from_centres.end()) continue;
+    from_points.push_back(found->second);
+    to_points.push_back(keyframe.cam_from_world.Inverse().translation);
+  }
+  if (from_points.size() < 3) return std::nullopt;
+  Result<Sim3> to_from_from = AlignSimilarity(from_points, to_points);
+  if (!to_from_from.ok()) return std::nullopt;
+  return *to_from_from;
+}
 
 std::string KeyframeName(int ordinal) {
   char name[32];
@@ -99,6 +120,7 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     live_options.publish_map = live_options.publish_map || options.track_map;
     live = std::make_unique<LiveReconstruction>(Project(options.project_dir), live_options);
   }
+  KeyframeGate keyframe_gate(options.gate);
   // The camera followed against the live model's newest map.
   LiveMap map;
   std::unique_ptr<MapTracker> map_tracker;
@@ -110,6 +132,11 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     if (!replay && live->MapVersion() != map.version) newest = live->LatestMap();
     if (newest.version != map.version && newest.map) {
       map_tracker.reset();  // it borrows the old map
+      // The gate's last keyframe, posed in the old map, carried into the new one.
+      if (map.map && keyframe_gate.keyframe_map_version() == map.version) {
+        if (const std::optional<Sim3> new_from_old = MapFromMap(*newest.map, *map.map))
+          keyframe_gate.MoveKeyframeToMap(newest.version, *new_from_old);
+      }
       map = std::move(newest);
       MapTrackerOptions tracker_options = options.map_tracker;
       tracker_options.intrinsics = ScaledIntrinsics(map.intrinsics, frame.width, frame.height);
@@ -214,7 +241,6 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     return false;
   };
 
-  KeyframeGate gate(options.gate);
   std::vector<double> gate_ms;
   int corrupt_in_a_row = 0;
   std::string last_damage;
@@ -259,13 +285,21 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
       std::this_thread::sleep_until(replay_start + std::chrono::duration<double>(event.video_seconds));
     emit_registered(event.frame_index, event.video_seconds);
     if (live) event.registered = live->NumRegistered();
-    const auto start = std::chrono::steady_clock::now();
-    const Status judged = gate.Process(frame.gray, &event.gate);
-    gate_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-    if (!judged.ok()) return Status(judged.code(), std::string(frame.name) + ": " + judged.message());
     if (const Status tracked = track_map(frame, &event); !tracked.ok()) {
       return Status(tracked.code(), std::string(frame.name) + ": " + tracked.message());
     }
+    GateMapPose map_pose;
+    if (event.map_pose_found) {
+      map_pose.map_version = event.map_version;
+      map_pose.cam_from_world = event.cam_from_world;
+      map_pose.points = map_report.inlier_world_points.data();
+      map_pose.num_points = static_cast<int>(map_report.inlier_world_points.size());
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const Status judged = keyframe_gate.Process(frame.gray, &event.gate, &map_pose);
+    gate_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    if (!judged.ok()) return Status(judged.code(), std::string(frame.name) + ": " + judged.message());
+    if (event.gate.triangulation_angle_deg >= 0.0) ++report.frames_map_motion;
     switch (event.gate.verdict) {
       case GateVerdict::kBlurred:
         ++report.blurred;

@@ -101,6 +101,7 @@ struct CaptureReport {
   // Following the live model's map (CaptureOptions::track_map): frames posed, maps used, the
   // median time per frame tracked (relocalisations included).
   int frames_map_posed = 0;
+  int frames_map_motion = 0;  // whose baseline the gate measured from the map poses
   int maps_used = 0;
   double median_map_track_ms = 0.0;
   bool live = false;  // CaptureOptions::reconstruct_live: `live_model` holds the live model's report

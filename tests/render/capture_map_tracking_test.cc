@@ -60,9 +60,9 @@ TEST(CaptureMapTracking, FramesArePosedAgainstTheGrowingModel) {
   const double walk_length = video->length_m();
   std::printf(
       "%d frames, %d keyframes, %d registered; %d maps; %d of the %d frames after the first map posed "
-      "against them, %.2f ms per frame (median)\n",
+      "against them, %.2f ms per frame (median); baseline from the poses for %d frames\n",
       report->frames, report->keyframes, report->live_model.registered, report->maps_used, report->frames_map_posed,
-      frames_with_map, report->median_map_track_ms);
+      frames_with_map, report->median_map_track_ms, report->frames_map_motion);
   // The keyframes in the final live model, for scale: what the map's own poses are worth.
   auto keyframes = testing::ScoreModelAgainstTruth((root / "capture" / "live").string(), video->truth,
                                                    [&](const std::string& name) { return frame_of_keyframe.at(name); });

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -238,6 +239,77 @@ TEST(KeyframeGateTest, AFrameOfAnotherSizeIsRefused) {
   bad.keyframe_overlap = 0.1;
   KeyframeGate refusing(bad);
   EXPECT_FALSE(refusing.Process(a.view(), &report).ok());
+}
+
+// With map poses the baseline is measured in 3D. The same still picture every frame (no parallax,
+// full overlap: the image tests alone would never take a second keyframe) with poses that move the
+// camera sideways 1 cm a frame in front of points 5 m away: the median triangulation angle is
+// atan(d / 5 m) after d of travel, so the next keyframe comes at the first frame past
+// 5 m x tan(1.5 deg) = 13.1 cm, the 14th. Turning on the spot gives no angle and no keyframe; a pose
+// in another map is not compared until the keyframe is carried into it.
+TEST(KeyframeGateTest, MapPosesMeasureTheBaselineInDegrees) {
+  const testing::RotationScene scene = Scene();
+  const Image<uint8_t> still = testing::RenderRotatedView(scene, testing::YawPitchRoll(0, 0, 0));
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 50; ++i) points.emplace_back(0.1 * (i % 10) - 0.5, 0.1 * (i / 10) - 0.25, 5.0);
+  const auto pose_at = [&](double x_m, double yaw_deg, int version) {
+    GateMapPose pose;
+    pose.map_version = version;
+    // cam_from_world of a camera at (x_m, 0, 0) turned by yaw_deg about the vertical.
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
+    pose.cam_from_world.rotation = rotation;
+    pose.cam_from_world.translation = -rotation * Eigen::Vector3d(x_m, 0.0, 0.0);
+    pose.points = points.data();
+    pose.num_points = static_cast<int>(points.size());
+    return pose;
+  };
+  const double expected_at_m = 5.0 * std::tan(1.5 * M_PI / 180.0);
+
+  KeyframeGate sideways;
+  GateFrameReport report;
+  int second_keyframe = -1;
+  for (int frame = 0; frame < 30 && second_keyframe < 0; ++frame) {
+    const GateMapPose pose = pose_at(0.01 * frame, 0.0, 1);
+    ASSERT_TRUE(sideways.Process(still.view(), &report, &pose).ok());
+    if (frame == 0) {
+      EXPECT_EQ(report.verdict, GateVerdict::kKeyframe);
+      continue;
+    }
+    EXPECT_NEAR(report.triangulation_angle_deg, std::atan(0.01 * frame / 5.0) * 180.0 / M_PI, 0.02) << frame;
+    if (report.verdict == GateVerdict::kKeyframe) second_keyframe = frame;
+  }
+  EXPECT_EQ(second_keyframe, static_cast<int>(std::ceil(expected_at_m / 0.01)));
+
+  KeyframeGate turning;
+  for (int frame = 0; frame < 30; ++frame) {
+    const GateMapPose pose = pose_at(0.0, 0.5 * frame, 1);
+    ASSERT_TRUE(turning.Process(still.view(), &report, &pose).ok());
+    if (frame > 0) {
+      EXPECT_NEAR(report.triangulation_angle_deg, 0.0, 1e-6) << frame;
+      EXPECT_EQ(report.verdict, GateVerdict::kTooClose) << frame;
+    }
+  }
+
+  // Poses in map 2 after a keyframe in map 1: not compared (the parallax decides: none here)...
+  KeyframeGate remapped;
+  GateMapPose pose = pose_at(0.0, 0.0, 1);
+  ASSERT_TRUE(remapped.Process(still.view(), &report, &pose).ok());
+  pose = pose_at(0.5, 0.0, 2);
+  ASSERT_TRUE(remapped.Process(still.view(), &report, &pose).ok());
+  EXPECT_LT(report.triangulation_angle_deg, 0.0);
+  EXPECT_EQ(report.verdict, GateVerdict::kTooClose);
+  // ... until the keyframe is carried into map 2, whose frame is map 1's scaled by 2 and shifted.
+  Sim3 map2_from_map1;
+  map2_from_map1.scale = 2.0;
+  map2_from_map1.translation = Eigen::Vector3d(1.0, 0.0, 0.0);
+  remapped.MoveKeyframeToMap(2, map2_from_map1);
+  EXPECT_EQ(remapped.keyframe_map_version(), 2);
+  std::vector<Eigen::Vector3d> map2_points;
+  for (const Eigen::Vector3d& point : points) map2_points.push_back(map2_from_map1.Apply(point));
+  pose = pose_at(1.0 + 2.0 * 0.05, 0.0, 2);  // 5 cm from the keyframe in map 1's units
+  pose.points = map2_points.data();
+  ASSERT_TRUE(remapped.Process(still.view(), &report, &pose).ok());
+  EXPECT_NEAR(report.triangulation_angle_deg, std::atan(0.05 / 5.0) * 180.0 / M_PI, 0.02);
 }
 
 }  // namespace
