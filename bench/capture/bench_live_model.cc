@@ -1,10 +1,13 @@
-// bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40]: how the capture's live model keeps up as a
-// capture grows. A walk down the rendered corridor (tests/support/corridor_walk.h, exact poses) is
+// bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40] [size=640x480]: how the capture's live model
+// keeps up as a capture grows. A walk down the rendered corridor (tests/support/corridor_walk.h, exact poses) is
 // replayed through `reconar capture`'s loop at 30 frames per second, as a camera would deliver it;
 // printed: the keyframes and how many registered, the time from a keyframe being written to its
 // registration over the first and the last quarter of the keyframes, the worker's time per step,
 // the final adjustment, and the live model's cameras against the truth; twice, with the pair rule's
-// defaults and with every pair matched; then `sfm` run offline on the first run's keyframes.
+// defaults and with every pair matched; then `sfm` run offline on the first run's keyframes. Also
+// the capturing thread's cost per frame (the gate; following the camera against the live model)
+// and the capture's wall time against the video's: a replay waits for the live model when it lags
+// more than a keyframe behind (CaptureOptions::map_lag_keyframes), a camera would not.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -46,8 +49,9 @@ void PrintLatency(const char* what, const std::vector<reconar::LiveKeyframe>& ke
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40]\n"
-                         "  pairs: the pair rule's exhaustive limit, window and retrieved count\n");
+    std::fprintf(stderr,
+                 "usage: bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40] [size=640x480]\n"
+                 "  pairs: the pair rule's exhaustive limit, window and retrieved count\n");
     return 2;
   }
   const fs::path out = argv[1];
@@ -61,6 +65,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_live_model: pairs must be N,W,M, got '%s'\n", argv[4]);
     return 2;
   }
+  if (argc > 5 &&
+      (std::sscanf(argv[5], "%dx%d", &walk.width, &walk.height) != 2 || walk.width < 64 || walk.height < 64)) {
+    std::fprintf(stderr, "bench_live_model: size must be WxH, got '%s'\n", argv[5]);
+    return 2;
+  }
+  walk.focal_px *= walk.width / 640.0;
   std::error_code error;
   fs::remove_all(out, error);
   const fs::path video = out / "video";
@@ -90,16 +100,25 @@ int main(int argc, char** argv) {
     capture.live.matching.pairs = pair_rule;
     if (every_pair) capture.live.matching.pairs.exhaustive_up_to = 1 << 24;
     frame_of_keyframe.clear();
+    const auto capture_start = std::chrono::steady_clock::now();
     auto report = reconar::RunCapture(capture, [&](const reconar::CaptureEvent& event) {
       if (event.kind != reconar::CaptureEvent::Kind::kKeyframe) return;
       frame_of_keyframe[fs::path(event.path).filename().string()] = names[static_cast<size_t>(event.frame_index)];
     });
     if (!report.ok()) return Fail(report.status());
+    const double capture_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - capture_start).count();
     const reconar::LiveReconstructionReport& live = report->live_model;
     const size_t n = live.keyframes.size();
     std::printf("%s: %d frames at 30 fps: %zu keyframes, %d registered in the live model (%d points)\n",
                 every_pair ? "every pair matched" : "pair rule", report->frames, n, live.registered,
                 live.points);
+    std::printf(
+        "  %dx%d; capturing thread per frame (median): gate %.2f ms, following the live model %.2f ms (%d of %d "
+        "frames posed against %d maps; baseline from the poses for %d); capture %.1f s for %.1f s of video (the "
+        "final adjustment included)\n",
+        walk.width, walk.height, report->median_gate_ms, report->median_map_track_ms, report->frames_map_posed,
+        report->frames, report->maps_used, report->frames_map_motion, capture_seconds, walk.frames / 30.0);
     PrintLatency("first quarter", live.keyframes, 0, n / 4);
     PrintLatency("last quarter ", live.keyframes, n - n / 4, n);
     std::printf("  latency over all: median %.2f s, p95 %.2f s\n", live.median_latency_seconds,
