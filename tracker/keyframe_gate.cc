@@ -8,6 +8,7 @@
 #include "core/base/median.h"
 #include "core/base/prng.h"
 #include "core/geometry/homography_four_point.h"
+#include "core/geometry/triangulation.h"
 
 namespace reconar {
 namespace {
@@ -144,13 +145,10 @@ void KeyframeGate::RememberSharpness(double sharpness) {
 }
 
 double KeyframeGate::TriangulationAngleDeg(const GateMapPose& map_pose) {
-  const Eigen::Vector3d centre = map_pose.cam_from_world.Inverse().translation;
+  const Eigen::Vector3d centre = CameraCenterInWorld(map_pose.cam_from_world);
   const int count = std::min(map_pose.num_points, kMaxAnglePoints);
-  for (int i = 0; i < count; ++i) {
-    const Eigen::Vector3d from_keyframe = keyframe_centre_ - map_pose.points[i];
-    const Eigen::Vector3d from_frame = centre - map_pose.points[i];
-    angles_[static_cast<size_t>(i)] = std::atan2(from_keyframe.cross(from_frame).norm(), from_keyframe.dot(from_frame));
-  }
+  for (int i = 0; i < count; ++i)
+    angles_[static_cast<size_t>(i)] = TriangulationAngle(keyframe_centre_, centre, map_pose.points[i]);
   double* middle = angles_.data() + count / 2;
   std::nth_element(angles_.data(), middle, angles_.data() + count);
   return *middle * 180.0 / M_PI;
@@ -167,7 +165,7 @@ void KeyframeGate::MoveKeyframeToMap(int map_version, const Sim3& new_from_old) 
 // enough for the flow.
 void KeyframeGate::TakeKeyframe(const GateMapPose* map_pose) {
   keyframe_map_version_ = map_pose != nullptr ? map_pose->map_version : 0;
-  if (keyframe_map_version_ > 0) keyframe_centre_ = map_pose->cam_from_world.Inverse().translation;
+  if (keyframe_map_version_ > 0) keyframe_centre_ = CameraCenterInWorld(map_pose->cam_from_world);
   const int w = small_.width(), h = small_.height();
   const int margin = flow_options_.window_radius + 2;
   num_corners_ = 0;

@@ -282,14 +282,12 @@ void LiveReconstruction::PublishMap() {
   MapBuildOptions map_options = options_.map;
   map_options.num_threads = 1;
   Result<LocalizationMap> map = BuildLocalizationMap(model_, load, "arbitrary", false, map_options);
-  const double seconds = SecondsBetween(start, Clock::now());
-  seconds_maps_ += seconds;
+  seconds_maps_ += SecondsBetween(start, Clock::now());
   if (!map.ok()) return;  // a model without points yet: the capture keeps the last map
   LiveMap published;
   published.map = std::make_shared<const LocalizationMap>(std::move(map).value());
   published.intrinsics = model_.cameras.front().Intrinsics();
   published.version = ++maps_published_;
-  published.seconds_to_build = seconds;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     published.keyframes = static_cast<int>(done_) + 1;

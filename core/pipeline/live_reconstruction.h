@@ -60,7 +60,6 @@ struct LiveMap {
   CameraIntrinsics intrinsics;                 // the model's camera, at the keyframes' size
   int version = 0;                             // maps published so far
   int keyframes = 0;                           // keyframes processed when it was built
-  double seconds_to_build = 0.0;
 };
 
 struct LiveKeyframe {

@@ -27,13 +27,13 @@ namespace fs = std::filesystem;
 std::optional<Sim3> MapFromMap(const LocalizationMap& to, const LocalizationMap& from) {
   std::map<std::string, Eigen::Vector3d> from_centres;
   for (const MapKeyframe& keyframe : from.keyframes)
-    from_centres[keyframe.name] = keyframe.cam_from_world.Inverse().translation;
+    from_centres[keyframe.name] = CameraCenterInWorld(keyframe.cam_from_world);
   std::vector<Eigen::Vector3d> from_points, to_points;
   for (const MapKeyframe& keyframe : to.keyframes) {
     const auto found = from_centres.find(keyframe.name);
     if (found == from_centres.end()) continue;
     from_points.push_back(found->second);
-    to_points.push_back(keyframe.cam_from_world.Inverse().translation);
+    to_points.push_back(CameraCenterInWorld(keyframe.cam_from_world));
   }
   if (from_points.size() < 3) return std::nullopt;
   Result<Sim3> to_from_from = AlignSimilarity(from_points, to_points);
@@ -128,8 +128,12 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
   std::vector<double> map_track_ms;
   const auto track_map = [&](const Frame& frame, CaptureEvent* event) -> Status {
     if (!live || !options.track_map) return Status::Ok();
-    LiveMap newest = replay ? live->MapAsOf(live->NumKeyframes() - options.map_lag_keyframes) : LiveMap();
-    if (!replay && live->MapVersion() != map.version) newest = live->LatestMap();
+    LiveMap newest;
+    if (replay) {
+      newest = live->MapAsOf(live->NumKeyframes() - options.map_lag_keyframes);
+    } else if (live->MapVersion() != map.version) {
+      newest = live->LatestMap();
+    }
     if (newest.version != map.version && newest.map) {
       map_tracker.reset();  // it borrows the old map
       // The gate's last keyframe, posed in the old map, carried into the new one.

@@ -49,7 +49,7 @@ TEST(CaptureMapTracking, FramesArePosedAgainstTheGrowingModel) {
     ASSERT_TRUE(event.frame_index >= 0 && event.frame_index < frames);
     testing::CameraPose pose;
     pose.cam_from_world_rotation = event.cam_from_world.rotation;
-    pose.centre = event.cam_from_world.Inverse().translation;
+    pose.centre = CameraCenterInWorld(event.cam_from_world);
     posed[event.map_version].push_back(pose);
     true_poses[event.map_version].push_back(
         testing::PoseOf(video->truth.at(video->names[static_cast<size_t>(event.frame_index)])));
