@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/base/atomic_file.h"
+#include "core/base/file_order.h"
 
 namespace reconar {
 
@@ -69,7 +70,7 @@ Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string
         if (ext == ".jpg" || ext == ".jpeg" || ext == ".png") found.push_back(entry.path().string());
       }
       if (ec) return FileError(StatusCode::kIoError, argument, "cannot list directory: " + ec.message());
-      std::sort(found.begin(), found.end());
+      SortFileNames(&found);
       paths.insert(paths.end(), found.begin(), found.end());
     } else if (fs::exists(argument, ec)) {
       paths.push_back(argument);

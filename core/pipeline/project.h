@@ -53,8 +53,8 @@ class Project {
 };
 
 // Expands arguments into image files: a directory contributes its .jpg/.jpeg/.png files (any case,
-// sorted by name), a file is taken as is. NotFound for a missing argument; InvalidArgument when two
-// images share a file name or nothing is left.
+// in name order with numbers by value: FileNameLess), a file is taken as is. NotFound for a missing
+// argument; InvalidArgument when two images share a file name or nothing is left.
 Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string>& arguments);
 
 // Removes a file when it exists; IoError naming the file when it cannot be removed.

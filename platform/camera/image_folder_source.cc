@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "core/base/atomic_file.h"
+#include "core/base/file_order.h"
 #include "platform/camera/pixel_convert.h"
 
 namespace reconar {
@@ -69,7 +70,7 @@ Result<std::unique_ptr<ImageFolderFrameSource>> ImageFolderFrameSource::Open(con
   }
   if (ec) return FileError(StatusCode::kIoError, directory, "cannot list directory: " + ec.message());
   if (names.empty()) return FileError(StatusCode::kNotFound, directory, "no .jpg/.jpeg/.png images in the directory");
-  std::sort(names.begin(), names.end());
+  SortFileNames(&names);
   return std::unique_ptr<ImageFolderFrameSource>(new ImageFolderFrameSource(directory, std::move(names), options));
 }
 

@@ -1,9 +1,9 @@
 #pragma once
-// ImageFolderFrameSource: the .jpg/.jpeg/.png files of one directory (not recursive), sorted by
-// file name (byte order), played as frames. JPEG goes through the same JpegFrameDecoder as MJPEG
-// camera buffers; PNG through libpng's simplified API (8-bit RGB; alpha dropped). Both decode into
-// the source's preallocated buffers. Frame i has timestamp i * 1e9 / options.folder_fps.
-// (platform/ may not use core/io, hence its own small decoding here.)
+// ImageFolderFrameSource: the .jpg/.jpeg/.png files of one directory (not recursive), in name
+// order with numbers by value (core/base/file_order.h: frame_9 before frame_10), played as frames.
+// JPEG goes through the same JpegFrameDecoder as MJPEG camera buffers; PNG through libpng's simplified API (8-bit RGB;
+// alpha dropped). Both decode into the source's preallocated buffers. Frame i has timestamp i * 1e9 /
+// options.folder_fps. (platform/ may not use core/io, hence its own small decoding here.)
 #include <memory>
 #include <string>
 #include <vector>

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "core/io/image_write.h"
 
@@ -172,9 +173,11 @@ Result<GroundTruthByName> RenderCorridorWalk(const std::string& out_dir, const C
   }
   const Corridor corridor(options, std::move(textures));
   GroundTruthByName truth;
+  // Zero-padded to the last frame's digits, so that a plain string sort keeps the walk's order too.
+  const int digits = std::max(2, static_cast<int>(std::to_string(options.frames - 1).size()));
   for (int i = 0; i < options.frames; ++i) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "walk_%02d.png", i);
+    const std::string number = std::to_string(i);
+    const std::string name = "walk_" + std::string(static_cast<size_t>(digits) - number.size(), '0') + number + ".png";
     const GroundTruthCamera camera = WalkCamera(options, i);
     const Image<uint8_t> view = RenderView(corridor, camera, options.supersampling);
     const Status written = WritePng(out_dir + "/" + name, view.view(), 3);

@@ -48,6 +48,18 @@ std::string Contents(const std::string& path) {
   return text.ok() ? *text : std::string();
 }
 
+// A folder's photos are taken in their numbers' order: the sequential pair rule relies on it.
+TEST(CollectImagePaths, AFolderIsListedInItsNumbersOrder) {
+  const std::string folder = testing::MakeTestDirectory("reconar_collect_numbered");
+  for (const char* name : {"img10.png", "img9.png", "img100.PNG", "notes.txt", "img1.jpg"}) {
+    ASSERT_TRUE(WriteFileAtomically(folder + "/" + name, "x").ok());
+  }
+  auto paths = CollectImagePaths({folder});
+  ASSERT_TRUE(paths.ok()) << paths.status().ToString();
+  EXPECT_EQ(*paths, (std::vector<std::string>{folder + "/img1.jpg", folder + "/img9.png", folder + "/img10.png",
+                                              folder + "/img100.PNG"}));
+}
+
 TEST(RunReconstruct, ProductDefaultsDifferFromTheStagesOwn) {
   const ReconstructOptions options;
   EXPECT_EQ(options.matching.match.max_ratio, 0.8);

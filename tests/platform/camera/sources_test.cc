@@ -48,6 +48,18 @@ TEST(ImageFolderSource, EmptyOrMissingFolderIsNotFound) {
   EXPECT_EQ(ImageFolderFrameSource::Open(empty + "/nope").status().code(), StatusCode::kNotFound);
 }
 
+// Numbered frames come in the order they were numbered, padded or not (frame_10 after frame_9).
+TEST(ImageFolderSource, NumberedFramesComeInTheirNumbersOrder) {
+  const std::string folder = FreshDirectory("numbered");
+  const std::string jpeg = testing::RecordPayload(testing::ReadFileBytes(kFixture), 0);
+  for (const char* name : {"frame_10.jpg", "frame_2.jpg", "frame_1.jpg", "frame_100.jpg", "frame_9.jpg"})
+    WriteBytes(folder + "/" + name, jpeg);
+  auto source = ImageFolderFrameSource::Open(folder);
+  ASSERT_TRUE(source.ok()) << source.status().ToString();
+  EXPECT_EQ((*source)->file_names(),
+            (std::vector<std::string>{"frame_1.jpg", "frame_2.jpg", "frame_9.jpg", "frame_10.jpg", "frame_100.jpg"}));
+}
+
 // The folder's JPEG decodes to exactly the recording's MJPEG frame (same bytes, same path), a
 // PNG of those pixels to the same RGB, files in name order, and a broken file is named.
 TEST(ImageFolderSource, JpegAndPngMatchTheRecordedMjpegFrame) {
