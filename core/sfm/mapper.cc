@@ -68,7 +68,7 @@ class Mapper {
       if (!registered_one) break;
       const int registered = model_.rec.NumRegisteredImages();
       if (registered >= opt_.global_ba_growth * last_global) {
-        RECONAR_RETURN_IF_ERROR(GlobalRefinement(GrowthAdjustment(opt_.global_ba_iterations)));
+        RECONAR_RETURN_IF_ERROR(GrowthRefinement());
         last_global = registered;
       }
       if (progress) progress(registered, static_cast<int>(images_.size()));
@@ -79,7 +79,7 @@ class Mapper {
       report_->seconds_total = SecondsSince(start);
       return Status::Ok();
     }
-    RECONAR_RETURN_IF_ERROR(GlobalRefinement(GrowthAdjustment(opt_.global_ba_iterations)));
+    RECONAR_RETURN_IF_ERROR(GrowthRefinement());
     IntrinsicsChoice choice;
     RECONAR_ASSIGN_OR_RETURN(choice, SelectIntrinsicsModel(&model_, images_, opt_, report_));
     MapperAdjustment final_adjustment;
@@ -167,8 +167,9 @@ class Mapper {
     }
     if (model_.rec.NumRegisteredImages() < 2) return InvalidArgument("mapper: a seed model of fewer than two images");
     for (const int image : model_.RegisteredImages()) TriangulateImage(&model_, image, opt_);
+    for (const SfmCamera& camera : model_.rec.cameras) growth_distortion_ |= camera.k1 != 0.0 || camera.k2 != 0.0;
     if (!refine) return Status::Ok();
-    return GlobalRefinement(GrowthAdjustment(opt_.global_ba_iterations));
+    return GrowthRefinement();
   }
 
   // The camera of image i under the sharing rule, created when no earlier image shares it.
@@ -195,11 +196,11 @@ class Mapper {
   }
 
   // The adjustments while the model grows: the principal point fixed, the distortion refined
-  // with MapperOptions::refine_distortion (from three registered images on).
+  // when the last global refinement chose it (GrowthRefinement; from three registered images on).
   MapperAdjustment GrowthAdjustment(int iterations) const {
     MapperAdjustment adjustment;
     adjustment.iterations = iterations;
-    adjustment.free.distortion = opt_.refine_distortion;
+    adjustment.free.distortion = growth_distortion_;
     return adjustment;
   }
 
@@ -245,7 +246,7 @@ class Mapper {
   // a focal).
   Status GrowAround(int image, bool focal_changed) {
     TriangulateImage(&model_, image, opt_);
-    if (focal_changed) return GlobalRefinement(GrowthAdjustment(opt_.global_ba_iterations));
+    if (focal_changed) return GrowthRefinement();
     const std::vector<int> local = LocalBundle(model_, image, opt_);
     RECONAR_RETURN_IF_ERROR(Adjust(local, GrowthAdjustment(opt_.local_ba_iterations)));
     FilterPoints(&model_, model_.PointsSeenBy(local), opt_);
@@ -257,13 +258,39 @@ class Mapper {
     return CountFailedAdjustment(BundleAdjust(&model_, images_, variable, adjustment, opt_, report_).status(), report_);
   }
 
-  Status GlobalRefinement(const MapperAdjustment& adjustment) {
-    RECONAR_RETURN_IF_ERROR(Adjust(model_.RegisteredImages(), adjustment));
+  // Adjusts the whole model, filters, triangulates every track again, adjusts and filters again.
+  // With `chosen` the first adjustment is instead the choice of the intrinsics (SelectIntrinsicsModel
+  // under `chosen`'s options), and the second uses that choice.
+  Status GlobalRefinement(const MapperAdjustment& adjustment, const MapperOptions* chosen = nullptr) {
+    MapperAdjustment second = adjustment;
+    if (chosen != nullptr) {
+      RECONAR_ASSIGN_OR_RETURN(second.free, SelectIntrinsicsModel(&model_, images_, *chosen, report_));
+    } else {
+      RECONAR_RETURN_IF_ERROR(Adjust(model_.RegisteredImages(), adjustment));
+    }
     FilterPoints(&model_, model_.AllPoints(), opt_);
     RetriangulateAll(&model_, opt_);
-    RECONAR_RETURN_IF_ERROR(Adjust(model_.RegisteredImages(), adjustment));
+    RECONAR_RETURN_IF_ERROR(Adjust(model_.RegisteredImages(), second));
     FilterPoints(&model_, model_.AllPoints(), opt_);
+    if (chosen != nullptr) growth_distortion_ = second.free.distortion;
     return Status::Ok();
+  }
+
+  // The global refinement while the model grows. The distortion is refined only when the data
+  // supports it, chosen as at the end of the run (intrinsics_selection.h: the information
+  // criterion, and no implausible coefficients) with the principal point held: from a few close
+  // views, k1 and k2 trade against the focal, and a focal gone wrong keeps the later images from
+  // registering (the AR video's 13 keyframes with the distortion always free: k2 = 0.65 and the
+  // focal 20 % long at four images, k2 = -2 at five, 11 of 13 registered in the end).
+  Status GrowthRefinement() {
+    MapperAdjustment adjustment = GrowthAdjustment(opt_.global_ba_iterations);
+    if (!opt_.refine_distortion || model_.rec.NumRegisteredImages() < 3) return GlobalRefinement(adjustment);
+    MapperOptions selection = opt_;
+    selection.principal_point = MapperOptions::PrincipalPoint::kFixed;
+    selection.refine_aspect = false;
+    selection.final_ba_iterations = adjustment.iterations;
+    selection.final_ba_function_tolerance = adjustment.function_tolerance;
+    return GlobalRefinement(adjustment, &selection);
   }
 
   void FinishReport() {
@@ -296,6 +323,7 @@ class Mapper {
   MapperReport* report_;
   const std::set<std::pair<int, int>>& excluded_starts_;
   InitialPairScores* initial_pair_scores_;
+  bool growth_distortion_ = false;  // the growth adjustments refine k1, k2 (GrowthRefinement's choice)
   MapperModel model_;
   std::vector<int> plain_tried_with_;  // per image: visible points at its last failure under the plain rule
 };

@@ -106,7 +106,8 @@ struct MapperOptions {
   // scale beyond this one (pixels): weight = min(1, base_scale / scale).
   bool weight_by_scale = true;
   double base_scale_px = 1.6;
-  // Intrinsics: focal, k1, k2 per image are refined once three images are registered.
+  // Intrinsics: the focal is refined once three images are registered; k1, k2 from then on when
+  // each global adjustment's information criterion chooses them (GrowthRefinement in mapper.cc).
   bool refine_focal = true;
   bool refine_distortion = true;
   // Principal point: fixed at the image centre, refined in the final bundle adjustment, or
