@@ -88,9 +88,6 @@ Result<IntrinsicsChoice> SelectIntrinsicsModel(MapperModel* model, const std::ve
     Snapshot richest_state;
     double richest_cost = 0.0;
     RECONAR_ASSIGN_OR_RETURN(richest_cost, adjust(richest, &richest_state));
-    const auto same = [](const IntrinsicsChoice& a, const IntrinsicsChoice& b) {
-      return a.principal_point == b.principal_point && a.distortion == b.distortion && a.aspect == b.aspect;
-    };
     double residuals = 0.0;
     for (const SfmPoint& point : model->rec.points) {
       residuals += point.deleted ? 0.0 : 2.0 * static_cast<double>(point.track.size());
@@ -124,7 +121,7 @@ Result<IntrinsicsChoice> SelectIntrinsicsModel(MapperModel* model, const std::ve
         }
         Snapshot state;
         double cost = 0.0;
-        if (same(c, richest)) {  // adjusted already, from the same start
+        if (c == richest) {  // adjusted already, from the same start
           state = richest_state;
           cost = richest_cost;
         } else {

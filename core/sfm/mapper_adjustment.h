@@ -16,6 +16,10 @@ struct IntrinsicsChoice {
   bool principal_point = false;
   bool distortion = false;
   bool aspect = false;
+
+  bool operator==(const IntrinsicsChoice& other) const {
+    return principal_point == other.principal_point && distortion == other.distortion && aspect == other.aspect;
+  }
 };
 
 struct MapperAdjustment {

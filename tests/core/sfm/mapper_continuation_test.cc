@@ -135,15 +135,14 @@ TEST(MapperContinuationTest, TheGrowthRefinesTheDistortionOnlyWhenTheDataHasIt) 
     ASSERT_TRUE(grown.ok()) << grown.status().ToString();
     ASSERT_EQ(grown->NumRegisteredImages(), static_cast<int>(scene.images.size()));
     const SfmCamera& camera = grown->cameras[0];
-    // The radial factor - 1 at normalised radius 0.6, as in intrinsics_selection_test.cc.
-    const auto radial = [](const SfmCamera& c) { return c.k1 * 0.36 + c.k2 * 0.36 * 0.36; };
     std::printf("  %s: grown to %d photos, k1 %.5f k2 %.5f (truth %.5f %.5f), distortion refined %d\n",
                 distortion ? "with distortion" : "without", grown->NumRegisteredImages(), camera.k1, camera.k2,
                 scene.camera.k1, scene.camera.k2, report.distortion_refined);
     EXPECT_EQ(report.distortion_refined, distortion);
     if (distortion) {
-      EXPECT_LT(radial(camera), 0.25 * radial(scene.camera));  // barrel, as in the data
-      EXPECT_GT(radial(camera), 1.75 * radial(scene.camera));
+      EXPECT_LT(testing::RadialFactorAt06(camera),
+                0.25 * testing::RadialFactorAt06(scene.camera));  // barrel, as in the data
+      EXPECT_GT(testing::RadialFactorAt06(camera), 1.75 * testing::RadialFactorAt06(scene.camera));
     } else {
       EXPECT_EQ(camera.k1, 0.0);
       EXPECT_EQ(camera.k2, 0.0);

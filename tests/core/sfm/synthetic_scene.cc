@@ -10,6 +10,11 @@
 
 namespace reconar::testing {
 
+double RadialFactorAt06(const SfmCamera& camera) {
+  const double r2 = 0.36;
+  return camera.k1 * r2 + camera.k2 * r2 * r2;
+}
+
 SfmCamera TrueCamera() {
   SfmCamera camera;
   camera.width = 1000;

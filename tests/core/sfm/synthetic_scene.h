@@ -39,6 +39,10 @@ struct SceneOptions {
 // little barrel distortion (about 4 px at the corners).
 SfmCamera TrueCamera();
 
+// The radial distortion factor - 1 at normalised radius 0.6 (540 px at the true focal): k1 and k2
+// trade against each other, their sum at a radius less so.
+double RadialFactorAt06(const SfmCamera& camera);
+
 struct Scene {
   SfmCamera camera;
   std::vector<Rigid3> poses;
