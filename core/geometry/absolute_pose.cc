@@ -1,5 +1,6 @@
-// Absolute pose from 2D-3D correspondences: LO-RANSAC over P3P / DLT, then the refinement. The
-// solvers are in p3p.cc and dlt_pose.cc, the refinement in pose_refinement.cc (one translation
+// Absolute pose from 2D-3D correspondences: LO-RANSAC over P3P (or DLT for an unknown focal),
+// then the refinement. The solvers are in p3p.cc and dlt_pose.cc, the local step and the
+// refinement in pose_refinement.cc (one translation
 // unit each, so that they compile in parallel and the allocation test needs only the refinement).
 #include "core/geometry/absolute_pose.h"
 
@@ -164,16 +165,16 @@ Result<AbsolutePoseResult> EstimateAbsolutePose(const std::vector<Eigen::Vector2
 
   RansacOptions ransac = options.ransac;
   ransac.max_residual = options.max_error_px / camera.focal;
-  RECONAR_ASSIGN_OR_RETURN(const auto report, (Ransac<P3PEstimator, DltPoseEstimator>::Run(samples, ransac)));
+  RECONAR_ASSIGN_OR_RETURN(const auto report, (Ransac<P3PEstimator, PoseLocalEstimator>::Run(samples, ransac)));
   result.ransac_iterations = report.iterations;
-  Eigen::Matrix3d R;
-  Eigen::Vector3d t;
   if (report.status != RansacStatus::kSuccess) {
     NoModel("every minimal sample was degenerate (collinear world points?) or gave no pose with the points in front "
             "of the camera",
             report.iterations, &result);
     return result;
   }
+  Eigen::Matrix3d R;  // both estimators give poses; this removes the rounding from the rotation
+  Eigen::Vector3d t;
   if (!NearestPose(report.model, &R, &t)) {
     NoModel("the best model is not a valid camera", report.iterations, &result);
     return result;

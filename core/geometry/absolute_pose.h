@@ -4,7 +4,9 @@
 //    Perspective Three Point (P3P) Solver", ECCV 2018), up to 4 poses from 3 correspondences.
 //  - DltPoseEstimator: the normalised direct linear transform for a 3x4 projection matrix from
 //    >= 6 correspondences (Hartley & Zisserman, "Multiple View Geometry", 2nd ed., sec. 7.1 and
-//    algorithm 7.1), the least-squares step of LO-RANSAC (Chum, Matas & Kittler, DAGM 2003).
+//    algorithm 7.1), the unknown-focal solver.
+//  - PoseLocalEstimator: the least-squares step of P3P's LO-RANSAC (Chum, Matas & Kittler, DAGM
+//    2003): Levenberg-Marquardt on the normalised reprojection error from the current pose.
 //  - EstimateAbsolutePose: P3P in LO-RANSAC for a camera of known focal length, then a robust
 //    Levenberg-Marquardt refinement of the pose (and optionally the focal) on the pixel
 //    reprojection error of the inliers. EstimateAbsolutePoseUnknownFocal: DLT in RANSAC, P
@@ -65,9 +67,8 @@ struct P3PEstimator {
 };
 
 // Normalised DLT for P (11 degrees of freedom, so it also absorbs an unknown calibration: in
-// normalised coordinates it is the least-squares local step for P3P, in focal-scaled coordinates it
-// is the unknown-focal solver). P is scaled so that |P(2, 0:3)| = 1 and det(P(:, 0:3)) > 0, which
-// makes P X's third coordinate the depth. Residuals are those of P3PEstimator.
+// focal-scaled coordinates it is the unknown-focal solver). P is scaled so that |P(2, 0:3)| = 1 and det(P(:, 0:3)) > 0,
+// which makes P X's third coordinate the depth. Residuals are those of P3PEstimator.
 struct DltPoseEstimator {
   using Sample = PoseCorrespondence;
   using Model = Matrix34d;
@@ -80,6 +81,26 @@ struct DltPoseEstimator {
   static int Estimate(const Sample* samples, int count, std::array<Model, kMaxModels>* models);
 
   static void Residuals(const Sample* samples, int count, const Model& P, double* squared_residuals);
+};
+
+// The least-squares step of P3P's LO-RANSAC (ransac.h calls Refine with the model whose inliers
+// it fits): up to kMaxIterations Levenberg-Marquardt steps on the squared normalised reprojection
+// error of the samples, from the pose `start`. The result is a pose [R | t] like P3P's. A linear
+// fit is no substitute: the DLT's 11 degrees of freedom fit the few inliers of a nearly flat patch
+// in a narrow cone of view with a 3x4 matrix that no rotation is near (left singular values 1.05,
+// 0.23, 0.19 on a handheld video), whose nearest pose then holds none of them; and scoring the
+// DLT's nearest pose instead changes the room's map for the worse (docs/capture.md). The steps
+// must converge: at 4 the fits stop short, and the poses they score flip the room's maps too.
+struct PoseLocalEstimator {
+  using Sample = PoseCorrespondence;
+  using Model = Matrix34d;
+  static constexpr int kMinSamples = 4;  // 6 parameters, more equations than unknowns
+  static constexpr int kMaxModels = 1;
+  static constexpr int kMaxIterations = 10;
+
+  // 1 and the refined pose, or 0 when count < kMinSamples or a sample lies behind `start`. No
+  // heap allocation.
+  static int Refine(const Sample* samples, int count, const Model& start, std::array<Model, kMaxModels>* models);
 };
 
 // The nearest rotation and matching translation to a projection P ~ [R | t] (normalised
@@ -181,8 +202,7 @@ const char* AbsolutePoseOutcomeName(AbsolutePoseResult::Outcome outcome);
 // The pose of a camera of known intrinsics from points_px[i] <-> world_points[i]. InvalidArgument
 // when the vectors differ in length or the camera or options fail Check(); every other outcome is
 // an AbsolutePoseResult whose `outcome` and `reason` say what happened. Non-finite or
-// non-undistortable correspondences are never inliers. The RANSAC model may be a DLT projection
-// from the local optimisation; it is made a pose by NearestPose before the refinement.
+// non-undistortable correspondences are never inliers.
 Result<AbsolutePoseResult> EstimateAbsolutePose(const std::vector<Eigen::Vector2d>& points_px,
                                                 const std::vector<Eigen::Vector3d>& world_points,
                                                 const RadialCamera& camera,

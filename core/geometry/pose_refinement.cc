@@ -13,8 +13,30 @@
 namespace reconar {
 namespace {
 
-// The NormalLmSolve problem: pose (dw, dt) and, when kRefineFocal, log focal.
-template <bool kRefineFocal>
+// Correspondences picked by index from parallel arrays (RefineAbsolutePoseInPlace): pixels,
+// projected through the camera.
+struct IndexedCorrespondences {
+  static constexpr bool kNormalised = false;
+  const Eigen::Vector2d* points;
+  const Eigen::Vector3d* world_points;
+  const int* indices;
+  int count;
+  const Eigen::Vector2d& Point(int k) const { return points[indices[k]]; }
+  const Eigen::Vector3d& World(int k) const { return world_points[indices[k]]; }
+};
+
+// The samples of the RANSAC loop (PoseLocalEstimator): normalised points, no camera.
+struct SampleCorrespondences {
+  static constexpr bool kNormalised = true;
+  const PoseCorrespondence* samples;
+  int count;
+  const Eigen::Vector2d& Point(int k) const { return samples[k].point; }
+  const Eigen::Vector3d& World(int k) const { return samples[k].world; }
+};
+
+// The NormalLmSolve problem: pose (dw, dt) and, when kRefineFocal, log focal, over the
+// reprojection errors camera(R X + t) - x of `Correspondences`.
+template <bool kRefineFocal, typename Correspondences>
 class PoseRefinementProblem {
  public:
   static constexpr int kDim = kRefineFocal ? 7 : 6;
@@ -25,38 +47,38 @@ class PoseRefinementProblem {
   };
   using Tangent = Eigen::Matrix<double, kDim, 1>;
 
-  PoseRefinementProblem(const Eigen::Vector2d* points_px, const Eigen::Vector3d* world_points, const int* indices,
-                        int count, const RadialCamera& camera, const PoseRefinementOptions& options)
-      : points_px_(points_px),
-        world_points_(world_points),
-        indices_(indices),
-        count_(count),
-        camera_(camera),
-        loss_{options.loss, options.loss_scale_px} {}
+  PoseRefinementProblem(const Correspondences& correspondences, const RadialCamera& camera, LossType loss,
+                        double loss_scale)
+      : correspondences_(correspondences), camera_(camera), loss_{loss, loss_scale} {}
 
   bool Linearize(const State& x, Eigen::Matrix<double, kDim, kDim>* jtj, Tangent* jtr, double* cost) const {
     jtj->setZero();
     jtr->setZero();
     *cost = 0.0;
-    for (int k = 0; k < count_; ++k) {
-      const int i = indices_[k];
-      const Eigen::Vector3d rotated = x.R * world_points_[i];
+    for (int k = 0; k < correspondences_.count; ++k) {
+      const Eigen::Vector3d rotated = x.R * correspondences_.World(k);
       const Eigen::Vector3d X = rotated + x.t;
       if (!(X.z() > 0.0)) return false;
       const double inv_z = 1.0 / X.z();
       const Eigen::Vector2d p(X.x() * inv_z, X.y() * inv_z);
-      RadialCamera camera = camera_;
-      camera.focal = x.focal;
-      const Eigen::Vector2d e = camera.PixelFromNormalised(p) - points_px_[i];
-
       Eigen::Matrix<double, 2, 3> dp_dX;
       dp_dX << inv_z, 0.0, -p.x() * inv_z, 0.0, inv_z, -p.y() * inv_z;
-      const Eigen::Matrix2d de_dp = camera.PixelFromNormalisedJacobian(p);
-      const Eigen::Matrix<double, 2, 3> de_dX = de_dp * dp_dX;
+      Eigen::Vector2d e;
+      Eigen::Matrix<double, 2, 3> de_dX;
+      RadialCamera camera = camera_;
+      if constexpr (Correspondences::kNormalised) {
+        e = p - correspondences_.Point(k);
+        de_dX = dp_dX;
+      } else {
+        camera.focal = x.focal;
+        e = camera.PixelFromNormalised(p) - correspondences_.Point(k);
+        de_dX = camera.PixelFromNormalisedJacobian(p) * dp_dX;
+      }
       Eigen::Matrix<double, 2, kDim> J;
       J.template leftCols<3>() = -de_dX * Skew(rotated);  // d(exp(dw) R X) / d dw = -[R X]x
       J.template middleCols<3>(3) = de_dX;
       if constexpr (kRefineFocal) {  // f = f0 exp(df)
+        static_assert(!Correspondences::kNormalised, "normalised points have no focal");
         const double d = camera.Distortion(p.squaredNorm());
         J.col(6) = Eigen::Vector2d(x.focal * d * p.x(), camera.aspect * x.focal * d * p.y());
       }
@@ -82,10 +104,7 @@ class PoseRefinementProblem {
   double Norm(const State& x) const { return 1.0 + x.t.norm(); }
 
  private:
-  const Eigen::Vector2d* points_px_;
-  const Eigen::Vector3d* world_points_;
-  const int* indices_;
-  int count_;
+  Correspondences correspondences_;
   RadialCamera camera_;
   RobustLoss loss_;
 };
@@ -94,8 +113,9 @@ template <bool kRefineFocal>
 NormalLmSummary SolvePoseRefinement(const Eigen::Vector2d* points_px, const Eigen::Vector3d* world_points,
                                     const int* indices, int count, const PoseRefinementOptions& options,
                                     RadialCamera* camera, Eigen::Matrix3d* R, Eigen::Vector3d* t) {
-  using Problem = PoseRefinementProblem<kRefineFocal>;
-  const Problem problem(points_px, world_points, indices, count, *camera, options);
+  using Problem = PoseRefinementProblem<kRefineFocal, IndexedCorrespondences>;
+  const Problem problem(IndexedCorrespondences{points_px, world_points, indices, count}, *camera, options.loss,
+                        options.loss_scale_px);
   typename Problem::State state{*R, *t, camera->focal};
   const NormalLmSummary summary = NormalLmSolve(problem, options.lm, &state);
   if (summary.termination != NormalLmSummary::Termination::kNumericFailure) {
@@ -107,6 +127,23 @@ NormalLmSummary SolvePoseRefinement(const Eigen::Vector2d* points_px, const Eige
 }
 
 }  // namespace
+
+int PoseLocalEstimator::Refine(const Sample* samples, int count, const Model& start,
+                               std::array<Model, kMaxModels>* models) {
+  if (count < kMinSamples) return 0;
+  using Problem = PoseRefinementProblem<false, SampleCorrespondences>;
+  const Problem problem(SampleCorrespondences{samples, count}, RadialCamera{}, LossType::kTrivial, 1.0);
+  Problem::State state{start.leftCols<3>(), start.col(3), 1.0};
+  // The start is a P3P pose or an earlier step's; its rotation is orthonormal to rounding.
+  LmOptions lm;
+  lm.max_iterations = kMaxIterations;
+  const NormalLmSummary summary = NormalLmSolve(problem, lm, &state);
+  if (summary.termination == NormalLmSummary::Termination::kNumericFailure) return 0;
+  Model& pose = (*models)[0];
+  pose.leftCols<3>() = state.R;
+  pose.col(3) = state.t;
+  return pose.allFinite() ? 1 : 0;
+}
 
 Status CheckCamera(const RadialCamera& camera) {
   if (!(camera.focal > 0.0) || !std::isfinite(camera.focal)) {

@@ -10,7 +10,10 @@
 //    inlier ratio w of the best model so far;
 //  - LO-RANSAC (Chum, Matas & Kittler 2003): every new best model is locally optimised by least
 //    squares (LocalEstimator with more than kMinSamples samples) on its inliers: inner RANSAC on
-//    non-minimal subsets, iterated fits under a threshold shrinking to t, and a final polish;
+//    non-minimal subsets, iterated fits under a threshold shrinking to t, and a final polish.
+//    A LocalEstimator that is iterative has, instead of Estimate,
+//      static int Refine(const Sample*, int count, const Model& start, std::array<Model, kMaxModels>*);
+//    and is started from the model whose inliers it fits;
 //  - early exit from scoring a hypothesis once its partial cost exceeds the best cost;
 //  - a SplitMix64 sampler seeded from the options: runs are deterministic.
 // The minimal solver is called on a std::array copy of the sample; the per-run buffers
@@ -53,6 +56,16 @@ inline int RequiredIterations(int num_inliers, int num_samples, int sample_size,
   return RequiredIterationsForRatio(static_cast<double>(num_inliers) / num_samples, sample_size, confidence,
                                     max_iterations);
 }
+
+// Whether Estimator has the iterative Refine (see above) rather than Estimate.
+template <typename Estimator, typename = void>
+struct HasRefine : std::false_type {};
+template <typename Estimator>
+struct HasRefine<Estimator, std::void_t<decltype(Estimator::Refine(
+                                static_cast<const typename Estimator::Sample*>(nullptr), 0,
+                                std::declval<const typename Estimator::Model&>(),
+                                static_cast<std::array<typename Estimator::Model, Estimator::kMaxModels>*>(nullptr)))>>
+    : std::true_type {};
 
 }  // namespace ransac_internal
 
@@ -156,8 +169,19 @@ class Ransac {
     std::vector<Sample> pool;     // inliers of the best model, shuffled for inner samples
   };
 
-  static constexpr int kScoreBlock = 256;
-  static constexpr int kMaxLocalRounds = 5;  // LO rounds per new best model from a minimal sample  // residuals computed between early-exit checks
+  static constexpr int kScoreBlock = 256;    // residuals computed between early-exit checks
+  static constexpr int kMaxLocalRounds = 5;  // LO rounds per new best model from a minimal sample
+
+  // The least-squares fit of the LO step to `samples`, started from `start` when LocalEstimator
+  // is iterative.
+  static int LocalFit(const Sample* samples, int count, const Model& start,
+                      std::array<Model, LocalEstimator::kMaxModels>* models) {
+    if constexpr (ransac_internal::HasRefine<LocalEstimator>::value) {
+      return LocalEstimator::Refine(samples, count, start, models);
+    } else {
+      return LocalEstimator::Estimate(samples, count, models);
+    }
+  }
 
   // kMinSamples distinct indices in [0, count), count >= kMinSamples, by rejection.
   static void DrawSample(SplitMix64* rng, int count, std::array<int, Estimator::kMinSamples>* indices) {
@@ -209,7 +233,7 @@ class Ransac {
     }
     if (static_cast<int>(inliers->size()) < LocalEstimator::kMinSamples) return false;
     std::array<Model, LocalEstimator::kMaxModels> models;
-    const int num_models = LocalEstimator::Estimate(inliers->data(), static_cast<int>(inliers->size()), &models);
+    const int num_models = LocalFit(inliers->data(), static_cast<int>(inliers->size()), model, &models);
     Candidate step_best;
     int best_index = -1;
     for (int m = 0; m < num_models; ++m) {
@@ -292,7 +316,7 @@ class Ransac {
           const int j = i + static_cast<int>(rng->UniformInt(static_cast<uint32_t>(pool_size - i)));
           std::swap(buffers->pool[i], buffers->pool[j]);
         }
-        const int num_models = LocalEstimator::Estimate(buffers->pool.data(), subset_size, &models);
+        const int num_models = LocalFit(buffers->pool.data(), subset_size, best->model, &models);
         for (int m = 0; m < num_models; ++m) {
           Candidate candidate;
           if (!Score(samples, count, models[m], t2, std::numeric_limits<double>::infinity(), residuals, &candidate)) {

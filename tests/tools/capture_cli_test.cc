@@ -314,9 +314,8 @@ TEST(CaptureCli, TheLiveModelRegistersTheKeyframesAndReconstructReusesItsWork) {
   std::printf("started over: %g of %g keyframes registered; in a project of its own: %g\n",
               Number(*report, "registered"), keyframes, Number(*fresh_report, "registered"));
   EXPECT_EQ(Number(*report, "registered"), Number(*fresh_report, "registered"));
-  // From scratch the mapper registers all but one of these few close views (the absolute pose's
-  // local optimisation: docs/capture.md).
-  EXPECT_GE(Number(*report, "registered"), 0.8 * keyframes);
+  // From scratch too, every keyframe of the capture registers.
+  EXPECT_EQ(Number(*report, "registered"), keyframes);
   fs::remove_all(root);
 }
 
