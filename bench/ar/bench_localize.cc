@@ -48,6 +48,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/thread_cpu_time.h"
 #include "core/base/json_writer.h"
 #include "core/features/kdtree.h"
 #include "core/io/gray.h"
@@ -73,11 +74,7 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int kFrameWidth = 640;
 
-double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
+using reconar::bench::ThreadCpuSeconds;
 
 // Wall and thread-CPU milliseconds of one timed section.
 struct Stopwatch {

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/common/thread_cpu_time.h"
 #include "core/optim/bal_problem.h"
 #include "core/optim/bundle_adjuster.h"
 
@@ -24,11 +25,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
+using reconar::bench::ThreadCpuSeconds;
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

@@ -20,6 +20,7 @@
 #include <ctime>
 #include <vector>
 
+#include "bench/common/thread_cpu_time.h"
 #include "core/features/descriptor_distance.h"
 #include "core/features/kdtree.h"
 #include "core/features/matcher.h"
@@ -58,12 +59,7 @@ struct Data {
 Data* g_data = nullptr;
 Config g_config;
 
-// CPU time of the calling thread (both sides run single-threaded).
-double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+using reconar::bench::ThreadCpuSeconds;
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

@@ -14,16 +14,12 @@
 #include <cstdlib>
 #include <vector>
 
+#include "bench/common/thread_cpu_time.h"
 #include "core/features/sift/sift.h"
 
 using Clock = std::chrono::steady_clock;
 
-// CPU time of the calling thread: robust against other processes on a busy machine.
-static double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
+using reconar::bench::ThreadCpuSeconds;
 
 static double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
