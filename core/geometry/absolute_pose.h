@@ -88,9 +88,8 @@ struct DltPoseEstimator {
 // error of the samples, from the pose `start`. The result is a pose [R | t] like P3P's. A linear
 // fit is no substitute: the DLT's 11 degrees of freedom fit the few inliers of a nearly flat patch
 // in a narrow cone of view with a 3x4 matrix that no rotation is near (left singular values 1.05,
-// 0.23, 0.19 on a handheld video), whose nearest pose then holds none of them; and scoring the
-// DLT's nearest pose instead changes the room's map for the worse (docs/capture.md). The steps
-// must converge: at 4 the fits stop short, and the poses they score flip the room's maps too.
+// 0.23, 0.19 on a handheld video), whose nearest pose then holds none of them. (Other local steps
+// measured against this one: docs/capture.md.)
 struct PoseLocalEstimator {
   using Sample = PoseCorrespondence;
   using Model = Matrix34d;
