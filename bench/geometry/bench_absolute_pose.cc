@@ -19,8 +19,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <functional>
-#include <string>
 #include <vector>
 
 #include "bench/common/thread_cpu_time.h"
@@ -100,12 +98,10 @@ struct Tally {
     if (!pose.ok) return;
     int inliers = 0;
     for (size_t i = 0; i < scene.world.size(); ++i) {
-      inliers += reconar::SquaredPixelError(scene.camera, pose.R, pose.t, scene.world[i], scene.pixels[i]) <
-                 kMaxErrorPx * kMaxErrorPx;
-      if (scene.is_inlier[i]) {
-        true_inliers_found += reconar::SquaredPixelError(scene.camera, pose.R, pose.t, scene.world[i],
-                                                         scene.pixels[i]) < kMaxErrorPx * kMaxErrorPx;
-      }
+      const bool within = reconar::SquaredPixelError(scene.camera, pose.R, pose.t, scene.world[i], scene.pixels[i]) <
+                          kMaxErrorPx * kMaxErrorPx;
+      inliers += within;
+      true_inliers_found += within && scene.is_inlier[i];
     }
     if (inliers < kMinInliers) return;
     ++posed;

@@ -1,7 +1,7 @@
 // Absolute pose from 2D-3D correspondences: LO-RANSAC over P3P (or DLT for an unknown focal),
 // then the refinement. The solvers are in p3p.cc and dlt_pose.cc, the local step and the
-// refinement in pose_refinement.cc (one translation
-// unit each, so that they compile in parallel and the allocation test needs only the refinement).
+// refinement in pose_refinement.cc (one translation unit each, so that they compile in parallel
+// and the allocation test needs only the refinement).
 #include "core/geometry/absolute_pose.h"
 
 #include <algorithm>

@@ -67,8 +67,9 @@ struct P3PEstimator {
 };
 
 // Normalised DLT for P (11 degrees of freedom, so it also absorbs an unknown calibration: in
-// focal-scaled coordinates it is the unknown-focal solver). P is scaled so that |P(2, 0:3)| = 1 and det(P(:, 0:3)) > 0,
-// which makes P X's third coordinate the depth. Residuals are those of P3PEstimator.
+// focal-scaled coordinates it is the unknown-focal solver). P is scaled so that |P(2, 0:3)| = 1
+// and det(P(:, 0:3)) > 0, which makes P X's third coordinate the depth. Residuals are those of
+// P3PEstimator.
 struct DltPoseEstimator {
   using Sample = PoseCorrespondence;
   using Model = Matrix34d;

@@ -91,6 +91,14 @@ Scene MakeScene(const SceneOptions& options) {
   return scene;
 }
 
+// MakeScene with the default options but the number of points and the seed.
+Scene MakeSceneOf(int num_points, uint64_t seed) {
+  SceneOptions options;
+  options.num_points = num_points;
+  options.seed = seed;
+  return MakeScene(options);
+}
+
 std::vector<PoseCorrespondence> NormalisedCorrespondences(const Scene& scene, bool exact) {
   std::vector<PoseCorrespondence> result;
   for (size_t i = 0; i < scene.world.size(); ++i) {
@@ -208,10 +216,7 @@ std::vector<Eigen::Vector3d> BruteForceP3P(const std::vector<PoseCorrespondence>
 TEST(P3PEstimator, ExactDataGivesTruePoseTo1e9) {
   for (uint64_t seed = 1; seed <= 200; ++seed) {
     SCOPED_TRACE(seed);
-    SceneOptions options;
-    options.num_points = 3;
-    options.seed = seed;
-    const Scene scene = MakeScene(options);
+    const Scene scene = MakeSceneOf(3, seed);
     const std::vector<PoseCorrespondence> sample = NormalisedCorrespondences(scene, /*exact=*/true);
     std::array<Matrix34d, P3PEstimator::kMaxModels> models;
     const int num_models = P3PEstimator::Estimate(sample.data(), 3, &models);
@@ -302,10 +307,7 @@ double ProjectiveDistance34(const Matrix34d& A, const Matrix34d& B) {
 TEST(DltPoseEstimator, ExactDataGivesTrueProjection) {
   for (uint64_t seed = 1; seed <= 50; ++seed) {
     SCOPED_TRACE(seed);
-    SceneOptions options;
-    options.num_points = 6;
-    options.seed = seed;
-    const Scene scene = MakeScene(options);
+    const Scene scene = MakeSceneOf(6, seed);
     const std::vector<PoseCorrespondence> sample = NormalisedCorrespondences(scene, /*exact=*/true);
     std::array<Matrix34d, 1> models;
     ASSERT_EQ(DltPoseEstimator::Estimate(sample.data(), 6, &models), 1);
@@ -333,10 +335,7 @@ TEST(DltPoseEstimator, CoplanarOrCoincidentPointsAreDegenerate) {
 TEST(PoseLocalEstimator, RefinesAPerturbedPoseToTheTruthOnExactData) {
   for (uint64_t seed = 1; seed <= 20; ++seed) {
     SCOPED_TRACE(seed);
-    SceneOptions options;
-    options.num_points = 12;
-    options.seed = seed;
-    const Scene scene = MakeScene(options);
+    const Scene scene = MakeSceneOf(12, seed);
     const std::vector<PoseCorrespondence> samples = NormalisedCorrespondences(scene, /*exact=*/true);
     SplitMix64 rng(seed + 100);
     const Eigen::Matrix3d R_start = RandomRotation(&rng, 2.0 * kPi / 180.0) * scene.R;
@@ -352,9 +351,7 @@ TEST(PoseLocalEstimator, RefinesAPerturbedPoseToTheTruthOnExactData) {
 }
 
 TEST(PoseLocalEstimator, TooFewSamplesOrAPointBehindTheStartGiveNoModel) {
-  SceneOptions options;
-  options.num_points = 12;
-  const Scene scene = MakeScene(options);
+  const Scene scene = MakeSceneOf(12, SceneOptions().seed);
   std::vector<PoseCorrespondence> samples = NormalisedCorrespondences(scene, /*exact=*/true);
   std::array<Matrix34d, 1> models;
   EXPECT_EQ(PoseLocalEstimator::Refine(samples.data(), 3, Pose(scene.R, scene.t), &models), 0);
