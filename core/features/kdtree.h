@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/base/arena.h"
+#include "core/base/prng.h"
 #include "core/base/status.h"
 #include "core/features/descriptor_distance.h"
 
@@ -149,8 +150,8 @@ class KdForest {
   };
   class SearchState;
 
-  void BuildTree(int tree, uint64_t* rng_state, std::vector<BuildTask>* stack);
-  bool ChooseSplit(int begin, int end, uint64_t* rng_state, int* dim, int* threshold) const;
+  void BuildTree(int tree, SplitMix64* random, std::vector<BuildTask>* stack);
+  bool ChooseSplit(int begin, int end, SplitMix64* random, int* dim, int* threshold) const;
 
   const uint8_t* descriptors_ = nullptr;
   int count_ = 0;
