@@ -45,6 +45,18 @@ void PrintLatency(const char* what, const std::vector<reconar::LiveKeyframe>& ke
               std::min(to, keyframes.size()), latency.size(), reconar::Median(latency), max);
 }
 
+// Mean, median and largest error: a mean far above the median is a few cameras astray.
+std::string Errors(const reconar::testing::CameraPoseErrors& errors, double path_m) {
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "centre error mean %.4f %% of the %.2f m walk (median %.4f %%, max %.4f %%), rotation mean %.3f deg "
+                "(median %.3f, max %.3f)",
+                100.0 * errors.centre_mean / path_m, path_m, 100.0 * errors.centre_median / path_m,
+                100.0 * errors.centre_max / path_m, errors.rotation_mean_deg, errors.rotation_median_deg,
+                errors.rotation_max_deg);
+  return text;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -130,9 +142,7 @@ int main(int argc, char** argv) {
         live.seconds_final_adjustment);
     auto live_score = reconar::testing::ScoreModelAgainstTruth(capture.project_dir + "/live", *truth, frame_of);
     if (!live_score.ok()) return Fail(live_score.status());
-    std::printf("  live model: %d registered, centre error mean %.4f %% of the %.2f m walk, rotation mean %.3f deg\n",
-                live_score->registered, 100.0 * live_score->errors.centre_mean / path, path,
-                live_score->errors.rotation_mean_deg);
+    std::printf("  live model: %d registered, %s\n", live_score->registered, Errors(live_score->errors, path).c_str());
     if (every_pair && report->keyframe_files.size() != keyframe_paths.size()) {
       std::printf("  (the two captures took different keyframes: %zu and %zu)\n", keyframe_paths.size(),
                   report->keyframe_files.size());
@@ -155,8 +165,7 @@ int main(int argc, char** argv) {
   auto offline_score =
       reconar::testing::ScoreModelAgainstTruth((out / "offline" / "sparse").string(), *truth, frame_of);
   if (!offline_score.ok()) return Fail(offline_score.status());
-  std::printf("offline sfm: %d registered, centre error mean %.4f %%, rotation mean %.3f deg (%.1f s)\n",
-              offline_score->registered, 100.0 * offline_score->errors.centre_mean / path,
-              offline_score->errors.rotation_mean_deg, offline_seconds);
+  std::printf("offline sfm: %d registered, %s (%.1f s)\n", offline_score->registered,
+              Errors(offline_score->errors, path).c_str(), offline_seconds);
   return 0;
 }
