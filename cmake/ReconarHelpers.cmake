@@ -29,6 +29,16 @@ function(reconar_add_library name)
   target_link_libraries(reconar_${name} PUBLIC ${ARG_PUBLIC_LINKS} PRIVATE ${ARG_PRIVATE_LINKS})
 endfunction()
 
+# The compile settings every test executable shares; the precompiled header is built with them,
+# so a test can reuse it only while they are the same.
+function(reconar_test_compile_settings name)
+  target_compile_options(${name} PRIVATE ${RECONAR_WARNING_FLAGS})
+  target_compile_definitions(${name} PRIVATE
+      RECONAR_SHARED_DATA_DIR="${RECONAR_SHARED_DATA_DIR}"
+      RECONAR_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  target_link_libraries(${name} PRIVATE GTest::gtest GTest::gtest_main)
+endfunction()
+
 # reconar_add_test_pch(): one precompiled header that every test reuses: GoogleTest, Eigen and the
 # standard headers most tests include. Parsing them is about 2 s of a test source's 6 to 10 s
 # compile; precompiled, it is done once per build. A test compiled with other definitions of the
@@ -36,11 +46,8 @@ endfunction()
 # that does not match (-Winvalid-pch, an error under RECONAR_WERROR).
 function(reconar_add_test_pch)
   add_executable(reconar_test_pch_host "${PROJECT_SOURCE_DIR}/tests/support/pch_host.cc")
-  target_compile_options(reconar_test_pch_host PRIVATE ${RECONAR_WARNING_FLAGS})
-  target_compile_definitions(reconar_test_pch_host PRIVATE
-      RECONAR_SHARED_DATA_DIR="${RECONAR_SHARED_DATA_DIR}"
-      RECONAR_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  target_link_libraries(reconar_test_pch_host PRIVATE Eigen3::Eigen GTest::gtest GTest::gtest_main)
+  reconar_test_compile_settings(reconar_test_pch_host)
+  target_link_libraries(reconar_test_pch_host PRIVATE Eigen3::Eigen)
   target_precompile_headers(reconar_test_pch_host PRIVATE
       <gtest/gtest.h> <Eigen/Dense>
       <algorithm> <array> <cmath> <cstdint> <cstdio> <filesystem> <fstream> <functional> <map>
@@ -65,11 +72,8 @@ function(reconar_add_test name)
     return()
   endif()
   add_executable(${name} ${ARG_SOURCES})
-  target_compile_options(${name} PRIVATE ${RECONAR_WARNING_FLAGS})
-  target_compile_definitions(${name} PRIVATE
-      RECONAR_SHARED_DATA_DIR="${RECONAR_SHARED_DATA_DIR}"
-      RECONAR_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  target_link_libraries(${name} PRIVATE ${ARG_LINKS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(${name} PRIVATE ${ARG_LINKS})  # before GoogleTest, as the linker wants them
+  reconar_test_compile_settings(${name})
   # The allocation tests compile Eigen with its heap guard and assertions on: not the shared header.
   if(TARGET reconar_test_pch_host AND NOT ARG_NO_PCH AND NOT "reconar_allocation_counter" IN_LIST ARG_LINKS)
     target_precompile_headers(${name} REUSE_FROM reconar_test_pch_host)
