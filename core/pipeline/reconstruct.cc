@@ -53,7 +53,7 @@ double NumberAt(const JsonValue* object, const char* key) {
 class StageRunner {
  public:
   StageRunner(const Project& project, const ReconstructOptions& options, ReconstructReport* report)
-      : project_(project), options_(options), report_(report), record_(project) {
+      : options_(options), report_(report), record_(project) {
     // What an earlier run measured for the stages this one reuses.
     if (auto previous = ReadJsonFile(project.ReportPath()); previous.ok()) {
       const JsonValue* stages = previous->Find("stages");
@@ -103,7 +103,6 @@ class StageRunner {
   bool redone() const { return redone_; }
 
  private:
-  const Project& project_;
   const ReconstructOptions& options_;
   ReconstructReport* report_;
   StageRecord record_;
