@@ -20,7 +20,7 @@ sudo_cmd=""
 if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive
 
-host_packages=(build-essential cmake ninja-build pkg-config
+host_packages=(build-essential clang lld cmake ninja-build pkg-config
   libjpeg62-turbo-dev libpng-dev libeigen3-dev libsuitesparse-dev
   libgtest-dev libbenchmark-dev
   libapriltag-dev libcamera-dev libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri

@@ -13,9 +13,14 @@ if [ -f "$gltf_validator_dir/node_modules/gltf-validator/package.json" ]; then
 fi
 # Ninja schedules all targets in one job pool (the Makefile generator serialises per target); a
 # build directory configured earlier keeps its generator.
-generator_args=()
-if [ ! -f "$build/CMakeCache.txt" ]; then generator_args=(-G Ninja); fi
-cmake -S . -B "$build" "${generator_args[@]}" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON "${validator_args[@]}" "$@" \
+new_build_args=()
+if [ ! -f "$build/CMakeCache.txt" ]; then new_build_args=(-G Ninja); fi
+# Built with clang and lld (toolchains/clang.cmake says why); RECONAR_TEST_TOOLCHAIN= (empty)
+# builds with the default compiler, as the README's first command does. A build directory keeps
+# the compiler it was configured with.
+toolchain=${RECONAR_TEST_TOOLCHAIN-toolchains/clang.cmake}
+if [ -n "$toolchain" ] && [ ! -f "$build/CMakeCache.txt" ]; then new_build_args+=(-DCMAKE_TOOLCHAIN_FILE="$toolchain"); fi
+cmake -S . -B "$build" "${new_build_args[@]}" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON "${validator_args[@]}" "$@" \
   > "$build.configure.log" 2>&1 \
   || { cat "$build.configure.log"; exit 1; }
 cmake --build "$build" -j"$(nproc)"

@@ -1,22 +1,5 @@
 # Cross-compile for 64-bit ARM Linux with Debian's g++-aarch64-linux-gnu and arm64 multiarch
 # libraries (scripts/install-deps.sh --cross). Tests run through qemu-user.
-set(CMAKE_SYSTEM_NAME Linux)
-set(CMAKE_SYSTEM_PROCESSOR aarch64)
 set(CMAKE_C_COMPILER aarch64-linux-gnu-gcc)
 set(CMAKE_CXX_COMPILER aarch64-linux-gnu-g++)
-set(CMAKE_LIBRARY_ARCHITECTURE aarch64-linux-gnu)
-
-# Headers and architecture-independent configs (Eigen) live in /usr; libraries in the multiarch dir.
-set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
-set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY BOTH)
-set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE BOTH)
-set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE BOTH)
-set(ENV{PKG_CONFIG_LIBDIR} "/usr/lib/aarch64-linux-gnu/pkgconfig:/usr/share/pkgconfig")
-
-# With the multiarch libc6:arm64 installed, qemu must use / as its sysroot: the cross loader in
-# /usr/aarch64-linux-gnu mismatches that libc and hangs in pthread_create.
-if(EXISTS "/lib/ld-linux-aarch64.so.1")
-  set(CMAKE_CROSSCOMPILING_EMULATOR "qemu-aarch64;-L;/" CACHE STRING "" FORCE)
-else()
-  set(CMAKE_CROSSCOMPILING_EMULATOR "qemu-aarch64;-L;/usr/aarch64-linux-gnu" CACHE STRING "" FORCE)
-endif()
+include("${CMAKE_CURRENT_LIST_DIR}/aarch64-linux-gnu-common.cmake")
