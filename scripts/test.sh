@@ -11,15 +11,16 @@ validator_args=()
 if [ -f "$gltf_validator_dir/node_modules/gltf-validator/package.json" ]; then
   validator_args=(-DRECONAR_GLTF_VALIDATOR_DIR="$gltf_validator_dir")
 fi
-# Ninja schedules all targets in one job pool (the Makefile generator serialises per target); a
-# build directory configured earlier keeps its generator.
+# A new build directory: Ninja, which schedules all targets in one job pool (the Makefile generator
+# serialises per target), and clang with lld (toolchains/clang.cmake says why);
+# RECONAR_TEST_TOOLCHAIN= (empty) builds with the default compiler, as the README's first command
+# does. A build directory configured earlier keeps its generator and compiler.
 new_build_args=()
-if [ ! -f "$build/CMakeCache.txt" ]; then new_build_args=(-G Ninja); fi
-# Built with clang and lld (toolchains/clang.cmake says why); RECONAR_TEST_TOOLCHAIN= (empty)
-# builds with the default compiler, as the README's first command does. A build directory keeps
-# the compiler it was configured with.
 toolchain=${RECONAR_TEST_TOOLCHAIN-toolchains/clang.cmake}
-if [ -n "$toolchain" ] && [ ! -f "$build/CMakeCache.txt" ]; then new_build_args+=(-DCMAKE_TOOLCHAIN_FILE="$toolchain"); fi
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  new_build_args=(-G Ninja)
+  if [ -n "$toolchain" ]; then new_build_args+=(-DCMAKE_TOOLCHAIN_FILE="$toolchain"); fi
+fi
 cmake -S . -B "$build" "${new_build_args[@]}" -DCMAKE_BUILD_TYPE=Release -DRECONAR_WERROR=ON "${validator_args[@]}" "$@" \
   > "$build.configure.log" 2>&1 \
   || { cat "$build.configure.log"; exit 1; }
