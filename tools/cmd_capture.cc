@@ -39,6 +39,8 @@ constexpr char kHelp[] =
     "  --no-live             do not grow the sparse model in the background (by default each\n"
     "                        keyframe's features and matches are computed as it is taken and it is\n"
     "                        registered into PROJECT_DIR/live/; `reconstruct` reuses that work)\n"
+    "  --worker-threads N    threads matching each keyframe for the live model (default 0: one\n"
+    "                        per core but the one the capture keeps; the model is the same)\n"
     "  --realtime            replay a folder or recording at the pace of its timestamps\n"
     "  --out-preview DIR     the view with the gate's verdict (border: green keyframe, blue keep\n"
     "                        moving, red refused), the keyframes (green once registered) and the\n"
@@ -115,7 +117,8 @@ void PrintEvent(const CaptureEvent& event, bool json) {
 }  // namespace
 
 int RunCapture(int argc, char** argv, int first) {
-  Args args({"intrinsics", "max-keyframes", "width", "height", "tag-size", "tag-family", "out-preview", "window"},
+  Args args({"intrinsics", "max-keyframes", "width", "height", "tag-size", "tag-family", "out-preview", "window",
+             "worker-threads"},
             {"json", "reconstruct", "no-live", "realtime"});
   if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
   CaptureOptions options;
@@ -135,6 +138,9 @@ int RunCapture(int argc, char** argv, int first) {
     if (!intrinsics.ok()) return Fail(intrinsics.status());
     options.focal_px = intrinsics->fx;
   }
+  auto worker_threads = args.GetInt("worker-threads", options.live.worker_threads, 0, 256);
+  if (!worker_threads.ok()) return Fail(worker_threads.status());
+  options.live.worker_threads = *worker_threads;
   options.reconstruct_live = !args.Has("no-live");
   options.replay_in_real_time = args.Has("realtime");
   if (args.Has("out-preview")) options.preview_dir = args.Get("out-preview");

@@ -1,13 +1,13 @@
-// bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40] [size=640x480]: how the capture's live model
-// keeps up as a capture grows. A walk down the rendered corridor (tests/support/corridor_walk.h, exact poses) is
-// replayed through `reconar capture`'s loop at 30 frames per second, as a camera would deliver it;
-// printed: the keyframes and how many registered, the time from a keyframe being written to its
-// registration over the first and the last quarter of the keyframes, the worker's time per step,
-// the final adjustment, and the live model's cameras against the truth; twice, with the pair rule's
-// defaults and with every pair matched; then `sfm` run offline on the first run's keyframes. Also
-// the capturing thread's cost per frame (the gate; following the camera against the live model)
-// and the capture's wall time against the video's: a replay waits for the live model when it lags
-// more than a keyframe behind (CaptureOptions::map_lag_keyframes), a camera would not.
+// bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40] [size=640x480] [worker_threads=0]
+// [every_pair=1]: how the capture's live model keeps up as a capture grows. A walk down the rendered corridor
+// (tests/support/corridor_walk.h, exact poses) is replayed through `reconar capture`'s loop at 30 frames per second, as
+// a camera would deliver it; printed: the keyframes and how many registered, the time from a keyframe being written to
+// its registration over the first and the last quarter of the keyframes, the worker's time per step, the final
+// adjustment, and the live model's cameras against the truth; twice, with the pair rule's defaults and with every pair
+// matched (every_pair=0: once); then `sfm` run offline on the first run's keyframes, whose true cameras are written to
+// OUT_DIR/capture/keyframes_truth.txt. Also the capturing thread's cost per frame (the gate;
+// following the camera against the live model) and the capture's wall time against the video's: a replay waits for the
+// live model when it lags more than a keyframe behind (CaptureOptions::map_lag_keyframes), a camera would not.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base/atomic_file.h"
 #include "core/base/median.h"
 #include "core/pipeline/reconstruct.h"
 #include "render/ar/capture_session.h"
@@ -45,15 +46,18 @@ void PrintLatency(const char* what, const std::vector<reconar::LiveKeyframe>& ke
               std::min(to, keyframes.size()), latency.size(), reconar::Median(latency), max);
 }
 
-// Mean, median and largest error: a mean far above the median is a few cameras astray.
+// Mean, median and largest error: a mean far above the median is a few cameras astray. The
+// rotations after the alignment by the centres, and between every two cameras (no alignment): a walk
+// nearly straight leaves the alignment's roll about it to the sway (12 cm) and the centres' errors,
+// so a common roll of the cameras may dominate the first.
 std::string Errors(const reconar::testing::CameraPoseErrors& errors, double path_m) {
-  char text[256];
+  char text[320];
   std::snprintf(text, sizeof(text),
                 "centre error mean %.4f %% of the %.2f m walk (median %.4f %%, max %.4f %%), rotation mean %.3f deg "
-                "(median %.3f, max %.3f)",
+                "(median %.3f, max %.3f), relative rotation mean %.3f deg",
                 100.0 * errors.centre_mean / path_m, path_m, 100.0 * errors.centre_median / path_m,
                 100.0 * errors.centre_max / path_m, errors.rotation_mean_deg, errors.rotation_median_deg,
-                errors.rotation_max_deg);
+                errors.rotation_max_deg, errors.relative_rotation_mean_deg);
   return text;
 }
 
@@ -62,8 +66,11 @@ std::string Errors(const reconar::testing::CameraPoseErrors& errors, double path
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40] [size=640x480]\n"
-                 "  pairs: the pair rule's exhaustive limit, window and retrieved count\n");
+                 "usage: bench_live_model OUT_DIR [frames=300] [step_m=0.05] [pairs=50,10,40] [size=640x480] "
+                 "[worker_threads=0] [every_pair=1]\n"
+                 "  pairs: the pair rule's exhaustive limit, window and retrieved count\n"
+                 "  worker_threads: LiveReconstructionOptions::worker_threads (0: one per core but one)\n"
+                 "  every_pair: 0 skips the second capture (every pair matched)\n");
     return 2;
   }
   const fs::path out = argv[1];
@@ -82,6 +89,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_live_model: size must be WxH, got '%s'\n", argv[5]);
     return 2;
   }
+  const int worker_threads = argc > 6 ? std::atoi(argv[6]) : 0;
+  const bool with_every_pair = argc > 7 ? std::atoi(argv[7]) != 0 : true;
   walk.focal_px *= walk.width / 640.0;
   std::error_code error;
   fs::remove_all(out, error);
@@ -105,7 +114,9 @@ int main(int argc, char** argv) {
   const double path = walk.step_m * (walk.frames - 1);
   std::vector<std::string> keyframe_paths;
   for (const bool every_pair : {false, true}) {
+    if (every_pair && !with_every_pair) break;
     reconar::CaptureOptions capture;
+    capture.live.worker_threads = worker_threads;
     capture.source = video.string();
     capture.project_dir = (out / (every_pair ? "capture_every_pair" : "capture")).string();
     capture.replay_in_real_time = true;
@@ -148,6 +159,21 @@ int main(int argc, char** argv) {
                   report->keyframe_files.size());
     }
     if (!every_pair) {
+      // The keyframes' true cameras, COLMAP's images.txt layout (no points), for scoring other tools
+      // or models on them: OUT/capture/keyframes_truth.txt.
+      std::string lines = "# IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME (true cam_from_world; frame)\n";
+      int id = 0;
+      for (const auto& [keyframe, frame] : frame_of_keyframe) {
+        const reconar::testing::GroundTruthCamera& camera = truth->at(frame);
+        const Eigen::Quaterniond q(camera.cam_from_world_rotation);
+        const Eigen::Vector3d& t = camera.cam_from_world_translation;
+        char line[256];
+        std::snprintf(line, sizeof(line), "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g 1 %s %s\n\n", ++id, q.w(),
+                      q.x(), q.y(), q.z(), t.x(), t.y(), t.z(), keyframe.c_str(), frame.c_str());
+        lines += line;
+      }
+      const reconar::Status written = reconar::WriteFileAtomically(capture.project_dir + "/keyframes_truth.txt", lines);
+      if (!written.ok()) return Fail(written);
       keyframe_paths = report->keyframe_files;
       frame_of_default_keyframe = frame_of_keyframe;
     }

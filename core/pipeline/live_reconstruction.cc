@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "core/base/atomic_file.h"
@@ -80,7 +81,12 @@ LiveReconstructionOptions::LiveReconstructionOptions() {
 }
 
 LiveReconstruction::LiveReconstruction(const Project& project, const LiveReconstructionOptions& options)
-    : project_(project), options_(options), start_(Clock::now()), extractor_(options.features) {
+    : project_(project),
+      options_(options),
+      worker_threads_(options.worker_threads > 0 ? options.worker_threads
+                                                 : std::max(1, ThreadPool::ResolveThreadCount(0) - 1)),
+      start_(Clock::now()),
+      extractor_(options.features) {
   growth_.final_adjustment = false;
   worker_ = std::thread([this] { Work(); });
 }
@@ -192,21 +198,27 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   RECONAR_RETURN_IF_ERROR(CreateDirectories(project_.FeaturesDir()));
   RECONAR_RETURN_IF_ERROR(WriteFeatureFile(project_.FeaturePath(summary->image.name),
                                            FeatureFile{summary->image.width, summary->image.height, features}));
-  if (!matcher_) {
+  if (!match_pool_) {
+    match_pool_ = std::make_unique<ThreadPool>(worker_threads_);
     MatchOptions one_thread = options_.matching.match;
     one_thread.num_threads = 1;
-    RECONAR_ASSIGN_OR_RETURN(matcher_, Matcher::Create(one_thread));
+    matchers_.resize(static_cast<size_t>(match_pool_->num_threads()));
+    for (std::unique_ptr<Matcher>& matcher : matchers_) {
+      RECONAR_ASSIGN_OR_RETURN(matcher, Matcher::Create(one_thread));
+    }
     PairSelectionOptions pairs_on_one_thread = options_.matching.pairs;
     pairs_on_one_thread.vocabulary.num_threads = 1;
     RECONAR_ASSIGN_OR_RETURN(pair_selector_, PairSelector::Create(pairs_on_one_thread));
   }
   const int image = static_cast<int>(images_.size());
-  RECONAR_RETURN_IF_ERROR(
-      matcher_->AddImage(image, features.descriptors.data(), static_cast<int>(features.keypoints.size())));
   images_.push_back(summary->image);
   keyframe_of_image_.push_back(index);
   mapper_images_.push_back(ToMapperImage(summary->image, features.keypoints));
   features_.push_back(std::move(features));
+  for (std::unique_ptr<Matcher>& matcher : matchers_) {
+    RECONAR_RETURN_IF_ERROR(matcher->AddImage(image, features_.back().descriptors.data(),
+                                              static_cast<int>(features_.back().keypoints.size())));
+  }
   {
     std::lock_guard<std::mutex> lock(mutex_);
     queued_[index].num_features = summary->num_features;
@@ -221,13 +233,29 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
       pair_selector_->Add(features_.back().descriptors.data(), static_cast<int>(features_.back().keypoints.size())));
   pairs_matched_ += static_cast<int>(partners.size());
   const ProjectImage& mine = images_.back();
-  for (const int other : partners) {
-    RECONAR_ASSIGN_OR_RETURN(const std::vector<FeatureMatch> putative, matcher_->Match(other, image));
-    const ProjectImage& theirs = images_[static_cast<size_t>(other)];
+  // In the partners' order whatever the threads, so that the model does not depend on their count.
+  std::vector<std::optional<VerifiedPair>> verified_pairs(partners.size());
+  std::vector<Status> errors(partners.size());
+  match_pool_->ParallelFor(0, partners.size(), [&](size_t k, int thread) {
+    const ProjectImage& theirs = images_[static_cast<size_t>(partners[k])];
+    Result<std::vector<FeatureMatch>> putative = matchers_[static_cast<size_t>(thread)]->Match(partners[k], image);
+    if (!putative.ok()) {
+      errors[k] = putative.status().WithContext(theirs.name + " / " + mine.name);
+      return;
+    }
     Result<VerifiedPair> verified =
-        VerifyMatches(features_[static_cast<size_t>(other)], theirs.width, theirs.height, features_.back(), mine.width,
-                      mine.height, putative, options_.matching.two_view);
-    if (!verified.ok()) return verified.status().WithContext(theirs.name + " / " + mine.name);
+        VerifyMatches(features_[static_cast<size_t>(partners[k])], theirs.width, theirs.height, features_.back(),
+                      mine.width, mine.height, *putative, options_.matching.two_view);
+    if (verified.ok()) {
+      verified_pairs[k] = std::move(verified).value();
+    } else {
+      errors[k] = verified.status().WithContext(theirs.name + " / " + mine.name);
+    }
+  });
+  for (size_t k = 0; k < partners.size(); ++k) {
+    RECONAR_RETURN_IF_ERROR(errors[k]);
+    const int other = partners[k];
+    std::optional<VerifiedPair>& verified = verified_pairs[k];
     if (verified->geometry.config == TwoViewGeometry::Config::kTooFewInliers) continue;
     verified->image_a = other;
     verified->image_b = image;

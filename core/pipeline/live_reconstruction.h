@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/base/thread_pool.h"
 #include "core/features/matcher.h"
 #include "core/features/pair_selection.h"
 #include "core/math/camera_intrinsics.h"
@@ -40,12 +41,15 @@
 namespace reconar {
 
 struct LiveReconstructionOptions {
-  // As `reconar reconstruct` runs them (ReconstructOptions' defaults), so that it reuses them; the
-  // worker is one thread.
+  // As `reconar reconstruct` runs them (ReconstructOptions' defaults), so that it reuses them.
   LiveReconstructionOptions();
   FeatureStageOptions features;
   MatchStageOptions matching;
   MapperOptions mapper;
+  // Threads that match and verify a keyframe's pairs (the worker's main cost); the rest of the
+  // worker is one thread. The model does not depend on the count. <= 0: one per core but one,
+  // which the capturing thread keeps (at least one).
+  int worker_threads = 0;
   // Publish the model as a localisation map (LatestMap) when it starts and at each of its global
   // adjustments, for following the camera against it while it grows.
   bool publish_map = false;
@@ -133,6 +137,7 @@ class LiveReconstruction {
 
   const Project project_;
   const LiveReconstructionOptions options_;
+  const int worker_threads_;  // options_.worker_threads resolved
   const std::chrono::steady_clock::time_point start_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
@@ -149,7 +154,8 @@ class LiveReconstruction {
 
   // The worker's own state.
   PhotoFeatureExtractor extractor_;
-  std::unique_ptr<Matcher> matcher_;
+  std::unique_ptr<ThreadPool> match_pool_;          // worker_threads_
+  std::vector<std::unique_ptr<Matcher>> matchers_;  // one per thread of match_pool_
   std::optional<PairSelector> pair_selector_;
   std::vector<ProjectImage> images_;
   std::vector<SiftFeatures> features_;

@@ -1,7 +1,7 @@
 // The pair rule (core/features/pair_selection.h) on Middlebury's templeRing, whose 47 views are
 // named out of ring order (the name order jumps by up to 164 degrees at six places): retrieval has
 // to find the views of the same side that the sequential window misses. And the live capture's
-// worker and the match stage choose the same pairs once retrieval is on.
+// worker (on one thread or two) and the match stage choose the same pairs once retrieval is on.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -101,28 +101,36 @@ std::string ReadOrEmpty(const std::string& path) {
 TEST(PairSelectionRing, LiveCaptureAndMatchStageChooseTheSamePairs) {
   auto truth = testing::ReadMiddleburyParInOrder(kSparseRingDir + "/templeSR_par.txt");
   ASSERT_TRUE(truth.ok()) << truth.status().ToString();
-  const Project project(testing::MakeTestDirectory("reconar_pair_selection_live"));
   LiveReconstructionOptions options;
   options.features.show_progress = false;
   options.matching.show_progress = false;
   options.matching.pairs.exhaustive_up_to = 6;
   options.matching.pairs.sequential_window = 2;
   options.matching.pairs.retrieved = 3;
-  int keyframes = 0;
-  {
+  const int keyframes = static_cast<int>(truth->size());
+  // The worker matching a keyframe's pairs on one thread and on two: the same matches and model.
+  const auto capture = [&](const Project& project, int threads) {
+    options.worker_threads = threads;
     LiveReconstruction live(project, options);
-    for (const testing::NamedGroundTruthCamera& camera : *truth) {
-      live.AddKeyframe(kSparseRingDir + "/" + camera.name);
-      ++keyframes;
-    }
+    for (const testing::NamedGroundTruthCamera& camera : *truth) live.AddKeyframe(kSparseRingDir + "/" + camera.name);
     auto report = live.Finish();
     ASSERT_TRUE(report.ok()) << report.status().ToString();
     // 15 pairs among the first 6, then 2 + 3 for each of the other 10.
     EXPECT_EQ(report->pairs_matched, 15 + 5 * (keyframes - 6));
     EXPECT_GT(report->registered, keyframes / 2);
-  }
+  };
+  const Project project(testing::MakeTestDirectory("reconar_pair_selection_live"));
+  const Project on_one_thread(testing::MakeTestDirectory("reconar_pair_selection_live_one_thread"));
+  capture(project, 2);
+  capture(on_one_thread, 1);
   const std::string live_matches = ReadOrEmpty(project.MatchesPath());
   ASSERT_FALSE(live_matches.empty());
+  EXPECT_EQ(ReadOrEmpty(on_one_thread.MatchesPath()), live_matches);
+  for (const char* file : {"/cameras.txt", "/images.txt", "/points3D.txt"}) {
+    const std::string model = ReadOrEmpty(project.LiveDir() + file);
+    EXPECT_FALSE(model.empty()) << file;
+    EXPECT_EQ(ReadOrEmpty(on_one_thread.LiveDir() + file), model) << file << " differs with the worker on one thread";
+  }
 
   MatchStageOptions matching = options.matching;
   matching.num_threads = 2;
