@@ -5,7 +5,7 @@
 // its registration over the first and the last quarter of the keyframes, the worker's time per step, the final
 // adjustment, and the live model's cameras against the truth; twice, with the pair rule's defaults and with every pair
 // matched (every_pair=0: once); then `sfm` run offline on the first run's keyframes, whose true cameras are written to
-// OUT_DIR/capture/keyframes_truth.txt. Also the capturing thread's cost per frame (the gate;
+// OUT_DIR/capture/truth/ (COLMAP text). Also the capturing thread's cost per frame (the gate;
 // following the camera against the live model) and the capture's wall time against the video's: a replay waits for the
 // live model when it lags more than a keyframe behind (CaptureOptions::map_lag_keyframes), a camera would not.
 #include <algorithm>
@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "core/base/atomic_file.h"
 #include "core/base/median.h"
 #include "core/pipeline/reconstruct.h"
+#include "core/sfm/model_io.h"
 #include "render/ar/capture_session.h"
 #include "tests/support/corridor_walk.h"
 #include "tests/support/sfm_evaluation.h"
@@ -159,20 +159,29 @@ int main(int argc, char** argv) {
                   report->keyframe_files.size());
     }
     if (!every_pair) {
-      // The keyframes' true cameras, COLMAP's images.txt layout (no points), for scoring other tools
-      // or models on them: OUT/capture/keyframes_truth.txt.
-      std::string lines = "# IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME (true cam_from_world; frame)\n";
-      int id = 0;
+      // The keyframes' true cameras as a COLMAP text model without points (OUT/capture/truth), for
+      // scoring other tools or models on them.
+      reconar::Reconstruction truth_model;
       for (const auto& [keyframe, frame] : frame_of_keyframe) {
         const reconar::testing::GroundTruthCamera& camera = truth->at(frame);
-        const Eigen::Quaterniond q(camera.cam_from_world_rotation);
-        const Eigen::Vector3d& t = camera.cam_from_world_translation;
-        char line[256];
-        std::snprintf(line, sizeof(line), "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g 1 %s %s\n\n", ++id, q.w(),
-                      q.x(), q.y(), q.z(), t.x(), t.y(), t.z(), keyframe.c_str(), frame.c_str());
-        lines += line;
+        if (truth_model.cameras.empty()) {
+          reconar::SfmCamera model_camera;
+          model_camera.width = camera.width;
+          model_camera.height = camera.height;
+          model_camera.focal = camera.K(0, 0);
+          model_camera.cx = camera.K(0, 2);
+          model_camera.cy = camera.K(1, 2);
+          truth_model.cameras.push_back(model_camera);
+        }
+        reconar::SfmImage image;
+        image.name = keyframe;
+        image.camera_id = 0;
+        image.registered = true;
+        image.cam_from_world.rotation = camera.cam_from_world_rotation;
+        image.cam_from_world.translation = camera.cam_from_world_translation;
+        truth_model.images.push_back(std::move(image));
       }
-      const reconar::Status written = reconar::WriteFileAtomically(capture.project_dir + "/keyframes_truth.txt", lines);
+      const reconar::Status written = reconar::WriteColmapTextModel(truth_model, capture.project_dir + "/truth");
       if (!written.ok()) return Fail(written);
       keyframe_paths = report->keyframe_files;
       frame_of_default_keyframe = frame_of_keyframe;
