@@ -32,6 +32,50 @@ std::string BaseName(const std::string& path) {
 
 }  // namespace
 
+Result<RecordedFrameRecord> ReadRecordedFrameRecord(const uint8_t* bytes, size_t size, size_t offset) {
+  const auto corrupt = [](const std::string& reason) { return Status(StatusCode::kCorruptData, reason); };
+  const size_t left = size - offset;
+  if (left < kRecordedFrameRecordBytes) {
+    return corrupt("truncated record header (" + std::to_string(left) + " of " +
+                   std::to_string(kRecordedFrameRecordBytes) + " bytes)");
+  }
+  const uint8_t* record = bytes + offset;
+  if (std::memcmp(record, kRecordTag, 4) != 0) return corrupt("bad record tag");
+  RecordedFrameRecord result;
+  RawFrame& raw = result.raw;
+  const uint32_t fourcc = GetU32(record + 4);
+  raw.layout.format = PixelFormatFromFourcc(fourcc);
+  const uint32_t width = GetU32(record + 8);
+  const uint32_t height = GetU32(record + 12);
+  raw.layout.bytes_per_line = GetU32(record + 16);
+  const uint32_t quantisation = GetU32(record + 20);
+  result.timestamp_ns = static_cast<int64_t>(static_cast<uint64_t>(GetU32(record + 24)) |
+                                             static_cast<uint64_t>(GetU32(record + 28)) << 32);
+  const uint32_t payload = GetU32(record + 32);
+  if (raw.layout.format == PixelFormat::kUnknown) {
+    char hex[16];
+    std::snprintf(hex, sizeof(hex), "0x%08x", fourcc);
+    return corrupt(std::string("unknown pixel format fourcc ") + hex);
+  }
+  if (quantisation > 1) return corrupt("bad quantisation " + std::to_string(quantisation));
+  if (width > 0x7FFF || height > 0x7FFF) {
+    return corrupt("bad frame size " + std::to_string(width) + "x" + std::to_string(height));
+  }
+  raw.layout.width = static_cast<int>(width);
+  raw.layout.height = static_cast<int>(height);
+  raw.layout.range = quantisation == 1 ? YuvRange::kFull : YuvRange::kLimited;
+  if (payload > left - kRecordedFrameRecordBytes) {
+    return corrupt("truncated payload (" + std::to_string(payload) + " bytes declared, " +
+                   std::to_string(left - kRecordedFrameRecordBytes) + " left)");
+  }
+  Status layout_status = CheckRawFrameLayout(raw.layout, "layout");
+  if (!layout_status.ok()) return corrupt(layout_status.message());
+  raw.data = record + kRecordedFrameRecordBytes;
+  raw.size = payload;
+  result.end_offset = offset + kRecordedFrameRecordBytes + payload;
+  return result;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Writer
 
@@ -171,44 +215,10 @@ Result<Frame> RecordedFrameSource::NextFrame() {
     return FileError(StatusCode::kFailedPrecondition, path_,
                      "all " + std::to_string(buffers_.count()) + " frame buffers are held; release one first");
   }
-  const size_t left = size_ - offset_;
-  if (left < kRecordedFrameRecordBytes) {
-    return FrameError(StatusCode::kCorruptData,
-                      "truncated record header (" + std::to_string(left) + " of " +
-                          std::to_string(kRecordedFrameRecordBytes) + " bytes)");
-  }
-  const uint8_t* record = map_ + offset_;
-  if (std::memcmp(record, kRecordTag, 4) != 0) return FrameError(StatusCode::kCorruptData, "bad record tag");
-  RawFrame raw;
-  const uint32_t fourcc = GetU32(record + 4);
-  raw.layout.format = PixelFormatFromFourcc(fourcc);
-  const uint32_t width = GetU32(record + 8);
-  const uint32_t height = GetU32(record + 12);
-  raw.layout.bytes_per_line = GetU32(record + 16);
-  const uint32_t quantisation = GetU32(record + 20);
-  const int64_t timestamp_ns =
-      static_cast<int64_t>(static_cast<uint64_t>(GetU32(record + 24)) | static_cast<uint64_t>(GetU32(record + 28)) << 32);
-  const uint32_t payload = GetU32(record + 32);
-  if (raw.layout.format == PixelFormat::kUnknown) {
-    char hex[16];
-    std::snprintf(hex, sizeof(hex), "0x%08x", fourcc);
-    return FrameError(StatusCode::kCorruptData, std::string("unknown pixel format fourcc ") + hex);
-  }
-  if (quantisation > 1) return FrameError(StatusCode::kCorruptData, "bad quantisation " + std::to_string(quantisation));
-  if (width > 0x7FFF || height > 0x7FFF) {
-    return FrameError(StatusCode::kCorruptData, "bad frame size " + std::to_string(width) + "x" + std::to_string(height));
-  }
-  raw.layout.width = static_cast<int>(width);
-  raw.layout.height = static_cast<int>(height);
-  raw.layout.range = quantisation == 1 ? YuvRange::kFull : YuvRange::kLimited;
-  if (payload > left - kRecordedFrameRecordBytes) {
-    return FrameError(StatusCode::kCorruptData, "truncated payload (" + std::to_string(payload) + " bytes declared, " +
-                                                    std::to_string(left - kRecordedFrameRecordBytes) + " left)");
-  }
-  Status layout_status = CheckRawFrameLayout(raw.layout, "layout");
-  if (!layout_status.ok()) return FrameError(StatusCode::kCorruptData, layout_status.message());
-  raw.data = record + kRecordedFrameRecordBytes;
-  raw.size = payload;
+  Result<RecordedFrameRecord> record = ReadRecordedFrameRecord(map_, size_, offset_);
+  if (!record.ok()) return FrameError(record.status().code(), record.status().message());
+  const RawFrame& raw = record->raw;
+  const int64_t timestamp_ns = record->timestamp_ns;
 
   const bool resize_needed = buffers_.gray(0).width != raw.layout.width || buffers_.gray(0).height != raw.layout.height;
   if (resize_needed && buffers_.held() > 0) {
@@ -228,7 +238,7 @@ Result<Frame> RecordedFrameSource::NextFrame() {
   Status status = converter_.Convert(raw, error_name, buffers_.gray(buffer), buffers_.rgb(buffer), &frame.gray,
                                      &frame.rgb);
   // A payload that does not decode is skipped: the container is intact, the next Next() goes on.
-  offset_ += kRecordedFrameRecordBytes + payload;
+  offset_ = record->end_offset;
   ++next_index_;
   if (!status.ok()) {
     buffers_.Release(buffer);

@@ -32,6 +32,18 @@ inline constexpr char kRecordedFramesMagic[] = "RECONAR-FRAMES 1";  // without i
 inline constexpr size_t kRecordedFramesHeaderBytes = 16;
 inline constexpr size_t kRecordedFrameRecordBytes = 36;
 
+// One record of a .frames file: its raw buffer, pointing into the file's bytes, and capture time.
+struct RecordedFrameRecord {
+  RawFrame raw;
+  int64_t timestamp_ns = 0;
+  size_t end_offset = 0;  // where the next record starts
+};
+
+// Reads the record at `offset` (past the file's header, at most `size`) of a .frames file's
+// `bytes`. kCorruptData with the reason when the record is damaged; the caller names the file
+// and the frame.
+Result<RecordedFrameRecord> ReadRecordedFrameRecord(const uint8_t* bytes, size_t size, size_t offset);
+
 // Writes a .frames file atomically: frames go to "<path>.tmp-<pid>", Finish() fsyncs and renames
 // it over <path>. A writer destroyed without Finish() removes its temporary file.
 class RecordedFramesWriter {

@@ -120,6 +120,15 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     live_options.publish_map = live_options.publish_map || options.track_map;
     live = std::make_unique<LiveReconstruction>(Project(options.project_dir), live_options);
   }
+  // A camera goes on after the keyframes an earlier run took, and the live model grows from them.
+  if (!replay) {
+    report.keyframes_kept = on_disk;
+    for (int k = 0; live && k < on_disk; ++k) {
+      live->AddKeyframe(report.keyframe_files[static_cast<size_t>(k)]);
+      live_paths.push_back(report.keyframe_files[static_cast<size_t>(k)]);
+      keyframe_registered.push_back(false);
+    }
+  }
   KeyframeGate keyframe_gate(options.gate);
   // The camera followed against the live model's newest map.
   LiveMap map;

@@ -380,6 +380,65 @@ TEST(CaptureCli, ARecordingCutShortEndsWithItsErrorAndKeepsTheKeyframes) {
   fs::remove_all(root);
 }
 
+#ifdef RECONAR_V4L2_DOUBLE_PRELOAD
+// A camera pulled out mid-capture, through the V4L2 code path: the V4L2 device double
+// (tests/platform/camera/v4l2_device_double.h), preloaded into `reconar capture v4l2:DEVICE`,
+// serves the AR video's frames at 30 fps through the V4L2 ioctl and mmap interface, and after 50
+// frames fails with ENODEV as a USB camera pulled out does. The capture ends naming the device and
+// keeps the keyframes and the live model. Plugged in again (the video's frames 50 to 92), the
+// capture goes on after those keyframes, leaves them as they were, and its live model grows from
+// them: every keyframe of both runs is in it.
+TEST(CaptureCli, ACameraThatDisconnectsEndsNamingItAndTheNextRunGoesOnFromItsKeyframes) {
+  const fs::path root = testing::MakeTestDirectory("capture_v4l2");
+  const fs::path recording = root / "video.frames";
+  WriteArVideoRecording(recording);
+  const fs::path device = root / "video0";
+  const fs::path project = root / "project";
+  const auto capture = [&](const std::string& frames) {
+    return testing::RunCommand("ASAN_OPTIONS=verify_asan_link_order=0 LD_PRELOAD=" RECONAR_V4L2_DOUBLE_PRELOAD
+                               " RECONAR_V4L2_DOUBLE='device=" +
+                               device.string() + ";recording=" + recording.string() + ";" + frames + ";fps=30' " +
+                               RECONAR_BINARY + " capture v4l2:" + device.string() + " " + project.string());
+  };
+  const auto live_report = [&]() -> std::pair<double, double> {
+    auto report = ParseJson(ReadBytes(project / "live" / "report.json"), "live/report.json");
+    EXPECT_TRUE(report.ok()) << report.status().ToString();
+    if (!report.ok()) return {-1.0, -1.0};
+    return {Number(*report, "keyframes"), Number(*report, "registered")};
+  };
+
+  const CommandRun first = capture("first=0;frames=50");
+  EXPECT_EQ(first.exit_code, 1) << first.output;
+  EXPECT_NE(first.output.find("reconar: error: " + device.string() + ": camera disconnected"), std::string::npos)
+      << first.output;
+  std::printf("%s", first.output.substr(first.output.find("reconar: error:")).c_str());
+  const std::vector<fs::path> first_keyframes = Keyframes(project);
+  ASSERT_GE(first_keyframes.size(), 2u) << first.output;
+  std::map<fs::path, std::string> first_bytes;
+  for (const fs::path& file : first_keyframes) {
+    EXPECT_TRUE(ReadImage(file.string()).ok()) << file;
+    first_bytes[file] = ReadBytes(file);
+  }
+  EXPECT_EQ(live_report(),
+            std::make_pair(static_cast<double>(first_keyframes.size()), static_cast<double>(first_keyframes.size())));
+
+  const CommandRun second = capture("first=50");
+  EXPECT_EQ(second.exit_code, 1) << second.output;
+  EXPECT_NE(second.output.find("reconar: error: " + device.string() + ": camera disconnected"), std::string::npos)
+      << second.output;
+  EXPECT_NE(second.output.find("(" + std::to_string(first_keyframes.size()) + " already there)"), std::string::npos)
+      << second.output;
+  const std::vector<fs::path> keyframes = Keyframes(project);
+  EXPECT_GT(keyframes.size(), first_keyframes.size()) << second.output;
+  for (const auto& [file, bytes] : first_bytes) EXPECT_EQ(ReadBytes(file), bytes) << file << " changed";
+  EXPECT_EQ(live_report(), std::make_pair(static_cast<double>(keyframes.size()), static_cast<double>(keyframes.size())))
+      << second.output;
+  std::printf("first run %zu keyframes, both runs %zu, all in the live model\n", first_keyframes.size(),
+              keyframes.size());
+  fs::remove_all(root);
+}
+#endif
+
 // The disk fills while keyframes and their features are written (ulimit -f; SIGXFSZ ignored, so a
 // write fails with EFBIG): an error naming the file, every file on disk whole, none half written.
 TEST(CaptureCli, AFullDiskEndsWithAClearErrorAndNoHalfFile) {

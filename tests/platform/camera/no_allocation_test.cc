@@ -1,5 +1,6 @@
 // After the first frame, Next() and the FrameHandle's release on a recording of raw YUYV / NV12 buffers makes no
-// heap allocation (the steady state of a tracking loop fed by a camera).
+// heap allocation (the steady state of a tracking loop fed by a camera), nor on a V4L2 device
+// delivering them (the V4L2 device double, v4l2_device_double.h).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -10,6 +11,10 @@
 #include "tests/platform/camera/camera_fixture.h"
 #include "tests/platform/camera/jpeg_reference.h"
 #include "tests/support/allocation_counter.h"
+#ifdef RECONAR_HAVE_V4L2
+#include "platform/camera/v4l2_source.h"
+#include "tests/platform/camera/v4l2_device_double.h"
+#endif
 
 namespace reconar {
 namespace {
@@ -68,6 +73,45 @@ TEST(CameraNoAllocation, RecordedYuyvAndNv12SteadyState) {
   }
   std::remove(path.c_str());
 }
+
+#ifdef RECONAR_HAVE_V4L2
+// 200 frames, so that a queue that grows in blocks would show; the double itself allocates nothing.
+TEST(CameraNoAllocation, V4L2YuyvAndNv12SteadyState) {
+  for (const int record : {1, 2}) {
+    testing::V4L2DeviceDoubleOptions device;
+    device.device_path = ::testing::TempDir() + "camera_no_allocation_video0";
+    device.recording = kFixture;
+    device.first_frame = record;
+    device.num_frames = 1;
+    device.disconnect_after = 201;
+    ASSERT_TRUE(testing::InstallV4L2DeviceDouble(device).ok());
+    auto source = V4L2FrameSource::Open(device.device_path);
+    ASSERT_TRUE(source.ok()) << source.status().ToString();
+    Loop loop;
+    {
+      auto first = (*source)->Next();
+      ASSERT_TRUE(first.ok()) << first.status().ToString();
+      first->reset();
+      testing::NoAllocationScope scope;
+      for (int i = 1; i < 201; ++i) {
+        Result<FrameHandle> frame = (*source)->Next();
+        if (!frame.ok()) {
+          loop.all_ok = false;
+          break;
+        }
+        ++loop.frames;
+        frame->reset();
+      }
+      loop.allocations = scope.allocations();
+    }
+    EXPECT_TRUE(loop.all_ok);
+    EXPECT_EQ(loop.frames, 200);
+    EXPECT_EQ(loop.allocations, 0) << "record " << record;
+    source->reset();
+    testing::RemoveV4L2DeviceDouble();
+  }
+}
+#endif
 
 TEST(CameraNoAllocation, TheGuardCountsAllocations) {
   testing::NoAllocationScope scope;
