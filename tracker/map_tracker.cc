@@ -72,8 +72,10 @@ Status MapTrackerOptions::Check() const {
   return Status::Ok();
 }
 
-MapTracker::MapTracker(const LocalizationMap* map, const MapTrackerOptions& options, Localizer localizer)
-    : map_(map), options_(options), localizer_(std::move(localizer)) {}
+MapTracker::MapTracker(const MapTrackerOptions& options, std::shared_ptr<const Localizer> localizer)
+    : map_(&localizer->map()), options_(options), localizer_(std::move(localizer)) {
+  options_.localizer = localizer_->options();
+}
 
 MapTracker::~MapTracker() = default;
 
@@ -82,7 +84,16 @@ Result<std::unique_ptr<MapTracker>> MapTracker::Create(const LocalizationMap* ma
   RECONAR_RETURN_IF_ERROR(options.Check());
   if (map->num_points() == 0) return InvalidArgument("MapTracker: the map has no point");
   RECONAR_ASSIGN_OR_RETURN(Localizer localizer, Localizer::Create(map, options.localizer));
-  std::unique_ptr<MapTracker> tracker(new MapTracker(map, options, std::move(localizer)));
+  return Create(std::make_shared<const Localizer>(std::move(localizer)), options);
+}
+
+Result<std::unique_ptr<MapTracker>> MapTracker::Create(std::shared_ptr<const Localizer> localizer,
+                                                       const MapTrackerOptions& options) {
+  if (localizer == nullptr) return InvalidArgument("MapTracker: no localizer");
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  const LocalizationMap* map = &localizer->map();
+  if (map->num_points() == 0) return InvalidArgument("MapTracker: the map has no point");
+  std::unique_ptr<MapTracker> tracker(new MapTracker(options, std::move(localizer)));
   const size_t num_points = map->points.size();
   // Mean viewing direction of each point: toward the keyframes that observed it.
   std::vector<Eigen::Vector3d> sum(num_points, Eigen::Vector3d::Zero());
@@ -284,7 +295,7 @@ Status MapTracker::Relocalise(ImageView<const uint8_t> gray, MapTrackerFrameRepo
   report->relocalisation_tried = true;
   Gray8ToFloat(gray, sift_image_.view());
   RECONAR_ASSIGN_OR_RETURN(const SiftFeatures features, sift_->Extract(sift_image_.view()));
-  RECONAR_ASSIGN_OR_RETURN(const LocalizationResult result, localizer_.Localize(features, query_camera_));
+  RECONAR_ASSIGN_OR_RETURN(const LocalizationResult result, localizer_->Localize(features, query_camera_));
   report->relocalise_ms = 1000.0 * SecondsSince(start);
   if (!result.registered) return Status::Ok();
   // The inliers (within max_error_px, up to the capacity, in the localizer's order: by map point

@@ -136,6 +136,11 @@ class MapTracker {
   // Borrows the map (must outlive the tracker). InvalidArgument for bad options or a map without
   // points; errors of Localizer::Create.
   static Result<std::unique_ptr<MapTracker>> Create(const LocalizationMap* map, const MapTrackerOptions& options);
+  // The same with the map's localizer built already (its search index is most of Create's cost, so
+  // a caller that builds it elsewhere, as the live model's worker does, takes up a map at once).
+  // The map is the localizer's; options.localizer is replaced by the localizer's own options.
+  static Result<std::unique_ptr<MapTracker>> Create(std::shared_ptr<const Localizer> localizer,
+                                                    const MapTrackerOptions& options);
   ~MapTracker();
 
   // The next frame. prior_cam_from_world: this frame's pose from another source (the tags) when
@@ -149,7 +154,7 @@ class MapTracker {
   const MapTrackerOptions& options() const { return options_; }
 
  private:
-  MapTracker(const LocalizationMap* map, const MapTrackerOptions& options, Localizer localizer);
+  MapTracker(const MapTrackerOptions& options, std::shared_ptr<const Localizer> localizer);
   Status StartFrameSize(int width, int height);
   // Flow + pose from the prediction; true when the pose passes the gate.
   bool TrackFrame(const Rigid3& predicted, MapTrackerFrameReport* report);
@@ -167,7 +172,7 @@ class MapTracker {
 
   const LocalizationMap* map_;
   MapTrackerOptions options_;
-  Localizer localizer_;
+  std::shared_ptr<const Localizer> localizer_;
   std::vector<Eigen::Vector3f> view_direction_;  // per map point: unit mean direction toward its keyframes
   std::vector<int32_t> seed_order_;              // map points in a fixed shuffled order
   std::vector<int64_t> followed_in_frame_;       // per map point: the frame it was last followed in

@@ -142,6 +142,10 @@ int main(int argc, char** argv) {
         "final adjustment included)\n",
         walk.width, walk.height, report->median_gate_ms, report->median_map_track_ms, report->frames_map_posed,
         report->frames, report->maps_used, report->frames_map_motion, capture_seconds, walk.frames / 30.0);
+    std::printf(
+        "  taking up a new map on the capturing thread: max %.1f ms, total %.2f s; maps built by the worker in "
+        "%.2f s\n",
+        report->max_map_switch_ms, report->total_map_switch_ms / 1000.0, live.seconds_maps);
     PrintLatency("first quarter", live.keyframes, 0, n / 4);
     PrintLatency("last quarter ", live.keyframes, n - n / 4, n);
     std::printf("  latency over all: median %.2f s, p95 %.2f s\n", live.median_latency_seconds,

@@ -293,9 +293,10 @@ Status LiveReconstruction::ProcessKeyframe(size_t index) {
   has_model_ = true;
   model_final_ = false;
   PublishModel();
-  if (options_.publish_map && (started_afresh || growth_.registered_at_last_global != registered_at_last_global)) {
-    PublishMap();
-  }
+  const bool map_due = started_afresh || growth_.registered_at_last_global != registered_at_last_global ||
+                       (options_.map_every_keyframes > 0 &&
+                        model_.NumRegisteredImages() - registered_at_last_map_ >= options_.map_every_keyframes);
+  if (options_.publish_map && map_due) PublishMap();
   return Status::Ok();
 }
 
@@ -310,12 +311,16 @@ void LiveReconstruction::PublishMap() {
   MapBuildOptions map_options = options_.map;
   map_options.num_threads = 1;
   Result<LocalizationMap> map = BuildLocalizationMap(model_, load, "arbitrary", false, map_options);
-  seconds_maps_ += SecondsBetween(start, Clock::now());
   if (!map.ok()) return;  // a model without points yet: the capture keeps the last map
   LiveMap published;
   published.map = std::make_shared<const LocalizationMap>(std::move(map).value());
+  Result<Localizer> localizer = Localizer::Create(published.map.get(), options_.localizer);
+  seconds_maps_ += SecondsBetween(start, Clock::now());
+  if (!localizer.ok()) return;
+  published.localizer = std::make_shared<const Localizer>(std::move(localizer).value());
   published.intrinsics = model_.cameras.front().Intrinsics();
   published.version = ++maps_published_;
+  registered_at_last_map_ = model_.NumRegisteredImages();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     published.keyframes = static_cast<int>(done_) + 1;

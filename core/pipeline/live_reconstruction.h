@@ -35,6 +35,7 @@
 #include "core/pipeline/match_stage.h"
 #include "core/pipeline/project.h"
 #include "core/sfm/localization_map.h"
+#include "core/sfm/localizer.h"
 #include "core/sfm/mapper.h"
 #include "core/sfm/reconstruction.h"
 
@@ -50,10 +51,19 @@ struct LiveReconstructionOptions {
   // worker is one thread. The model does not depend on the count. <= 0: one per core but one,
   // which the capturing thread keeps (at least one).
   int worker_threads = 0;
-  // Publish the model as a localisation map (LatestMap) when it starts and at each of its global
-  // adjustments, for following the camera against it while it grows.
+  // Publish the model as a localisation map (LatestMap) when it starts, at each of its global
+  // adjustments, and once map_every_keyframes more keyframes have registered since the last map
+  // (<= 0: not), for following the camera against it while it grows.
   bool publish_map = false;
+  // The camera is lost a few metres past a map's last keyframe, and the global adjustments come
+  // further apart as the model grows. On the 1000-frame corridor walk (bench_live_model) maps at
+  // the global adjustments alone posed 723 of the frames (19 maps); with one every 5 keyframes as
+  // well, 982 (57 maps), for 8.2 s of the worker's time (a map and its localizer each; capture 210 s).
+  int map_every_keyframes = 5;
   MapBuildOptions map;  // num_threads is the worker's one
+  // Each published map comes with its localizer (LiveMap::localizer), built by the worker with
+  // these options: the camera's tracker takes it as it is instead of building its search index.
+  LocalizerOptions localizer;
 };
 
 // The live model as a localisation map (core/sfm/localization_map.h) for tracking the camera
@@ -61,6 +71,7 @@ struct LiveReconstructionOptions {
 // adjustments changed the model; a map is built from all of it.
 struct LiveMap {
   std::shared_ptr<const LocalizationMap> map;  // null before the first model
+  std::shared_ptr<const Localizer> localizer;  // over `map` (which must outlive it)
   CameraIntrinsics intrinsics;                 // the model's camera, at the keyframes' size
   int version = 0;                             // maps published so far
   int keyframes = 0;                           // keyframes processed when it was built
@@ -171,6 +182,7 @@ class LiveReconstruction {
   int pairs_matched_ = 0;
   double seconds_maps_ = 0.0;
   int maps_published_ = 0;
+  int registered_at_last_map_ = 0;
 
   std::thread worker_;
 };

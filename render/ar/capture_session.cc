@@ -118,6 +118,7 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
   if (options.reconstruct_live) {
     LiveReconstructionOptions live_options = options.live;
     live_options.publish_map = live_options.publish_map || options.track_map;
+    live_options.localizer = options.map_tracker.localizer;
     live = std::make_unique<LiveReconstruction>(Project(options.project_dir), live_options);
   }
   // A camera goes on after the keyframes an earlier run took, and the live model grows from them.
@@ -144,6 +145,7 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
       newest = live->LatestMap();
     }
     if (newest.version != map.version && newest.map) {
+      const auto switch_start = std::chrono::steady_clock::now();
       map_tracker.reset();  // it borrows the old map
       // The gate's last keyframe, posed in the old map, carried into the new one.
       if (map.map && keyframe_gate.keyframe_map_version() == map.version) {
@@ -153,10 +155,15 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
       map = std::move(newest);
       MapTrackerOptions tracker_options = options.map_tracker;
       tracker_options.intrinsics = ScaledIntrinsics(map.intrinsics, frame.width, frame.height);
-      Result<std::unique_ptr<MapTracker>> created = MapTracker::Create(map.map.get(), tracker_options);
+      Result<std::unique_ptr<MapTracker>> created = map.localizer ? MapTracker::Create(map.localizer, tracker_options)
+                                                                  : MapTracker::Create(map.map.get(), tracker_options);
       if (!created.ok()) return created.status().WithContext("following the live model");
       map_tracker = std::move(created).value();
       ++report.maps_used;
+      const double switch_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - switch_start).count();
+      report.max_map_switch_ms = std::max(report.max_map_switch_ms, switch_ms);
+      report.total_map_switch_ms += switch_ms;
     }
     if (!map_tracker) return Status::Ok();
     RECONAR_RETURN_IF_ERROR(map_tracker->Track(frame.gray, nullptr, &map_report));

@@ -104,6 +104,10 @@ struct CaptureReport {
   int frames_map_motion = 0;  // whose baseline the gate measured from the map poses
   int maps_used = 0;
   double median_map_track_ms = 0.0;
+  // The capturing thread's time to take up a new map (the tracker made for it), largest and total:
+  // a frame that waits for it is late.
+  double max_map_switch_ms = 0.0;
+  double total_map_switch_ms = 0.0;
   bool live = false;  // CaptureOptions::reconstruct_live: `live_model` holds the live model's report
   LiveReconstructionReport live_model;
 };

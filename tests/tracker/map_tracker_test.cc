@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "tests/tracker/rotation_video.h"
@@ -152,6 +153,35 @@ TEST_F(MapTrackerTest, APriorRestartsTrackingWithoutRelocalisation) {
     EXPECT_LT(error.rotation_deg, 0.05) << step;
     EXPECT_LT(error.centre, 0.005) << step;
   }
+}
+
+// A tracker given the map's localizer built beforehand (the live model's worker builds it with the
+// map) follows the camera exactly as one that builds its own; trackers may share one localizer.
+TEST_F(MapTrackerTest, ATrackerOnALocalizerBuiltBeforehandFollowsAsOneBuildingItsOwn) {
+  auto localizer = Localizer::Create(map_, Options().localizer);
+  ASSERT_TRUE(localizer.ok()) << localizer.status().ToString();
+  const auto shared = std::make_shared<const Localizer>(std::move(*localizer));
+  auto own = MapTracker::Create(map_, Options());
+  auto given = MapTracker::Create(shared, Options());
+  auto also_given = MapTracker::Create(shared, Options());
+  ASSERT_TRUE(own.ok() && given.ok() && also_given.ok());
+  MapTrackerFrameReport own_report, given_report, also_report;
+  int found = 0;
+  for (int step = 0; step < 15; ++step) {
+    const Image<uint8_t> image = testing::RenderRotatedView(*scene_, Sweep(step));
+    ASSERT_TRUE((*own)->Track(image.view(), nullptr, &own_report).ok());
+    ASSERT_TRUE((*given)->Track(image.view(), nullptr, &given_report).ok());
+    ASSERT_TRUE((*also_given)->Track(image.view(), nullptr, &also_report).ok());
+    EXPECT_EQ(given_report.found, own_report.found) << step;
+    EXPECT_EQ(given_report.relocalised, own_report.relocalised) << step;
+    EXPECT_EQ(given_report.inliers, own_report.inliers) << step;
+    EXPECT_EQ(given_report.cam_from_world.rotation, own_report.cam_from_world.rotation) << step;
+    EXPECT_EQ(given_report.cam_from_world.translation, own_report.cam_from_world.translation) << step;
+    EXPECT_EQ(also_report.cam_from_world.translation, own_report.cam_from_world.translation) << step;
+    found += own_report.found;
+  }
+  EXPECT_EQ(found, 15);
+  EXPECT_FALSE(MapTracker::Create(std::shared_ptr<const Localizer>(), Options()).ok());
 }
 
 TEST_F(MapTrackerTest, RejectsBadOptionsAndInputs) {
