@@ -73,7 +73,8 @@ Status MapTrackerOptions::Check() const {
 }
 
 MapTracker::MapTracker(const MapTrackerOptions& options, std::shared_ptr<const Localizer> localizer)
-    : map_(&localizer->map()), options_(options), localizer_(std::move(localizer)) {
+    : options_(options), localizer_(std::move(localizer)) {
+  map_ = &localizer_->map();
   options_.localizer = localizer_->options();
 }
 

@@ -170,7 +170,7 @@ class MapTracker {
   void RebuildFreeSlots();
   float* TemplateOf(int32_t slot) { return templates_.data() + static_cast<size_t>(slot) * template_floats_; }
 
-  const LocalizationMap* map_;
+  const LocalizationMap* map_ = nullptr;  // the localizer's
   MapTrackerOptions options_;
   std::shared_ptr<const Localizer> localizer_;
   std::vector<Eigen::Vector3f> view_direction_;  // per map point: unit mean direction toward its keyframes

@@ -124,10 +124,12 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
   // A camera goes on after the keyframes an earlier run took, and the live model grows from them.
   if (!replay) {
     report.keyframes_kept = on_disk;
-    for (int k = 0; live && k < on_disk; ++k) {
-      live->AddKeyframe(report.keyframe_files[static_cast<size_t>(k)]);
-      live_paths.push_back(report.keyframe_files[static_cast<size_t>(k)]);
-      keyframe_registered.push_back(false);
+    if (live) {
+      for (const std::string& path : report.keyframe_files) {
+        live->AddKeyframe(path);
+        live_paths.push_back(path);
+        keyframe_registered.push_back(false);
+      }
     }
   }
   KeyframeGate keyframe_gate(options.gate);

@@ -1,6 +1,9 @@
 #include "tests/platform/camera/camera_fixture.h"
 
+#include <gtest/gtest.h>
+
 #include <cstring>
+#include <filesystem>
 
 #include "platform/camera/recorded_frames.h"
 
@@ -25,6 +28,13 @@ size_t RecordOffset(const std::string& file, int index) {
 std::string RecordPayload(const std::string& file, int index) {
   const size_t at = RecordOffset(file, index);
   return file.substr(at + kRecordedFrameRecordBytes, U32At(file, at + 32));
+}
+
+std::string FreshCameraTestDirectory(const std::string& name) {
+  const std::string path = ::testing::TempDir() + "camera_" + name;
+  std::filesystem::remove_all(path);
+  std::filesystem::create_directories(path);
+  return path;
 }
 
 bool SameViews(const ImageView<const uint8_t>& a, const ImageView<const uint8_t>& b) {

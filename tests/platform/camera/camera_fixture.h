@@ -17,6 +17,9 @@ size_t RecordOffset(const std::string& file, int index);
 // The payload of record `index`.
 std::string RecordPayload(const std::string& file, int index);
 
+// "<gtest temp dir>/camera_<name>", emptied and created.
+std::string FreshCameraTestDirectory(const std::string& name);
+
 bool SameViews(const ImageView<const uint8_t>& a, const ImageView<const uint8_t>& b);
 
 }  // namespace reconar::testing

@@ -38,6 +38,28 @@ struct Loop {
   bool all_ok = true;
 };
 
+// Takes a first frame (which sizes the buffers), then counts the allocations of up to `frames`
+// more, each released at once.
+Loop CountSteadyStateAllocations(FrameSource& source, int frames) {
+  Loop loop;
+  auto first = source.Next();
+  EXPECT_TRUE(first.ok()) << first.status().ToString();
+  if (!first.ok()) return loop;
+  first->reset();
+  testing::NoAllocationScope scope;
+  for (int i = 0; i < frames; ++i) {
+    Result<FrameHandle> frame = source.Next();
+    if (!frame.ok()) {
+      loop.all_ok = false;
+      break;
+    }
+    ++loop.frames;
+    frame->reset();
+  }
+  loop.allocations = scope.allocations();
+  return loop;
+}
+
 TEST(CameraNoAllocation, RecordedYuyvAndNv12SteadyState) {
   const std::string path = MakeRawRecording(8);
   for (const bool want_rgb : {true, false}) {
@@ -48,23 +70,7 @@ TEST(CameraNoAllocation, RecordedYuyvAndNv12SteadyState) {
       auto source = RecordedFrameSource::Open(path, options);
       ASSERT_TRUE(source.ok()) << source.status().ToString();
       // Count allocations through the last frame, excluding the end-of-stream status.
-      Loop loop;
-      {
-        auto first = (*source)->Next();
-        ASSERT_TRUE(first.ok()) << first.status().ToString();
-        first->reset();
-        testing::NoAllocationScope scope;
-        for (int i = 1; i < 16; ++i) {
-          Result<FrameHandle> frame = (*source)->Next();
-          if (!frame.ok()) {
-            loop.all_ok = false;
-            break;
-          }
-          ++loop.frames;
-          frame->reset();
-        }
-        loop.allocations = scope.allocations();
-      }
+      const Loop loop = CountSteadyStateAllocations(**source, 15);
       EXPECT_TRUE(loop.all_ok);
       EXPECT_EQ(loop.frames, 15);
       EXPECT_EQ(loop.allocations, 0) << "want_rgb " << want_rgb;
@@ -87,23 +93,7 @@ TEST(CameraNoAllocation, V4L2YuyvAndNv12SteadyState) {
     ASSERT_TRUE(testing::InstallV4L2DeviceDouble(device).ok());
     auto source = V4L2FrameSource::Open(device.device_path);
     ASSERT_TRUE(source.ok()) << source.status().ToString();
-    Loop loop;
-    {
-      auto first = (*source)->Next();
-      ASSERT_TRUE(first.ok()) << first.status().ToString();
-      first->reset();
-      testing::NoAllocationScope scope;
-      for (int i = 1; i < 201; ++i) {
-        Result<FrameHandle> frame = (*source)->Next();
-        if (!frame.ok()) {
-          loop.all_ok = false;
-          break;
-        }
-        ++loop.frames;
-        frame->reset();
-      }
-      loop.allocations = scope.allocations();
-    }
+    const Loop loop = CountSteadyStateAllocations(**source, 200);
     EXPECT_TRUE(loop.all_ok);
     EXPECT_EQ(loop.frames, 200);
     EXPECT_EQ(loop.allocations, 0) << "record " << record;

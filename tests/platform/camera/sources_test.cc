@@ -25,20 +25,13 @@ namespace {
 
 const std::string kFixture = testing::CameraFixturePath();
 
-std::string FreshDirectory(const std::string& name) {
-  const std::string path = ::testing::TempDir() + "camera_sources_" + name;
-  std::filesystem::remove_all(path);
-  std::filesystem::create_directories(path);
-  return path;
-}
-
 void WriteBytes(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 TEST(ImageFolderSource, EmptyOrMissingFolderIsNotFound) {
-  const std::string empty = FreshDirectory("empty");
+  const std::string empty = testing::FreshCameraTestDirectory("sources_empty");
   WriteBytes(empty + "/notes.txt", "not an image");
   auto source = ImageFolderFrameSource::Open(empty);
   ASSERT_FALSE(source.ok());
@@ -50,7 +43,7 @@ TEST(ImageFolderSource, EmptyOrMissingFolderIsNotFound) {
 
 // Numbered frames come in the order they were numbered, padded or not (frame_10 after frame_9).
 TEST(ImageFolderSource, NumberedFramesComeInTheirNumbersOrder) {
-  const std::string folder = FreshDirectory("numbered");
+  const std::string folder = testing::FreshCameraTestDirectory("sources_numbered");
   const std::string jpeg = testing::RecordPayload(testing::ReadFileBytes(kFixture), 0);
   for (const char* name : {"frame_10.jpg", "frame_2.jpg", "frame_1.jpg", "frame_100.jpg", "frame_9.jpg"})
     WriteBytes(folder + "/" + name, jpeg);
@@ -68,7 +61,7 @@ TEST(ImageFolderSource, JpegAndPngMatchTheRecordedMjpegFrame) {
   auto mjpeg = (*recorded)->Next();
   ASSERT_TRUE(mjpeg.ok());
 
-  const std::string folder = FreshDirectory("images");
+  const std::string folder = testing::FreshCameraTestDirectory("sources_images");
   WriteBytes(folder + "/b.JPG", testing::RecordPayload(testing::ReadFileBytes(kFixture), 0));
   std::vector<uint8_t> packed(static_cast<size_t>((*mjpeg)->rgb.width) * (*mjpeg)->rgb.height);
   for (int y = 0; y < (*mjpeg)->rgb.height; ++y) {
@@ -114,7 +107,7 @@ TEST(OpenFrameSource, DispatchesOnTheSpecification) {
   auto recorded = OpenFrameSource(kFixture);
   ASSERT_TRUE(recorded.ok()) << recorded.status().ToString();
   EXPECT_NE((*recorded)->Describe().find("recording"), std::string::npos);
-  const std::string folder = FreshDirectory("dispatch");
+  const std::string folder = testing::FreshCameraTestDirectory("sources_dispatch");
   WriteBytes(folder + "/x.jpg", testing::RecordPayload(testing::ReadFileBytes(kFixture), 0));
   auto images = OpenFrameSource(folder);
   ASSERT_TRUE(images.ok());

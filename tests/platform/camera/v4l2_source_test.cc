@@ -21,13 +21,6 @@ namespace {
 
 const std::string kFixture = testing::CameraFixturePath();
 
-std::string FreshDirectory(const std::string& name) {
-  const std::string path = ::testing::TempDir() + "camera_v4l2_" + name;
-  std::filesystem::remove_all(path);
-  std::filesystem::create_directories(path);
-  return path;
-}
-
 // The fixture's record `index` decoded by the recording's own source, kept open for its views.
 struct RecordedReference {
   std::unique_ptr<RecordedFrameSource> source;
@@ -55,7 +48,7 @@ class V4L2SourceTest : public ::testing::Test {
   // A device serving the fixture's record `record` over and over, gone after `frames`.
   std::string InstallDevice(const std::string& name, int record, int frames) {
     testing::V4L2DeviceDoubleOptions device;
-    device.device_path = FreshDirectory(name) + "/video0";
+    device.device_path = testing::FreshCameraTestDirectory("v4l2_" + name) + "/video0";
     device.recording = kFixture;
     device.first_frame = record;
     device.num_frames = 1;
@@ -151,7 +144,7 @@ TEST_F(V4L2SourceTest, HeldFramesKeepTheirBuffers) {
 // source replays to the same frames.
 TEST_F(V4L2SourceTest, RecordsTheBuffersTheDeviceDelivered) {
   const std::string device = InstallDevice("record", 2, 3);
-  const std::string recording = FreshDirectory("record_out") + "/session.frames";
+  const std::string recording = testing::FreshCameraTestDirectory("v4l2_record_out") + "/session.frames";
   FrameSourceOptions options;
   options.record_path = recording;
   {
