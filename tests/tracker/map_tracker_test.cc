@@ -156,31 +156,30 @@ TEST_F(MapTrackerTest, APriorRestartsTrackingWithoutRelocalisation) {
 }
 
 // A tracker given the map's localizer built beforehand (the live model's worker builds it with the
-// map) follows the camera exactly as one that builds its own; trackers may share one localizer.
+// map) follows the camera exactly as one that builds its own: the first frame relocalised, the
+// next ones tracked. Trackers may share one localizer.
 TEST_F(MapTrackerTest, ATrackerOnALocalizerBuiltBeforehandFollowsAsOneBuildingItsOwn) {
   auto localizer = Localizer::Create(map_, Options().localizer);
   ASSERT_TRUE(localizer.ok()) << localizer.status().ToString();
   const auto shared = std::make_shared<const Localizer>(std::move(*localizer));
   auto own = MapTracker::Create(map_, Options());
   auto given = MapTracker::Create(shared, Options());
-  auto also_given = MapTracker::Create(shared, Options());
-  ASSERT_TRUE(own.ok() && given.ok() && also_given.ok());
-  MapTrackerFrameReport own_report, given_report, also_report;
+  ASSERT_TRUE(own.ok() && given.ok());
+  EXPECT_TRUE(MapTracker::Create(shared, Options()).ok());
+  MapTrackerFrameReport own_report, given_report;
   int found = 0;
-  for (int step = 0; step < 15; ++step) {
+  for (int step = 0; step < 3; ++step) {
     const Image<uint8_t> image = testing::RenderRotatedView(*scene_, Sweep(step));
     ASSERT_TRUE((*own)->Track(image.view(), nullptr, &own_report).ok());
     ASSERT_TRUE((*given)->Track(image.view(), nullptr, &given_report).ok());
-    ASSERT_TRUE((*also_given)->Track(image.view(), nullptr, &also_report).ok());
     EXPECT_EQ(given_report.found, own_report.found) << step;
     EXPECT_EQ(given_report.relocalised, own_report.relocalised) << step;
     EXPECT_EQ(given_report.inliers, own_report.inliers) << step;
     EXPECT_EQ(given_report.cam_from_world.rotation, own_report.cam_from_world.rotation) << step;
     EXPECT_EQ(given_report.cam_from_world.translation, own_report.cam_from_world.translation) << step;
-    EXPECT_EQ(also_report.cam_from_world.translation, own_report.cam_from_world.translation) << step;
     found += own_report.found;
   }
-  EXPECT_EQ(found, 15);
+  EXPECT_EQ(found, 3);
   EXPECT_FALSE(MapTracker::Create(std::shared_ptr<const Localizer>(), Options()).ok());
 }
 
