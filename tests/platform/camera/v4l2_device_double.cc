@@ -177,8 +177,7 @@ int Serve(DeviceDouble& device, int fd, unsigned long request, void* argument) {
         return Fail(EINVAL);
       }
       if (device.streaming) return Fail(EBUSY);
-      const int count =
-          std::min<int>(static_cast<int>(std::min<uint32_t>(request_buffers->count, kMaxBuffers)), kMaxBuffers);
+      const int count = static_cast<int>(std::min<uint32_t>(request_buffers->count, kMaxBuffers));
       if (::ftruncate(fd, static_cast<off_t>(static_cast<size_t>(count) * device.buffer_length)) != 0) {
         return Fail(ENOMEM);
       }
