@@ -204,7 +204,7 @@ void KeyframeGate::TakeKeyframe(const GateMapPose* map_pose) {
       ++num_corners_;
     }
   }
-  keyframe_pyramid_ = pyramids_[current_];
+  keyframe_pyramid_ = pyramids_[newest_];
   have_keyframe_ = true;
   ++keyframes_;
   lost_frames_ = 0;
@@ -250,15 +250,15 @@ double KeyframeGate::Parallax(int count) {
   return MedianInPlace(residuals_.data(), static_cast<size_t>(count));
 }
 
-// flow_ for the corners at `from` (in `previous`) into `next`; a result whose flow back does not
-// return within kMaxForwardBackwardPx is marked lost (kLargeError).
-Status KeyframeGate::ConsistentFlow(const ImagePyramid& previous, const ImagePyramid& next,
-                                    const Eigen::Vector2f* from) {
-  RECONAR_RETURN_IF_ERROR(TrackPoints(previous, next, flow_options_, from, nullptr, num_corners_, flow_.data()));
-  for (int i = 0; i < num_corners_; ++i) forward_[static_cast<size_t>(i)] = flow_[static_cast<size_t>(i)].point;
+// flow_ for the `count` points at `from` (in `previous`) into `next`; a result whose flow back does
+// not return within kMaxForwardBackwardPx is marked lost (kLargeError).
+Status KeyframeGate::ConsistentFlow(const ImagePyramid& previous, const ImagePyramid& next, const Eigen::Vector2f* from,
+                                    int count) {
+  RECONAR_RETURN_IF_ERROR(TrackPoints(previous, next, flow_options_, from, nullptr, count, flow_.data()));
+  for (int i = 0; i < count; ++i) forward_[static_cast<size_t>(i)] = flow_[static_cast<size_t>(i)].point;
   RECONAR_RETURN_IF_ERROR(
-      TrackPoints(next, previous, flow_options_, forward_.data(), from, num_corners_, backward_flow_.data()));
-  for (int i = 0; i < num_corners_; ++i) {
+      TrackPoints(next, previous, flow_options_, forward_.data(), from, count, backward_flow_.data()));
+  for (int i = 0; i < count; ++i) {
     const size_t k = static_cast<size_t>(i);
     if (flow_[k].status != FlowStatus::kTracked) continue;
     if (backward_flow_[k].status != FlowStatus::kTracked ||
@@ -268,11 +268,12 @@ Status KeyframeGate::ConsistentFlow(const ImagePyramid& previous, const ImagePyr
   return Status::Ok();
 }
 
-// Follows the keyframe's corners from the previous frame into the newest one.
-Status KeyframeGate::FollowCorners(GateFrameReport* report) {
-  const ImagePyramid& previous = pyramids_[1 - current_];
-  const ImagePyramid& next = pyramids_[current_];
-  RECONAR_RETURN_IF_ERROR(ConsistentFlow(previous, next, corners_.data()));
+// Follows the keyframe's corners from the previous frame into the newest one. In a frame the gate
+// accepts after rejected ones, the corners lost since the last accepted frame are looked for again
+// from there: a blurred or dark frame loses corners the next sharp frame can still show.
+Status KeyframeGate::FollowCorners(bool accepted, GateFrameReport* report) {
+  const ImagePyramid& next = pyramids_[newest_];
+  RECONAR_RETURN_IF_ERROR(ConsistentFlow(pyramids_[previous_], next, corners_.data(), num_corners_));
   int alive = 0, moved = 0;
   for (int i = 0; i < num_corners_; ++i) {
     const size_t k = static_cast<size_t>(i);
@@ -283,11 +284,31 @@ Status KeyframeGate::FollowCorners(GateFrameReport* report) {
     }
     scratch_[static_cast<size_t>(moved++)] = (flow_[k].point - corners_[k]).norm();
     corners_[k] = flow_[k].point;
-    pairs_[static_cast<size_t>(alive++)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
+    ++alive;
+  }
+  if (accepted && frames_since_accepted_ > 0) {
+    int retried = 0;
+    for (int i = 0; i < num_corners_; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      if (alive_[k] || !accepted_alive_[k]) continue;
+      retry_index_[static_cast<size_t>(retried)] = i;
+      retry_from_[static_cast<size_t>(retried++)] = accepted_corners_[k];
+    }
+    if (retried > 0) RECONAR_RETURN_IF_ERROR(ConsistentFlow(pyramids_[accepted_], next, retry_from_.data(), retried));
+    const float intervals = static_cast<float>(frames_since_accepted_ + 1);
+    for (int r = 0; r < retried; ++r) {
+      const FlowResult& found = flow_[static_cast<size_t>(r)];
+      if (found.status != FlowStatus::kTracked) continue;
+      const size_t k = static_cast<size_t>(retry_index_[static_cast<size_t>(r)]);
+      scratch_[static_cast<size_t>(moved++)] = (found.point - accepted_corners_[k]).norm() / intervals;
+      corners_[k] = found.point;
+      alive_[k] = true;
+      ++alive;
+    }
   }
   // Lost: the view may have come back to the keyframe's, so look for its corners from there.
   if (alive < options_.lost_overlap * num_corners_) {
-    RECONAR_RETURN_IF_ERROR(ConsistentFlow(keyframe_pyramid_, next, keyframe_corners_.data()));
+    RECONAR_RETURN_IF_ERROR(ConsistentFlow(keyframe_pyramid_, next, keyframe_corners_.data(), num_corners_));
     int found = 0;
     for (int i = 0; i < num_corners_; ++i) found += flow_[static_cast<size_t>(i)].status == FlowStatus::kTracked;
     if (found > alive) {
@@ -296,11 +317,15 @@ Status KeyframeGate::FollowCorners(GateFrameReport* report) {
       for (int i = 0; i < num_corners_; ++i) {
         const size_t k = static_cast<size_t>(i);
         alive_[k] = flow_[k].status == FlowStatus::kTracked;
-        if (!alive_[k]) continue;
-        corners_[k] = flow_[k].point;
-        pairs_[static_cast<size_t>(alive++)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
+        if (alive_[k]) corners_[k] = flow_[k].point, ++alive;
       }
     }
+  }
+  int paired = 0;
+  for (int i = 0; i < num_corners_; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    if (alive_[k])
+      pairs_[static_cast<size_t>(paired++)] = {keyframe_corners_[k].cast<double>(), corners_[k].cast<double>()};
   }
   const float width = static_cast<float>(small_.width());
   report->corners = num_corners_;
@@ -333,10 +358,22 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
                            std::to_string(frame_height_));
   }
   Downscale(gray);
-  current_ = 1 - current_;
-  RECONAR_RETURN_IF_ERROR(pyramids_[current_].Build(small_.view(), kPyramidLevels));
+  // The newest frame's pyramid in a slot neither the previous nor the last accepted frame holds,
+  // taken in turn so that all three are sized within the first three frames.
+  previous_ = newest_;
+  do {
+    newest_ = (newest_ + 1) % kPyramids;
+  } while (newest_ == previous_ || newest_ == accepted_);
+  RECONAR_RETURN_IF_ERROR(pyramids_[newest_].Build(small_.view(), kPyramidLevels));
   MeasureImage(gray, report);
-  if (have_keyframe_) RECONAR_RETURN_IF_ERROR(FollowCorners(report));
+  const bool too_dark = report->bright_level < options_.min_bright_level;
+  const bool too_bright = report->dark_level > options_.max_dark_level;
+  const bool exposed = !too_dark && !too_bright && report->highlight_fraction <= options_.max_highlight_fraction;
+  report->sharpness_threshold = options_.sharpness_ratio * SharpnessReference();
+  if (exposed) RememberSharpness(report->sharpness);
+  const bool accepted = exposed && report->sharpness >= report->sharpness_threshold;
+
+  if (have_keyframe_) RECONAR_RETURN_IF_ERROR(FollowCorners(accepted, report));
   if (!options_.use_map_poses) map_pose = nullptr;
   if (have_keyframe_ && map_pose != nullptr && map_pose->map_version > 0 &&
       map_pose->map_version == keyframe_map_version_ && map_pose->num_points >= kMinAnglePoints) {
@@ -345,17 +382,11 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
   const bool enough_baseline = report->triangulation_angle_deg >= 0.0
                                    ? report->triangulation_angle_deg >= options_.keyframe_angle_deg
                                    : report->parallax >= options_.keyframe_parallax;
-
-  const bool too_dark = report->bright_level < options_.min_bright_level;
-  const bool too_bright = report->dark_level > options_.max_dark_level;
-  const bool exposed = !too_dark && !too_bright && report->highlight_fraction <= options_.max_highlight_fraction;
-  report->sharpness_threshold = options_.sharpness_ratio * SharpnessReference();
-  if (exposed) RememberSharpness(report->sharpness);
   const bool fast = report->frame_motion > options_.max_frame_motion;
   if (!exposed) {
     report->verdict = GateVerdict::kBadExposure;
     report->advice = too_dark ? GateAdvice::kTooDark : too_bright ? GateAdvice::kTooBright : GateAdvice::kHarshLight;
-  } else if (report->sharpness < report->sharpness_threshold) {
+  } else if (!accepted) {
     report->verdict = GateVerdict::kBlurred;
     report->advice = fast ? GateAdvice::kTooFast : GateAdvice::kBlurred;
   } else if (!have_keyframe_) {
@@ -378,6 +409,14 @@ Status KeyframeGate::Process(ImageView<const uint8_t> gray, GateFrameReport* rep
   }
   if (report->verdict == GateVerdict::kKeyframe) TakeKeyframe(map_pose);
   if (report->verdict != GateVerdict::kLost) lost_frames_ = 0;
+  if (accepted) {
+    accepted_ = newest_;
+    accepted_corners_ = corners_;
+    accepted_alive_ = alive_;
+    frames_since_accepted_ = 0;
+  } else {
+    ++frames_since_accepted_;
+  }
   return Status::Ok();
 }
 

@@ -12,7 +12,9 @@
 //  - motion against the last keyframe: corners found in the keyframe (one per grid cell, the
 //    strongest Shi-Tomasi response) followed frame to frame by pyramidal Lucas-Kanade, each kept
 //    only when the flow back from the new frame returns it within a pixel (Kalal, Mikolajczyk &
-//    Matas, "Forward-Backward Error", ICPR 2010: a jump the flow cannot follow fails here). From
+//    Matas, "Forward-Backward Error", ICPR 2010: a jump the flow cannot follow fails here). The
+//    corners lost in frames the gate rejects (blurred, badly exposed) are looked for again in the
+//    next accepted frame from the last accepted one, so a bad frame does not cost the overlap. From
 //    them: the parallax since the keyframe (the median distance of the corners from where the
 //    best homography of the keyframe puts them: a camera turning on the spot, or a plane, gives
 //    none, depth seen from a new place does), the share still followed (the overlap with the
@@ -23,8 +25,9 @@
 // last keyframe and from this frame (the triangulation angle a point seen in both would get).
 // A sharp, well-exposed frame becomes a keyframe when it has enough baseline to triangulate
 // from, or when the overlap has fallen so low that the next one would not register
-// (docs/capture.md gives the rules and the reasons for their defaults). Steady state makes no heap allocation: every
-// buffer is sized on the first frame (tests/tracker/keyframe_gate_allocation_test.cc).
+// (docs/capture.md gives the rules and the reasons for their defaults). Steady state makes no heap
+// allocation: every buffer is sized within the first three frames and the second keyframe
+// (tests/tracker/keyframe_gate_allocation_test.cc).
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
@@ -149,17 +152,22 @@ class KeyframeGate {
   void RememberSharpness(double sharpness);
   void TakeKeyframe(const GateMapPose* map_pose);
   double TriangulationAngleDeg(const GateMapPose& map_pose);
-  Status FollowCorners(GateFrameReport* report);
+  Status FollowCorners(bool accepted, GateFrameReport* report);
   double Parallax(int count);
-  Status ConsistentFlow(const ImagePyramid& previous, const ImagePyramid& next, const Eigen::Vector2f* from);
+  Status ConsistentFlow(const ImagePyramid& previous, const ImagePyramid& next, const Eigen::Vector2f* from,
+                        int count);
 
   KeyframeGateOptions options_;
   OpticalFlowOptions flow_options_;
   int frame_width_ = 0, frame_height_ = 0, factor_ = 1;
   Image<uint8_t> small_;
-  ImagePyramid pyramids_[2];
+  static constexpr int kPyramids = 3;
+  ImagePyramid pyramids_[kPyramids];
   ImagePyramid keyframe_pyramid_;  // a copy (its storage reused from the first keyframe on)
-  int current_ = 0;                // index of the pyramid of the newest frame
+  // Indices into pyramids_: the newest frame's, the one before it, and the last accepted frame's
+  // (sharp and well exposed; -1: none yet).
+  int newest_ = kPyramids - 1, previous_ = -1, accepted_ = -1;
+  int frames_since_accepted_ = 0;
   bool have_keyframe_ = false;
   int keyframes_ = 0;
   int lost_frames_ = 0;
@@ -169,6 +177,10 @@ class KeyframeGate {
   std::array<Eigen::Vector2f, kMaxCorners> forward_{};  // forward flow's results, tracked back
   std::array<FlowResult, kMaxCorners> backward_flow_{};
   std::array<bool, kMaxCorners> alive_{};
+  std::array<Eigen::Vector2f, kMaxCorners> accepted_corners_{};  // corners_ and alive_ in the last accepted frame
+  std::array<bool, kMaxCorners> accepted_alive_{};
+  std::array<Eigen::Vector2f, kMaxCorners> retry_from_{};  // of the corners lost since, looked for again
+  std::array<int, kMaxCorners> retry_index_{};
   std::array<float, kMaxCorners> scratch_{};
   std::array<Correspondence, kMaxCorners> pairs_{};  // keyframe corner -> its place now
   std::array<Correspondence, kMaxCorners> inlier_pairs_{};
