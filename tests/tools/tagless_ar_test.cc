@@ -46,11 +46,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return std::nan("");
-  std::sort(values.begin(), values.end());
-  return values[std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size())))];
-}
+using testing::Quantile;
 
 std::string Stem(const std::string& name) { return fs::path(name).stem().string(); }
 

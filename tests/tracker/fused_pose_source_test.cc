@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -152,7 +153,8 @@ TEST(FusedPoseSource, AMapNeedsTheLayoutOfItsFrame) {
 // A project without tags: the map alone poses every frame, the tag in view or not, and no tag is
 // searched.
 TEST(FusedPoseSource, WithoutTagsTheMapAlonePosesEveryFrame) {
-  const Video video = MakeVideo(20);
+  const Video video = MakeVideo(12);
+  ASSERT_GT(std::count(video.tag_in_view.begin(), video.tag_in_view.end(), true), 0);
   FusedPoseSourceOptions options = OptionsFor(video, true);
   options.track_tags = false;
   options.tags.layout = TagLayout();
