@@ -45,7 +45,13 @@ Result<std::optional<ArProject>> ProjectFromArgs(const Args& args, TrackerDefaul
   ArProjectOptions options;
   options.load_map = !args.Has("no-map");
   RECONAR_ASSIGN_OR_RETURN(ArProject project, LoadArProject(args.Get("project"), options));
-  *defaults = {project.photo_intrinsics, project.tag_size, project.family};
+  defaults->intrinsics.reset();
+  if (!project.photo_cameras.empty()) defaults->intrinsics = project.photo_cameras.front();
+  defaults->track_tags = project.has_tags;
+  if (project.has_tags) {
+    defaults->tag_size = project.tag_size;
+    defaults->family = project.family;
+  }
   return std::optional<ArProject>(std::move(project));
 }
 
@@ -60,6 +66,7 @@ Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args, const Tracker
   } else {
     return InvalidArgument("--intrinsics is required (fx,fy,cx,cy or a file)");
   }
+  if (!defaults.track_tags) return options;
   if (!args.Has("tag-size") && !defaults.tag_size) {
     return InvalidArgument("--tag-size is required (metres, edge of the black square)");
   }

@@ -22,13 +22,16 @@ struct TrackerDefaults {
   std::optional<CameraIntrinsics> intrinsics;
   std::optional<double> tag_size;
   std::optional<std::string> family;
+  bool track_tags = true;  // false (a project without tags): only the camera is read, no tag option
 };
 
 // --project DIR (with --no-map, without its map): the project, and in *defaults the camera, tag
-// size and family it gives; nullopt without --project. Errors of LoadArProject.
+// size and family it gives (without tags: track_tags false); nullopt without --project. Errors of
+// LoadArProject.
 Result<std::optional<ArProject>> ProjectFromArgs(const Args& args, TrackerDefaults* defaults);
 
-// --intrinsics, --tag-size, --family, --decimate, --threads, --full-frame-interval, --max-tags.
+// --intrinsics, --tag-size, --family, --decimate, --threads, --full-frame-interval, --max-tags;
+// only --intrinsics when defaults.track_tags is false.
 Result<TagTrackerOptions> TrackerOptionsFromArgs(const Args& args, const TrackerDefaults& defaults = {});
 inline const std::set<std::string> kTrackerValuedOptions = {"intrinsics", "tag-size", "family", "decimate",
                                                               "threads", "full-frame-interval", "max-tags"};

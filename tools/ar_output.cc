@@ -7,10 +7,25 @@
 
 namespace reconar::tools {
 
+namespace {
+
+// The frame's tag report; an empty one when tags are not tracked (a project without tags).
+const TagTrackerFrameReport& TagReport(const ArSession& session) {
+  static const TagTrackerFrameReport kNoTags;
+  return session.tags() != nullptr ? session.tags()->report() : kNoTags;
+}
+
+// How the frame was searched for tags: "none" when tags are not tracked.
+const char* TagSearchName(const ArSession& session) {
+  return session.tags() != nullptr ? SearchName(session.tags()->report().search) : "none";
+}
+
+}  // namespace
+
 std::string ArFrameJson(const ArSession& session) {
   const Frame& frame = session.frame();
-  const TagTrackerFrameReport& report = session.tags().report();
-  const bool with_layout = !session.tags().options().layout.empty();
+  const TagTrackerFrameReport& report = TagReport(session);
+  const bool with_layout = session.tags() != nullptr && !session.tags()->options().layout.empty();
   JsonWriter json;
   json.BeginObject().Key("frame").String(std::string(frame.name)).Key("tags").BeginArray();
   for (const TrackedTag& tag : report.tags) {
@@ -26,7 +41,7 @@ std::string ArFrameJson(const ArSession& session) {
     json.EndObject();
   }
   json.EndArray();
-  if (const BoardPose* board = session.tags().board()) {
+  if (const BoardPose* board = session.tags() != nullptr ? session.tags()->board() : nullptr) {
     WriteRigid3Json(json.Key("cam_from_layout"), board->cam_from_layout);
     json.Key("layout_tags").Int(board->tags_used).Key("layout_rms_px").Double(board->rms_reprojection_px);
   }
@@ -40,14 +55,15 @@ std::string ArFrameJson(const ArSession& session) {
     if (session.pose().found) WriteRigid3Json(json.Key("cam_from_world"), session.pose().cam_from_world);
     json.Key("map_inliers").Int(map->found ? map->inliers : 0).Key("relocalised").Bool(map->relocalised);
     json.Key("fused_map_points").Int(session.sources().fused_map_points());
+    json.Key("metric").Bool(session.metric()).Key("units").String(session.metric() ? "metres" : "model");
   }
-  json.Key("search").String(SearchName(report.search)).Key("ms").Double(session.pose().track_ms).EndObject();
+  json.Key("search").String(TagSearchName(session)).Key("ms").Double(session.pose().track_ms).EndObject();
   return json.str();
 }
 
 std::string ArFrameText(const ArSession& session) {
   const Frame& frame = session.frame();
-  const TagTrackerFrameReport& report = session.tags().report();
+  const TagTrackerFrameReport& report = TagReport(session);
   int measured = 0;
   for (const TrackedTag& tag : report.tags) measured += tag.measured ? 1 : 0;
   char text[256];
@@ -62,16 +78,16 @@ std::string ArFrameText(const ArSession& session) {
     line += text;
   }
   if (const MapTrackerFrameReport* map = session.sources().map_report()) {
-    std::snprintf(text, sizeof(text), "  [map: %s, %d inliers%s; pose: %s]", MapTrackingStateName(map->state),
+    std::snprintf(text, sizeof(text), "  [map: %s, %d inliers%s; pose: %s%s]", MapTrackingStateName(map->state),
                   map->found ? map->inliers : 0, map->relocalised ? ", relocalised" : "",
-                  PoseSourceKindName(session.sources().source()));
+                  PoseSourceKindName(session.sources().source()), session.metric() ? "" : ", model units");
     line += text;
   }
   if (report.predicted_searched > 0) {
-    std::snprintf(text, sizeof(text), "  [%s + %d predicted (%d found), %.2f ms]", SearchName(report.search),
+    std::snprintf(text, sizeof(text), "  [%s + %d predicted (%d found), %.2f ms]", TagSearchName(session),
                   report.predicted_searched, report.predicted_found, session.pose().track_ms);
   } else {
-    std::snprintf(text, sizeof(text), "  [%s, %.2f ms]", SearchName(report.search), session.pose().track_ms);
+    std::snprintf(text, sizeof(text), "  [%s, %.2f ms]", TagSearchName(session), session.pose().track_ms);
   }
   return line + text;
 }

@@ -30,16 +30,19 @@ constexpr char kHelp[] =
     "With --project, the frames are posed in the project's world frame from its tags (tags.layout)\n"
     "and its localisation map (map/map.rmap) together; each JSON line also has \"source\" (tags,\n"
     "map, tags+map or none), \"state\" (the map tracker's: tracking, relocalising or lost),\n"
-    "\"cam_from_world\", \"map_inliers\", \"relocalised\" and \"fused_map_points\".\n"
+    "\"cam_from_world\", \"map_inliers\", \"relocalised\", \"fused_map_points\" and \"metric\" /\n"
+    "\"units\" (true / \"metres\"; false / \"model\" for a project without tags: its map alone poses\n"
+    "the frames, in the model's own frame and arbitrary units).\n"
     "Without --json, prints a short line per frame. A summary goes to stderr.\n"
     "  --layout FILE         multi-tag layout (tag_layout.h format): also prints the layout's pose\n"
     "                        (\"cam_from_layout\"), and searches the layout's tags not found yet where\n"
     "                        that pose puts them (\"predicted\": regions searched, tags found;\n"
     "                        \"predicted\": true on a tag found so); --max-tags is raised to the\n"
     "                        layout's tag count\n"
-    "  --project DIR         a project of `reconar reconstruct --tag-size`: its tags, map, tag size,\n"
-    "                        family and camera (scaled to the frame size; --intrinsics overrides)\n"
-    "  --no-map              with --project: tags only\n"
+    "  --project DIR         a project of `reconar reconstruct`: its map and camera (the photos' of\n"
+    "                        the frame size, or scaled to it; --intrinsics overrides), and with\n"
+    "                        --tag-size its tags, tag size and family\n"
+    "  --no-map              with --project: tags only (a project with tags)\n"
     "  --max-frames N        stop after N frames\n"
     "  --json                JSON lines on stdout\n";
 
@@ -69,7 +72,8 @@ int RunTrack(int argc, char** argv, int first) {
   if (*project) {
     options.pose.layout = std::move((*project)->layout);
     options.map = std::move((*project)->map);
-    options.scale_intrinsics_to_video = !args.Has("intrinsics");
+    options.track_tags = (*project)->has_tags;
+    if (!args.Has("intrinsics")) options.photo_cameras = (*project)->photo_cameras;
   }
   auto tracker_options = TrackerOptionsFromArgs(args, defaults);
   if (!tracker_options.ok()) return Fail(tracker_options.status());
@@ -86,7 +90,10 @@ int RunTrack(int argc, char** argv, int first) {
   auto session = ArSession::Open(options);
   if (!session.ok()) return Fail(session.status());
   std::fprintf(stderr, "reconar track: %s%s\n", (*session)->Describe().c_str(),
-               options.map ? "; posed by the project's tags and map" : "");
+               !options.map ? "" : options.track_tags ? "; posed by the project's tags and map" : "; posed by the project's map");
+  if (*project && !(*project)->has_tags) {
+    std::fprintf(stderr, "reconar track: %s\n", (*project)->no_tags_note.c_str());
+  }
 
   std::vector<double> frame_ms;
   long frames_with_tags = 0;
@@ -98,12 +105,14 @@ int RunTrack(int argc, char** argv, int first) {
     auto more = (*session)->Step();
     if (!more.ok()) return Fail(more.status());
     if (!*more) break;
-    int measured = 0;
-    for (const TrackedTag& tag : (*session)->tags().report().tags) measured += tag.measured ? 1 : 0;
-    frames_with_tags += measured > 0 ? 1 : 0;
-    tag_instances += measured;
-    predicted_found += (*session)->tags().report().predicted_found;
-    predicted_searched += (*session)->tags().report().predicted_searched;
+    if (const TagPoseSource* tags = (*session)->tags()) {
+      int measured = 0;
+      for (const TrackedTag& tag : tags->report().tags) measured += tag.measured ? 1 : 0;
+      frames_with_tags += measured > 0 ? 1 : 0;
+      tag_instances += measured;
+      predicted_found += tags->report().predicted_found;
+      predicted_searched += tags->report().predicted_searched;
+    }
     ++frames_by_source[static_cast<int>((*session)->sources().source())];
     frame_ms.push_back((*session)->pose().track_ms);
     std::printf("%s\n", (json ? ArFrameJson(**session) : ArFrameText(**session)).c_str());
@@ -114,16 +123,18 @@ int RunTrack(int argc, char** argv, int first) {
   std::sort(sorted.begin(), sorted.end());
   double total = 0.0;
   for (double ms : frame_ms) total += ms;
-  std::fprintf(stderr,
-               "reconar track: %ld frames, tags in %ld (%ld tag instances); tracking %.2f ms/frame mean, %.2f "
-               "median, %.2f max\n",
-               frames, frames_with_tags, tag_instances, total / frames, sorted[sorted.size() / 2], sorted.back());
-  if (!options.pose.layout.empty()) {
+  std::string tags_seen = options.track_tags ? ", tags in " + std::to_string(frames_with_tags) + " (" +
+                                                   std::to_string(tag_instances) + " tag instances)"
+                                             : "";
+  std::fprintf(stderr, "reconar track: %ld frames%s; tracking %.2f ms/frame mean, %.2f median, %.2f max\n", frames,
+               tags_seen.c_str(), total / frames, sorted[sorted.size() / 2], sorted.back());
+  if (options.track_tags && !options.pose.layout.empty()) {
     std::fprintf(stderr, "reconar track: %ld of the tag instances found by prediction (%ld predicted regions)\n",
                  predicted_found, predicted_searched);
   }
   if (options.map) {
-    std::fprintf(stderr, "reconar track: %s\n", PoseSourceCounts(frames_by_source).c_str());
+    std::fprintf(stderr, "reconar track: %s%s\n", PoseSourceCounts(frames_by_source).c_str(),
+                 (*session)->metric() ? "" : "; poses in model units");
   }
   return 0;
 }

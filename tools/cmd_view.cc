@@ -28,13 +28,14 @@ constexpr char kHelp[] =
     "full screen through DRM/KMS ('q' or Escape quits the window). With --out, one PNG per frame\n"
     "is written to DIR instead (headless, no display needed).\n"
     "  --model FILE          mesh or point cloud to show (.ply, .obj, .glb)\n"
-    "  --project DIR         a project of `reconar reconstruct --tag-size`: its mesh (or dense, or\n"
-    "                        sparse points) at true size, posed from all of its tags in view at once\n"
-    "                        (tags.layout) and from its localisation map (map/map.rmap), so the model\n"
-    "                        stays in place with no tag in view; with its tag size, family and camera\n"
-    "                        (scaled to the frame size; --intrinsics overrides); the --model-* options\n"
-    "                        do not apply\n"
-    "  --no-map              with --project: pose from the tags only\n"
+    "  --project DIR         a project of `reconar reconstruct`: its mesh (or dense, or sparse points)\n"
+    "                        where it was reconstructed, posed from its localisation map\n"
+    "                        (map/map.rmap) and, with --tag-size, from all of its tags in view at once\n"
+    "                        (tags.layout: metres, so the model stays in place with or without a tag\n"
+    "                        in view); without tags the map alone poses the frames, in the model's\n"
+    "                        own units; with the photos' camera (of the frame size, or scaled to it;\n"
+    "                        --intrinsics overrides); the --model-* options do not apply\n"
+    "  --no-map              with --project: pose from the tags only (a project with tags)\n"
     "  --json                one JSON line per frame on stdout, as `reconar track --json` prints\n"
     "                        (with --project: the pose's source and the map tracker's state)\n"
     "  --camera DEVICE       /dev/videoN, libcamera or libcamera:N\n"
@@ -135,8 +136,9 @@ int RunView(int argc, char** argv, int first) {
   if (project) {
     session.pose.layout = project->layout;
     session.map = project->map;
+    session.track_tags = project->has_tags;
+    if (!args.Has("intrinsics")) session.photo_cameras = project->photo_cameras;
   }
-  session.scale_intrinsics_to_video = project && !args.Has("intrinsics");
   session.pose.smoothed = args.Has("smooth");
   session.source = args.Has("camera") ? args.Get("camera") : args.Get("frames");
   auto tag_id = args.GetInt("tag-id", -1, -1, 1 << 20);
@@ -178,6 +180,10 @@ int RunView(int argc, char** argv, int first) {
   auto view = ArView::Open(options, model->mesh);
   if (!view.ok()) return Fail(view.status());
   std::fprintf(stderr, "reconar view: %s\n", (*view)->Describe(model_path).c_str());
+  if (project && !project->has_tags) {
+    std::fprintf(stderr, "reconar view: %s; the model is drawn where it was reconstructed\n",
+                 project->no_tags_note.c_str());
+  }
   const bool stderr_is_terminal = ::isatty(STDERR_FILENO) != 0;
   const bool json = args.Has("json");
   auto report = (*view)->Run([&](const ArSession& frame) {
@@ -196,7 +202,8 @@ int RunView(int argc, char** argv, int first) {
                stderr_is_terminal ? "\r" : "", report->frames, report->frames_with_model, report->median_track_ms,
                report->median_render_ms, report->median_frame_ms, to_files ? " (render includes the readback)" : "");
   if (session.map) {
-    std::fprintf(stderr, "reconar view: %s\n", PoseSourceCounts(report->frames_by_source).c_str());
+    std::fprintf(stderr, "reconar view: %s%s\n", PoseSourceCounts(report->frames_by_source).c_str(),
+                 session.map->metric ? "" : "; poses in model units");
   }
   if (to_files) std::fprintf(stderr, "reconar view: wrote %ld PNGs to %s\n", report->frames, options.out_dir.c_str());
   return 0;

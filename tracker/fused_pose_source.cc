@@ -23,9 +23,14 @@ const char* PoseSourceKindName(PoseSourceKind kind) {
 }
 
 Status FusedPoseSourceOptions::Check() const {
-  RECONAR_RETURN_IF_ERROR(tags.Check());
-  if (map != nullptr && tags.layout.empty()) {
-    return InvalidArgument("fused pose source: a map needs the tags' layout (the map's world frame)");
+  if (track_tags) {
+    RECONAR_RETURN_IF_ERROR(tags.Check());
+    if (map != nullptr && tags.layout.empty()) {
+      return InvalidArgument("fused pose source: a map needs the tags' layout (the map's world frame)");
+    }
+  } else {
+    if (map == nullptr) return InvalidArgument("fused pose source: without tags it needs a map");
+    if (!tags.tracker.intrinsics.valid()) return InvalidArgument("fused pose source: the camera's fx and fy must be > 0");
   }
   if (!(fusion_max_error_px > 0.0) || !std::isfinite(fusion_max_error_px)) {
     return InvalidArgument("fused pose source: fusion_max_error_px must be > 0");
@@ -38,7 +43,9 @@ FusedPoseSource::FusedPoseSource(const FusedPoseSourceOptions& options) : option
 Result<std::unique_ptr<FusedPoseSource>> FusedPoseSource::Create(const FusedPoseSourceOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   std::unique_ptr<FusedPoseSource> source(new FusedPoseSource(options));
-  RECONAR_ASSIGN_OR_RETURN(source->tags_, TagPoseSource::Create(options.tags));
+  if (options.track_tags) {
+    RECONAR_ASSIGN_OR_RETURN(source->tags_, TagPoseSource::Create(options.tags));
+  }
   if (options.map != nullptr) {
     MapTrackerOptions map_options = options.map_tracking;
     map_options.intrinsics = options.tags.tracker.intrinsics;
@@ -60,7 +67,9 @@ Status FusedPoseSource::Track(ImageView<const uint8_t> gray, WorldPose* pose) {
     if (pose->found) source_ = PoseSourceKind::kTags;
     return Status::Ok();
   }
-  RECONAR_RETURN_IF_ERROR(tags_->Track(gray, has_previous_ ? &previous_cam_from_world_ : nullptr, &tag_pose_));
+  if (tags_) {
+    RECONAR_RETURN_IF_ERROR(tags_->Track(gray, has_previous_ ? &previous_cam_from_world_ : nullptr, &tag_pose_));
+  }
   // The tags' pose restarts a map tracker that has lost the map without a relocalisation; a restart
   // that did not take (the next frame has no map pose: photos far apart rather than a video) is
   // followed by a relocalisation.

@@ -13,7 +13,8 @@
 //     within fusion_max_error_px. The tags keep the metric anchor (a map that disagrees with them
 //     is left out, and the frame is posed by the tags alone); the map keeps the model in place when
 //     no tag is in view. Either alone poses the frame by itself.
-// Without a map it is the TagPoseSource. Steady-state Track() makes no heap allocation of its own
+// Without a map it is the TagPoseSource; without tags (track_tags false: a project reconstructed
+// without tags) it is the map tracker alone, in the map's own frame and units. Steady-state Track() makes no heap allocation of its own
 // (every buffer is sized at construction; the tag and map trackers give the same guarantee for
 // their tracked frames; a relocalisation allocates).
 #include <Eigen/Core>
@@ -33,6 +34,9 @@ namespace reconar {
 struct FusedPoseSourceOptions {
   TagPoseSourceOptions tags;             // needs a layout when there is a map (the map's world frame)
   const LocalizationMap* map = nullptr;  // borrowed; nullptr: tags only
+  // false: no tag is searched and the map alone poses the frames, in its own world frame (a project
+  // without tags); of `tags` only tracker.intrinsics is used. Needs a map.
+  bool track_tags = true;
   // Its intrinsics are replaced by tags.tracker.intrinsics (one camera for both).
   MapTrackerOptions map_tracking;
   // A map inlier joins the fused refinement when its error under the tags' pose is below this: the
@@ -49,14 +53,16 @@ const char* PoseSourceKindName(PoseSourceKind kind);  // "none", "tags", "map", 
 
 class FusedPoseSource final : public PoseSource {
  public:
-  // InvalidArgument for bad options (a map without a layout); errors of the tag and map trackers.
+  // InvalidArgument for bad options (a map without a layout, no tags and no map); errors of the tag
+  // and map trackers.
   static Result<std::unique_ptr<FusedPoseSource>> Create(const FusedPoseSourceOptions& options);
 
   Status Track(ImageView<const uint8_t> gray, WorldPose* pose) override;
 
   // This frame's (valid after Track, until the next).
   PoseSourceKind source() const { return source_; }
-  const TagPoseSource& tags() const { return *tags_; }
+  // nullptr when tags are not tracked (track_tags false).
+  const TagPoseSource* tags() const { return tags_.get(); }
   const WorldPose& tag_pose() const { return tag_pose_; }
   // nullptr without a map.
   const MapTrackerFrameReport* map_report() const { return map_ ? &map_report_ : nullptr; }

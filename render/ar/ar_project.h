@@ -1,10 +1,11 @@
 #pragma once
-// Loading an AR scene: a project of `reconar reconstruct --tag-size` for AR (its model, tags.layout,
-// tag size and family, and the photos' camera, scaled to the video), and the model to draw
-// (simplified to a face budget for the handheld).
+// Loading an AR scene: a project of `reconar reconstruct` for AR (its model, its localisation map,
+// the photos' cameras, and with --tag-size its tags.layout, tag size and family), the photos'
+// camera for the video's size, and the model to draw (simplified to a face budget for the handheld).
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/base/status.h"
 #include "core/math/camera_intrinsics.h"
@@ -15,26 +16,41 @@
 
 namespace reconar {
 
-// What `reconar view --project DIR` brings: the model in metres in the world frame, where each tag
-// sits in it, the tags' size and family, the photos' camera, and the localisation map that poses
-// the camera where no tag is in view.
+// What `reconar view --project DIR` brings: the model in its world frame, the localisation map that
+// poses the camera in that frame, the photos' cameras, and when the project has tags (reconstructed
+// with --tag-size, tags.json metric) where each tag sits in the world and their size and family:
+// the world is then the world tag's frame in metres. Without tags the world is the model's own
+// frame, in its arbitrary units, and the map alone poses the camera.
 struct ArProject {
   std::string model_path;  // the mesh, else the dense points, else the sparse points
+  bool has_tags = false;   // tags.json says the model is metric: layout, tag_size and family are set
+  // Without tags: why not, and what that means for the poses (one line for the commands to print).
+  std::string no_tags_note;
   TagLayout layout;        // world_from_tag of every registered tag (PROJECT/tags.layout)
   double tag_size = 0.0;   // metres
   std::string family;
-  std::optional<CameraIntrinsics> photo_intrinsics;  // the first camera of sparse/, if readable
-  std::shared_ptr<const LocalizationMap> map;         // PROJECT/map/map.rmap; nullptr when absent or not asked for
+  // The cameras of the registered photos (sparse/), the one most photos use first; empty when the
+  // model is unreadable.
+  std::vector<CameraIntrinsics> photo_cameras;
+  std::shared_ptr<const LocalizationMap> map;  // PROJECT/map/map.rmap; nullptr when absent or not asked for
 };
 
 struct ArProjectOptions {
   bool load_map = true;
 };
 
-// FailedPrecondition when the project's tags.json says the model is not in metres, or when its map
-// is not in the tags' metric frame (a map built before the tags: `reconar map` rebuilds it); file
-// errors of tags.json, tags.layout and the map (a damaged map is an error, not ignored).
+// With tags: FailedPrecondition when the map is not in the tags' metric frame (a map built before
+// the tags: `reconar map` rebuilds it). Without tags (no tags.json, or one saying the model is not
+// in metres) the map is required: NotFound naming the map's path and what to run when there is
+// none, FailedPrecondition when it was not asked for. NotFound for a folder that does not exist;
+// file errors of tags.json, tags.layout and the map (a damaged file is an error, not ignored).
 Result<ArProject> LoadArProject(const std::string& dir, const ArProjectOptions& options = {});
+
+// The photos' camera for frames of width x height: the first of `photo_cameras` (ArProject's
+// order) of that size, else the first of that aspect ratio scaled to it (ScaleIntrinsicsToFrame).
+// InvalidArgument naming the sizes when none fits (or there is none): --intrinsics is needed.
+Result<CameraIntrinsics> PhotoCameraForFrame(const std::vector<CameraIntrinsics>& photo_cameras, int width,
+                                             int height);
 
 struct ArModel {
   Mesh mesh;

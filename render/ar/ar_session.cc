@@ -19,13 +19,13 @@ Result<std::unique_ptr<ArSession>> ArSession::Open(const ArSessionOptions& optio
   session->height_ = session->frame_->height;
   FusedPoseSourceOptions pose_options;
   pose_options.tags = options.pose;
-  if (options.scale_intrinsics_to_video) {
-    RECONAR_ASSIGN_OR_RETURN(
-        pose_options.tags.tracker.intrinsics,
-        ScaleIntrinsicsToFrame(pose_options.tags.tracker.intrinsics, session->width_, session->height_));
+  if (!options.photo_cameras.empty()) {
+    RECONAR_ASSIGN_OR_RETURN(pose_options.tags.tracker.intrinsics,
+                             PhotoCameraForFrame(options.photo_cameras, session->width_, session->height_));
   }
   session->map_ = options.map;
   pose_options.map = session->map_.get();
+  pose_options.track_tags = options.track_tags;
   pose_options.map_tracking = options.map_tracking;
   RECONAR_ASSIGN_OR_RETURN(session->pose_source_, FusedPoseSource::Create(pose_options));
   return session;

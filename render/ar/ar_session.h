@@ -1,14 +1,16 @@
 #pragma once
 // ArSession: the AR runtime's loop over a video, joining a FrameSource (platform/camera) and the
-// pose source (tracker/fused_pose_source.h: the tags, and a project's map when one is given). Open() opens the source, reads the first frame (its size
-// fixes the camera's), scales the project camera to it when asked, and creates the pose source.
+// pose source (tracker/fused_pose_source.h: the tags, and a project's map when one is given; a
+// project without tags: its map alone). Open() opens the source, reads the first frame (its size
+// fixes the camera's), takes the project's camera for that size when asked, and creates the pose
+// source.
 // Each Step() gives the previous frame back, takes the next one and finds its pose:
 //
 //   RECONAR_ASSIGN_OR_RETURN(auto session, ArSession::Open(options));
 //   for (;;) {
 //     RECONAR_ASSIGN_OR_RETURN(const bool more, session->Step());
 //     if (!more) break;
-//     use(session->frame(), session->pose(), session->tags().report());
+//     use(session->frame(), session->pose(), session->sources());
 //   }
 //
 // `reconar track` prints what Step() found; `reconar view` (render/ar/ar_view.h) draws it. The
@@ -17,6 +19,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/base/status.h"
 #include "core/math/camera_intrinsics.h"
@@ -32,12 +35,15 @@ struct ArSessionOptions {
   std::string source;  // OpenFrameSource specification
   FrameSourceOptions frames;
   TagPoseSourceOptions pose;
-  // pose.tracker.intrinsics are the photos' camera: scale them to the video's frame size
-  // (ScaleIntrinsicsToFrame, core/math/camera_intrinsics.h).
-  bool scale_intrinsics_to_video = false;
+  // Non-empty (a project's cameras, ArProject::photo_cameras): the camera is the one of the video's
+  // frame size (PhotoCameraForFrame, render/ar/ar_project.h) instead of pose.tracker.intrinsics.
+  std::vector<CameraIntrinsics> photo_cameras;
   // A project's localisation map (in the world frame of pose.layout): frames are also posed from
   // it, and without tags in view by it alone. nullptr: tags only.
   std::shared_ptr<const LocalizationMap> map;
+  // false (a project without tags): no tag is searched, the map alone poses the frames in its own
+  // frame; only pose.tracker.intrinsics of `pose` is used. Needs a map.
+  bool track_tags = true;
   MapTrackerOptions map_tracking;  // its intrinsics are the tags' (scaled with them)
   int max_frames = 0;  // Step() ends after this many frames (0: at the end of the stream)
 };
@@ -45,7 +51,7 @@ struct ArSessionOptions {
 class ArSession {
  public:
   // Errors of the source, "SOURCE: no frames" (FailedPrecondition) for an empty stream, errors of
-  // scaling the intrinsics and of FusedPoseSource::Create.
+  // PhotoCameraForFrame and of FusedPoseSource::Create.
   static Result<std::unique_ptr<ArSession>> Open(const ArSessionOptions& options);
   ~ArSession();
 
@@ -55,10 +61,14 @@ class ArSession {
 
   const Frame& frame() const { return *frame_; }
   const WorldPose& pose() const { return pose_; }
-  const TagPoseSource& tags() const { return pose_source_->tags(); }
+  // The tags of the frame; nullptr when tags are not tracked (track_tags false).
+  const TagPoseSource* tags() const { return pose_source_->tags(); }
   // Which sources posed the frame, and the map tracker's report.
   const FusedPoseSource& sources() const { return *pose_source_; }
   const CameraIntrinsics& intrinsics() const { return pose_source_->options().tags.tracker.intrinsics; }
+  // Whether the world's units are metres: tags, or a map in a tag's metric frame. False for a
+  // project without tags: poses are in the model's own, arbitrary units.
+  bool metric() const { return map_ == nullptr || map_->metric; }
   int width() const { return width_; }  // of the first frame
   int height() const { return height_; }
   long frames() const { return frames_; }  // frames stepped through so far

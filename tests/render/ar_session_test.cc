@@ -103,8 +103,7 @@ TEST(ArSessionTest, PhotoCameraIsScaledToTheVideo) {
   photo.fx = photo.fy = 1200.0;
   photo.cx = 640.5;  // pixel centres at integer coordinates: (640.5 + 0.5) / 2 - 0.5 = 320
   photo.cy = 480.5;
-  options.pose.tracker.intrinsics = photo;
-  options.scale_intrinsics_to_video = true;
+  options.photo_cameras = {photo};
   auto session = ArSession::Open(options);
   ASSERT_TRUE(session.ok()) << session.status().ToString();
   const CameraIntrinsics& k = (*session)->intrinsics();
@@ -114,6 +113,40 @@ TEST(ArSessionTest, PhotoCameraIsScaledToTheVideo) {
   EXPECT_EQ(k.cy, 240.0);
   photo.width = 1000;  // another aspect ratio
   EXPECT_EQ(ScaleIntrinsicsToFrame(photo, 640, 480).status().code(), StatusCode::kInvalidArgument);
+}
+
+// A project's cameras: the one of the frame's size, else the first of its aspect ratio, scaled.
+TEST(ArSessionTest, PhotoCameraForFrameTakesTheCameraOfTheFramesSize) {
+  CameraIntrinsics wide;  // 16:9, used by most photos
+  wide.width = 1920;
+  wide.height = 1080;
+  wide.fx = wide.fy = 1500.0;
+  wide.cx = 959.5;
+  wide.cy = 539.5;
+  CameraIntrinsics large = testing::TestCamera();  // 4:3
+  large.width = 1280;
+  large.height = 960;
+  large.fx = large.fy = 1200.0;
+  large.cx = 640.5;
+  large.cy = 480.5;
+  CameraIntrinsics small = large;
+  small.width = 640;
+  small.height = 480;
+  small.fx = small.fy = 610.0;
+  small.cx = 321.0;
+  small.cy = 239.0;
+  auto exact = PhotoCameraForFrame({wide, large, small}, 640, 480);
+  ASSERT_TRUE(exact.ok()) << exact.status().ToString();
+  EXPECT_EQ(exact->fx, 610.0);
+  EXPECT_EQ(exact->cx, 321.0);
+  auto scaled = PhotoCameraForFrame({wide, large}, 640, 480);
+  ASSERT_TRUE(scaled.ok()) << scaled.status().ToString();
+  EXPECT_EQ(scaled->fx, 600.0);
+  EXPECT_EQ(scaled->cx, 320.0);
+  auto none = PhotoCameraForFrame({wide}, 640, 480);
+  EXPECT_EQ(none.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(none.status().message().find("1920x1080"), std::string::npos) << none.status().message();
+  EXPECT_EQ(PhotoCameraForFrame({}, 640, 480).status().code(), StatusCode::kInvalidArgument);
 }
 
 // The whole loop (a raw recording's frames, tracking, the world pose) makes no heap allocation per

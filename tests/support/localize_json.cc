@@ -97,6 +97,9 @@ Result<TrackedFrame> ParseFrame(const JsonValue& json) {
   frame.source = source->string();
   frame.state = state->string();
   frame.map_inliers = static_cast<int>(inliers->number());
+  const JsonValue* units = json.Find("units");
+  if (units == nullptr || !units->is_string()) return CorruptData("\"source\" without \"units\"");
+  frame.units = units->string();
   if (const JsonValue* pose = json.Find("cam_from_world")) {
     double rotation[9], translation[3];
     if (!ReadNumbers(*pose, "R", 9, rotation) || !ReadNumbers(*pose, "t", 3, translation))

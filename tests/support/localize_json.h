@@ -46,6 +46,8 @@ struct TrackedFrame {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
   int map_inliers = 0;
+  // With --project: "metres", or "model" for a project without tags (its own arbitrary units).
+  std::string units;
   double ms = 0.0;
 };
 

@@ -50,7 +50,8 @@ constexpr char kTrackedWithMap[] =
     R"({"frame": "f1.png", "tags": [{"id": 3, "corners": [[1, 2], [3, 4], [5, 6], [7, 8]], "cam_from_tag": )"
     R"({"R": [1, 0, 0, 0, 1, 0, 0, 0, 1], "t": [0, 0, 1]}, "rms_px": 0.2, "reacquired": false}], "source": "map", )"
     R"("state": "tracking", "cam_from_world": {"R": [1, 0, 0, 0, 1, 0, 0, 0, 1], "t": [4, 5, 6]}, )"
-    R"("map_inliers": 120, "relocalised": false, "fused_map_points": 0, "search": "regions", "ms": 7.5})";
+    R"("map_inliers": 120, "relocalised": false, "fused_map_points": 0, "metric": false, "units": "model", )"
+    R"("search": "regions", "ms": 7.5})";
 constexpr char kTrackedTagsOnly[] = R"({"frame": "f2.png", "tags": [], "search": "full_frame", "ms": 3})";
 
 TEST(TrackJson, ReadsFramesWithAndWithoutAMap) {
@@ -67,6 +68,7 @@ TEST(TrackJson, ReadsFramesWithAndWithoutAMap) {
   EXPECT_TRUE(a.has_pose);
   EXPECT_EQ(a.t, Eigen::Vector3d(4, 5, 6));
   EXPECT_EQ(a.map_inliers, 120);
+  EXPECT_EQ(a.units, "model");
   EXPECT_DOUBLE_EQ(a.ms, 7.5);
   const testing::TrackedFrame& b = (*parsed)[1];
   EXPECT_TRUE(b.tags.empty());

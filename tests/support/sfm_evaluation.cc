@@ -20,6 +20,12 @@ double Median(std::vector<double> values) {
   return 0.5 * (values[mid] + *std::max_element(values.begin(), values.begin() + mid));
 }
 
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::nan("");
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size())))];
+}
+
 // atan2(|sin|, cos) from the skew and symmetric parts: accurate for small angles, where
 // acos((trace - 1) / 2) loses half the digits.
 double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {

@@ -20,6 +20,8 @@ using reconar::AlignSimilarity;
 
 // The median of `values` (the mean of the middle two for an even count); 0 for none.
 double Median(std::vector<double> values);
+// The value of rank floor(q * size) of the sorted values (q = 1: the largest); NaN for none.
+double Quantile(std::vector<double> values, double q);
 
 // The angle of the rotation a * b^T, in degrees.
 double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);

@@ -20,6 +20,7 @@
 #include "tests/support/ar_video.h"
 #include "tests/support/localization_evaluation.h"
 #include "tests/support/run_command.h"
+#include "tests/support/sfm_evaluation.h"
 #include "tests/support/tag_paint.h"
 #include "tracker/map_tracker.h"
 #include "tracker/tag_pose.h"
@@ -29,11 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return std::nan("");
-  std::sort(values.begin(), values.end());
-  return values[std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size())))];
-}
+using testing::Quantile;
 
 TEST(MapTrackerVideo, TracksTheArVideoWithTheTagPaintedOutAgainstAMapOfEveryFourthFrame) {
   const std::vector<testing::ArVideoFrame> frames = testing::ReadArVideoFrames();

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -147,6 +148,41 @@ TEST(FusedPoseSource, AMapNeedsTheLayoutOfItsFrame) {
   auto source = FusedPoseSource::Create(options);
   ASSERT_FALSE(source.ok());
   EXPECT_EQ(source.status().code(), StatusCode::kInvalidArgument);
+}
+
+// A project without tags: the map alone poses every frame, the tag in view or not, and no tag is
+// searched.
+TEST(FusedPoseSource, WithoutTagsTheMapAlonePosesEveryFrame) {
+  const Video video = MakeVideo(12);
+  ASSERT_GT(std::count(video.tag_in_view.begin(), video.tag_in_view.end(), true), 0);
+  FusedPoseSourceOptions options = OptionsFor(video, true);
+  options.track_tags = false;
+  options.tags.layout = TagLayout();
+  options.tags.tracker.tag_size = 0.0;  // not used
+  auto source = FusedPoseSource::Create(options);
+  ASSERT_TRUE(source.ok()) << source.status().ToString();
+  EXPECT_EQ((*source)->tags(), nullptr);
+  WorldPose pose;
+  int by_map = 0;
+  double worst_rotation = 0.0, worst_centre = 0.0;
+  for (size_t i = 0; i < video.frames.size(); ++i) {
+    ASSERT_TRUE((*source)->Track(video.frames[i].view(), &pose).ok());
+    EXPECT_TRUE(pose.markers.empty());
+    if (!pose.found) continue;
+    EXPECT_EQ((*source)->source(), PoseSourceKind::kMap);
+    ++by_map;
+    worst_rotation = std::max(worst_rotation, RotationErrorDeg(pose.cam_from_world, video.truth[i]));
+    worst_centre =
+        std::max(worst_centre, (CameraCenterInWorld(pose.cam_from_world) - CameraCenterInWorld(video.truth[i])).norm());
+  }
+  std::printf("without tags: %d of %zu frames posed by the map; worst rotation %.4f deg, centre %.2f mm\n", by_map,
+              video.frames.size(), worst_rotation, 1000.0 * worst_centre);
+  EXPECT_GE(by_map, static_cast<int>(video.frames.size()) - 1);
+  EXPECT_LT(worst_rotation, 0.2);
+  EXPECT_LT(worst_centre, 0.02);
+
+  options.map = nullptr;  // nothing to pose from
+  EXPECT_EQ(FusedPoseSource::Create(options).status().code(), StatusCode::kInvalidArgument);
 }
 
 TEST(FusedPoseSource, SteadyStateFramesDoNotAllocate) {
