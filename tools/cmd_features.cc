@@ -21,9 +21,7 @@ constexpr char kHelp[] =
     "  --first-octave N    -1 (default) doubles the image first for more small-scale features; 0 does not\n"
     "  --max-features N    keep the N strongest per image (default 16384, 0 = all)\n"
     "  --contrast-threshold C  DoG contrast threshold before division by the 3 levels (default 0.04, Lowe)\n"
-    "  --texture-poor-features N  a photo with fewer features is extracted again with the threshold\n"
-    "                      halved, down to --texture-poor-contrast C (default 0.005); default 0 (off),\n"
-    "                      1000 with `reconar sfm|reconstruct --texture-poor`\n"
+
     "  --sift-memory-mib M working-memory bound per thread (default 512); larger photos fall back to\n"
     "                      first octave 0 with a warning\n"
     "  --threads N         photos processed in parallel (default: one per core)\n"
@@ -58,15 +56,9 @@ Result<SiftOptions> SiftOptionsFromArgs(const Args& args) {
   return options;
 }
 
-Result<FeatureStageOptions> FeatureStageOptionsFromArgs(const Args& args, int texture_poor_features) {
+Result<FeatureStageOptions> FeatureStageOptionsFromArgs(const Args& args) {
   FeatureStageOptions options;
-  options.texture_poor_min_features = texture_poor_features;
   RECONAR_ASSIGN_OR_RETURN(options.sift, SiftOptionsFromArgs(args));
-  RECONAR_ASSIGN_OR_RETURN(options.texture_poor_min_features,
-                           args.GetInt("texture-poor-features", options.texture_poor_min_features, 0, 1 << 24));
-  RECONAR_ASSIGN_OR_RETURN(
-      options.texture_poor_min_contrast_threshold,
-      args.GetDouble("texture-poor-contrast", options.texture_poor_min_contrast_threshold, 1e-4, 1.0));
   return options;
 }
 

@@ -36,12 +36,10 @@ namespace reconar::tools {
 // --first-octave, --max-features, --contrast-threshold and --sift-memory-mib (MiB) shared by
 // features, match, sfm and reconstruct.
 Result<SiftOptions> SiftOptionsFromArgs(const Args& args);
-inline const std::set<std::string> kSiftValuedOptions = {"first-octave",          "max-features",
-                                                         "sift-memory-mib",       "contrast-threshold",
-                                                         "texture-poor-features", "texture-poor-contrast"};
-// The feature stage's options: the SIFT ones above, --texture-poor-features N (default
-// texture_poor_features; 0: off) and --texture-poor-contrast C.
-Result<FeatureStageOptions> FeatureStageOptionsFromArgs(const Args& args, int texture_poor_features = 0);
+inline const std::set<std::string> kSiftValuedOptions = {"first-octave", "max-features", "sift-memory-mib",
+                                                         "contrast-threshold"};
+// The feature stage's options: the SIFT ones above.
+Result<FeatureStageOptions> FeatureStageOptionsFromArgs(const Args& args);
 
 // --ratio, --checks, --min-inliers, --f-threshold, --exhaustive-up-to, --window, --retrieved and
 // --threads over the values `options` holds.

@@ -15,8 +15,9 @@
 namespace reconar::tools {
 namespace {
 
-const std::set<std::string> kFlags = {"no-tags-in-ba",    "no-preview", "force",        "json",
-                                      "fixed-distortion", "no-fill",    "texture-poor", "merge-models"};
+const std::set<std::string> kFlags = {"no-tags-in-ba", "no-preview",           "force",           "json",
+                                      "fixed-distortion", "no-fill",          "strict-registration",
+                                      "separate-models"};
 
 std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
@@ -54,7 +55,11 @@ Status ReadMapperArgs(const Args& args, MapperOptions* mapper) {
     return InvalidArgument("--principal-point must be fixed, auto or refine, got '" + pp + "'");
   }
   if (args.Has("fixed-distortion")) mapper->refine_distortion = false;
-  if (args.Has("merge-models")) mapper->merge_models = true;
+  if (args.Has("separate-models")) mapper->merge_models = false;
+  if (args.Has("strict-registration")) {
+    mapper->registration_min_verified_inliers = mapper->registration_min_inliers;
+    mapper->registration_min_baseline_points = 0;
+  }
   RECONAR_ASSIGN_OR_RETURN(mapper->max_reprojection_error_px,
                            args.GetDouble("max-error", mapper->max_reprojection_error_px, 0.1, 100.0));
   mapper->registration_max_error_px =
@@ -96,9 +101,7 @@ Status ReadDenseAndMeshArgs(const Args& args, ReconstructOptions* options) {
 
 Result<ReconstructOptions> OptionsFromArgs(const Args& args) {
   ReconstructOptions options;
-  if (args.Has("texture-poor")) UseTexturePoorSettings(&options);
-  RECONAR_ASSIGN_OR_RETURN(options.features,
-                           FeatureStageOptionsFromArgs(args, options.features.texture_poor_min_features));
+  RECONAR_ASSIGN_OR_RETURN(options.features, FeatureStageOptionsFromArgs(args));
   RECONAR_RETURN_IF_ERROR(ReadMatchArgs(args, &options.matching));
   RECONAR_RETURN_IF_ERROR(ReadMapperArgs(args, &options.sfm.mapper));
   RECONAR_ASSIGN_OR_RETURN(options.tag_size_m, args.GetDouble("tag-size", 0.0, 0.0, 100.0));

@@ -65,23 +65,6 @@ Result<ImageFeatureSummary> PhotoFeatureExtractor::Extract(const std::string& pa
     result = used->Extract(gray.view());
   }
   if (!result.ok()) return Status(result.status().code(), path + ": " + result.status().message());
-  summary.contrast_threshold = used->options().contrast_threshold;
-  const size_t first_count = result->keypoints.size();
-  while (static_cast<int>(result->keypoints.size()) < options_.texture_poor_min_features &&
-         summary.contrast_threshold / 2.0 >= options_.texture_poor_min_contrast_threshold) {
-    summary.contrast_threshold /= 2.0;
-    used->set_contrast_threshold(summary.contrast_threshold);
-    auto again = used->Extract(gray.view());
-    used->set_contrast_threshold(options_.sift.contrast_threshold);
-    if (!again.ok()) break;
-    result = std::move(again);
-  }
-  if (summary.contrast_threshold < options_.sift.contrast_threshold) {
-    char note[160];
-    std::snprintf(note, sizeof(note), "texture-poor: %zu features at contrast threshold %g, %zu at %g", first_count,
-                  options_.sift.contrast_threshold, result->keypoints.size(), summary.contrast_threshold);
-    summary.warnings.push_back(note);
-  }
   summary.num_features = static_cast<int>(result->keypoints.size());
   *features = std::move(result).value();
   summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -93,9 +76,7 @@ std::string FeatureStageSettings(const FeatureStageOptions& options) {
   return StageRecord::Settings({{"first_octave", sift.first_octave},
                                 {"max_features", sift.max_features},
                                 {"contrast_threshold", sift.contrast_threshold},
-                                {"arena_mib", static_cast<double>(sift.arena_bytes) / (1 << 20)},
-                                {"texture_poor_min_features", static_cast<double>(options.texture_poor_min_features)},
-                                {"texture_poor_min_contrast", options.texture_poor_min_contrast_threshold}});
+                                {"arena_mib", static_cast<double>(sift.arena_bytes) / (1 << 20)}});
 }
 
 Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image_paths, const Project* project,

@@ -17,21 +17,11 @@ struct FeatureStageOptions {
   int num_threads = 0;          // images in parallel; <= 0: one per core
   std::string key_output;       // "" none; a .key path for one image, else a directory
   bool show_progress = true;
-  // Texture-poor photos: when a photo yields fewer than texture_poor_min_features features, the
-  // contrast threshold is halved and the photo extracted again, down to
-  // texture_poor_min_contrast_threshold (three halvings of Lowe's 0.04; COLMAP's default is 0.02 in
-  // these units) or until the count is reached (the image's summary says so). A plaster figure on
-  // velvet gives a hundred features at 0.04, too few for a sparse ring's neighbours to match
-  // (dinoSparseRing). Off (0) by default; `--texture-poor` sets 1000 (UseTexturePoorSettings in
-  // core/pipeline/reconstruct.h says why not always).
-  int texture_poor_min_features = 0;
-  double texture_poor_min_contrast_threshold = 0.005;
 };
 
 struct ImageFeatureSummary {
   ProjectImage image;
   int num_features = 0;
-  double contrast_threshold = 0;  // the one used (below SiftOptions' for a texture-poor photo)
   double seconds = 0;
   std::string focal_explanation;
   std::vector<std::string> warnings;

@@ -44,7 +44,7 @@ Result<MapStageReport> RunMapStage(const Project& project, const MapStageOptions
   }
   RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(project.SparseDir()));
   const ImageDescriptorLoader load = [&](const SfmImage& image) -> Result<std::vector<uint8_t>> {
-    RECONAR_ASSIGN_OR_RETURN(FeatureFile features, ReadFeatureFile(project.FeaturePath(image.name)));
+    RECONAR_ASSIGN_OR_RETURN(FeatureFile features, ReadFeatureFile(project.MatchedFeaturePath(image.name)));
     return std::move(features.features.descriptors);
   };
   MapStageReport report;

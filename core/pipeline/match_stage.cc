@@ -8,9 +8,12 @@
 #include <sstream>
 
 #include "core/base/atomic_file.h"
+#include "core/base/json_writer.h"
+#include "core/base/log.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/features/sift/sift_io.h"
+#include "core/pipeline/feature_stage.h"
 #include "core/pipeline/stage_record.h"
 
 namespace reconar {
@@ -60,7 +63,58 @@ Result<std::vector<std::pair<int, int>>> ChoosePairs(const Project& project, con
   return pairs;
 }
 
+// Per image: the pairs it is in that verified (as a general or a planar two-view geometry).
+std::vector<int> VerifiedPartners(const std::vector<std::optional<VerifiedPair>>& results, size_t num_images) {
+  std::vector<int> partners(num_images, 0);
+  for (const std::optional<VerifiedPair>& result : results) {
+    if (!result || result->geometry.config == TwoViewGeometry::Config::kTooFewInliers) continue;
+    ++partners[static_cast<size_t>(result->image_a)];
+    ++partners[static_cast<size_t>(result->image_b)];
+  }
+  return partners;
+}
+
 }  // namespace
+
+std::vector<ReextractionReason> PhotosToExtractAgain(const std::vector<int>& partners,
+                                                     const std::vector<int>& feature_counts, int min_partners) {
+  const size_t n = partners.size();
+  std::vector<ReextractionReason> reasons(n, ReextractionReason::kNone);
+  if (n == 0 || min_partners <= 0) return reasons;
+  const auto median_of = [](std::vector<int> values) {  // the mean of the middle two for an even count
+    std::sort(values.begin(), values.end());
+    return 0.5 * (values[(values.size() - 1) / 2] + values[values.size() / 2]);
+  };
+  if (median_of(partners) < min_partners) {
+    for (ReextractionReason& reason : reasons) reason = ReextractionReason::kTheSetMatchesPoorly;
+    return reasons;
+  }
+  const double median_features = median_of(feature_counts);
+  int texture_poor_bound = -1;  // the most features a poorly matched photo under the median has
+  for (size_t i = 0; i < n; ++i) {
+    if (partners[i] >= min_partners) continue;
+    reasons[i] = ReextractionReason::kPoorlyMatched;
+    if (feature_counts[i] < median_features) texture_poor_bound = std::max(texture_poor_bound, feature_counts[i]);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (reasons[i] == ReextractionReason::kNone && feature_counts[i] <= texture_poor_bound)
+      reasons[i] = ReextractionReason::kAsTexturePoor;
+  }
+  return reasons;
+}
+
+std::string ReextractionReasonText(ReextractionReason reason, int partners, int min_partners) {
+  const std::string matched = "matched with " + std::to_string(partners) + " other photo(s)";
+  switch (reason) {
+    case ReextractionReason::kNone: return "";
+    case ReextractionReason::kPoorlyMatched: return matched + ", need " + std::to_string(min_partners);
+    case ReextractionReason::kAsTexturePoor:
+      return matched + ", but has no more features than a poorly matched photo with fewer than the set's median";
+    case ReextractionReason::kTheSetMatchesPoorly:
+      return matched + "; the set's median photo matched with fewer than " + std::to_string(min_partners);
+  }
+  return "";
+}
 
 double MatchBytesPerFeature(const MatchOptions& match, int workers) {
   // A descriptor and its keypoint, and in every worker's forest one point id per tree plus about
@@ -85,7 +139,9 @@ std::string MatchStageSettings(const MatchStageOptions& options) {
   return StageRecord::Settings({{"ratio", options.match.max_ratio},
                                 {"checks", options.match.max_leaf_checks},
                                 {"min_inliers", options.two_view.min_inliers},
-                                {"f_threshold", options.two_view.f_threshold_fraction}}) +
+                                {"f_threshold", options.two_view.f_threshold_fraction},
+                                {"poorly_matched_partners", options.poorly_matched.min_partners},
+                                {"poorly_matched_contrast", options.poorly_matched.contrast_threshold}}) +
          " pairs=" + options.pairs.Describe();
 }
 
@@ -128,9 +184,17 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
   const double budget = options.memory_budget_bytes > 0 ? static_cast<double>(options.memory_budget_bytes)
                                                         : std::numeric_limits<double>::infinity();
 
+  // Richer features of an earlier run are not this run's input.
+  for (const ProjectImage& image : images) RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.RicherFeaturePath(image.name)));
+  // Each image's features: the feature stage's, until it is extracted again.
+  std::vector<char> reextracted(images.size(), 0);
+  const auto feature_path = [&](size_t i) {
+    return reextracted[i] ? project.RicherFeaturePath(images[i].name) : project.FeaturePath(images[i].name);
+  };
   // Every image's size and feature count; the features stay loaded while all of them fit.
   std::vector<FeatureFile> files(images.size());
   std::vector<double> image_bytes(images.size());
+  std::vector<int> feature_counts(images.size());
   double total_bytes = 0.0;
   bool all_loaded = true;
   for (size_t i = 0; i < images.size(); ++i) {
@@ -148,6 +212,7 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
       count = header.count;
     }
     image_bytes[i] = per_feature * static_cast<double>(count);
+    feature_counts[i] = static_cast<int>(count);
     total_bytes += image_bytes[i];
     if (all_loaded && total_bytes > budget) {
       all_loaded = false;
@@ -204,7 +269,7 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
       }
       if (!wanted || matchers.front()->HasImage(static_cast<int>(i))) continue;
       if (!all_loaded) {
-        RECONAR_ASSIGN_OR_RETURN(FeatureFile file, ReadFeatureFile(project.FeaturePath(images[i].name)));
+        RECONAR_ASSIGN_OR_RETURN(FeatureFile file, ReadFeatureFile(feature_path(i)));
         files[i].features = std::move(file.features);
       }
       const SiftFeatures& f = files[i].features;
@@ -218,39 +283,103 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
 
   std::vector<std::optional<VerifiedPair>> results(pairs.size());
   std::vector<Status> errors(pairs.size());
-  std::optional<Progress> progress;
-  if (options.show_progress) progress.emplace("matching", pairs.size());
-  for (int a = 0; a < num_blocks; ++a) {
-    for (int b = a; b < num_blocks; ++b) {
-      const std::vector<size_t>& block_pairs = pairs_of_blocks[static_cast<size_t>(a * num_blocks + b)];
-      if (block_pairs.empty()) continue;
-      RECONAR_RETURN_IF_ERROR(hold_blocks(a, b));
-      pool.ParallelFor(0, block_pairs.size(), [&](size_t k, int worker) {
-        const size_t p = block_pairs[k];
-        const auto [i, j] = pairs[p];
-        auto putative = matchers[worker]->Match(i, j);
-        if (!putative.ok()) {
-          errors[p] = putative.status();
-        } else {
-          auto verified = VerifyMatches(files[i].features, files[i].image_width, files[i].image_height,
-                                        files[j].features, files[j].image_width, files[j].image_height, *putative,
-                                        options.two_view);
-          if (verified.ok()) {
-            verified->image_a = i;
-            verified->image_b = j;
-            results[p] = std::move(verified).value();
+  // Matches and verifies the pairs `chosen` (indices into `pairs`), a pair of blocks at a time.
+  const auto match_pairs = [&](const std::vector<char>& chosen, const char* label) -> Status {
+    size_t count = 0;
+    for (char c : chosen) count += c ? 1 : 0;
+    std::optional<Progress> progress;
+    if (options.show_progress) progress.emplace(label, count);
+    for (int a = 0; a < num_blocks; ++a) {
+      for (int b = a; b < num_blocks; ++b) {
+        std::vector<size_t> block_pairs;
+        for (size_t p : pairs_of_blocks[static_cast<size_t>(a * num_blocks + b)])
+          if (chosen[p]) block_pairs.push_back(p);
+        if (block_pairs.empty()) continue;
+        RECONAR_RETURN_IF_ERROR(hold_blocks(a, b));
+        pool.ParallelFor(0, block_pairs.size(), [&](size_t k, int worker) {
+          const size_t p = block_pairs[k];
+          const auto [i, j] = pairs[p];
+          auto putative = matchers[worker]->Match(i, j);
+          if (!putative.ok()) {
+            errors[p] = putative.status();
           } else {
-            errors[p] = verified.status().WithContext(images[i].name + " / " + images[j].name);
+            auto verified = VerifyMatches(files[i].features, files[i].image_width, files[i].image_height,
+                                          files[j].features, files[j].image_width, files[j].image_height, *putative,
+                                          options.two_view);
+            if (verified.ok()) {
+              verified->image_a = i;
+              verified->image_b = j;
+              results[p] = std::move(verified).value();
+            } else {
+              errors[p] = verified.status().WithContext(images[i].name + " / " + images[j].name);
+            }
           }
-        }
-        if (progress) progress->Advance();
-      });
-      for (size_t p : block_pairs) RECONAR_RETURN_IF_ERROR(errors[p]);
+          if (progress) progress->Advance();
+        });
+        for (size_t p : block_pairs) RECONAR_RETURN_IF_ERROR(errors[p]);
+      }
+    }
+    if (progress) progress->Finish();
+    return Status::Ok();
+  };
+  RECONAR_RETURN_IF_ERROR(match_pairs(std::vector<char>(pairs.size(), 1), "matching"));
+
+  // The poorly matched photos, extracted again, and their pairs matched again.
+  MatchStageReport report;
+  const auto reextraction_start = Clock::now();
+  const std::vector<int> partners_before = VerifiedPartners(results, images.size());
+  const int needed = std::min(options.poorly_matched.min_partners, n - 1);
+  const std::vector<ReextractionReason> reasons = PhotosToExtractAgain(partners_before, feature_counts, needed);
+  std::vector<char> rematch(pairs.size(), 0);
+  {
+    FeatureStageOptions richer;
+    richer.sift = options.poorly_matched.sift;
+    richer.sift.contrast_threshold = options.poorly_matched.contrast_threshold;
+    PhotoFeatureExtractor extractor(richer);
+    for (size_t i = 0; i < images.size(); ++i) {
+      if (reasons[i] == ReextractionReason::kNone) continue;
+      SiftFeatures features;
+      const Result<ImageFeatureSummary> summary = extractor.Extract(images[i].path, &features);
+      if (!summary.ok()) {
+        LogWarning("matching: " + images[i].name + " not extracted again: " + summary.status().message());
+        continue;
+      }
+      RECONAR_ASSIGN_OR_RETURN(const FeatureFileHeader before, ReadFeatureFileHeader(project.FeaturePath(images[i].name)));
+      if (features.keypoints.size() <= before.count) continue;  // nothing more to find
+      FeatureFile file;
+      file.image_width = summary->image.width;
+      file.image_height = summary->image.height;
+      if (file.image_width != files[i].image_width || file.image_height != files[i].image_height) {
+        return FileError(StatusCode::kCorruptData, images[i].path, "the photo's size differs from its features'");
+      }
+      const int features_after = static_cast<int>(features.keypoints.size());
+      file.features = std::move(features);
+      RECONAR_RETURN_IF_ERROR(WriteFeatureFile(project.RicherFeaturePath(images[i].name), file));
+      reextracted[i] = 1;
+      for (auto& matcher : matchers) matcher->RemoveImage(static_cast<int>(i));
+      files[i].features = all_loaded ? std::move(file.features) : SiftFeatures{};
+      MatchStageReport::ReextractedPhoto photo;
+      photo.name = images[i].name;
+      photo.partners_before = partners_before[i];
+      photo.reason = ReextractionReasonText(reasons[i], partners_before[i], needed);
+      photo.features_before = static_cast<int>(before.count);
+      photo.features_after = features_after;
+      photo.contrast_threshold = richer.sift.contrast_threshold;
+      report.reextracted.push_back(photo);
+    }
+    for (size_t p = 0; p < pairs.size(); ++p) rematch[p] = reextracted[pairs[p].first] || reextracted[pairs[p].second];
+  }
+  if (!report.reextracted.empty()) {
+    RECONAR_RETURN_IF_ERROR(match_pairs(rematch, "matching again"));
+    const std::vector<int> partners_after = VerifiedPartners(results, images.size());
+    for (MatchStageReport::ReextractedPhoto& photo : report.reextracted) {
+      for (size_t i = 0; i < images.size(); ++i) {
+        if (images[i].name == photo.name) photo.partners_after = partners_after[i];
+      }
     }
   }
-  if (progress) progress->Finish();
+  report.seconds_reextraction = std::chrono::duration<double>(Clock::now() - reextraction_start).count();
 
-  MatchStageReport report;
   report.num_images = static_cast<int>(images.size());
   report.num_pairs = static_cast<int>(pairs.size());
   report.num_blocks = num_blocks;
@@ -266,7 +395,26 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
   }
   RECONAR_RETURN_IF_ERROR(WriteMatchesFile(project, images, report.pairs));
   report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(project.MatchesDir() + "/report.json", MatchStageReportJson(report)));
   return report;
+}
+
+std::string MatchStageReportJson(const MatchStageReport& report) {
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("images").Int(report.num_images).Key("pairs_matched").Int(report.num_pairs);
+  json.Key("pairs_verified").Int(report.num_verified).Key("pairs_planar").Int(report.num_planar);
+  json.Key("seconds").Double(report.seconds).Key("seconds_reextraction").Double(report.seconds_reextraction);
+  json.Key("reextracted").BeginArray();
+  for (const MatchStageReport::ReextractedPhoto& photo : report.reextracted) {
+    json.BeginObject().Key("image").String(photo.name);
+    json.Key("reason").String(photo.reason);
+    json.Key("partners_before").Int(photo.partners_before).Key("partners_after").Int(photo.partners_after);
+    json.Key("features_before").Int(photo.features_before).Key("features_after").Int(photo.features_after);
+    json.Key("contrast_threshold").Double(photo.contrast_threshold).EndObject();
+  }
+  json.EndArray().EndObject();
+  return json.str() + "\n";
 }
 
 Result<std::vector<MatchesFilePair>> ReadMatchesFile(const std::string& path) {

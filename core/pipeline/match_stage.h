@@ -2,7 +2,8 @@
 // Match stage: kd-forest matching with Lowe's ratio test between the pairs of a project's images
 // that PairSelector chooses (every pair of a small project; beyond, a sequential window plus
 // vocabulary-tree retrieval: core/features/pair_selection.h), then two-view verification (F by
-// LO-RANSAC, H screening). Pairs with at
+// LO-RANSAC, H screening), then the poorly matched photos extracted again and their pairs matched
+// again (PoorlyMatchedPhotoOptions). Pairs with at
 // least TwoViewOptions::min_inliers F-inliers go to <project>/matches/matches.txt:
 //   # reconar matches v1
 //   pair NAME_A NAME_B CONFIG NUM_INLIERS f11 f12 ... f33     (x_b^T F x_a = 0, pixels;
@@ -24,10 +25,25 @@
 
 namespace reconar {
 
+// Photos the default extraction leaves poorly matched (a plaster figure on velvet, a dark object
+// on a plain ground: texture-poor by what matching found, not by a feature count, which differs
+// between scenes and photo sizes) are extracted again at contrast_threshold, written to
+// Project::RicherFeaturePath, and every pair they are in is matched again (PhotosToExtractAgain
+// says which). Photos that match well keep their features, so a textured set costs nothing.
+// min_partners = 0 turns it off.
+struct PoorlyMatchedPhotoOptions {
+  int min_partners = 2;  // a chain of photos needs two partners per photo
+  // Three halvings of Lowe's 0.04: a plaster figure gives about a hundred features at 0.04 and
+  // 250-400 here (dinoSparseRing).
+  double contrast_threshold = 0.005;
+  SiftOptions sift;  // the rest of the extraction: the feature stage's
+};
+
 struct MatchStageOptions {
   MatchOptions match;
   PairSelectionOptions pairs;
   TwoViewOptions two_view;
+  PoorlyMatchedPhotoOptions poorly_matched;
   int num_threads = 0;  // pairs in parallel; <= 0: one per core
   bool show_progress = true;
   size_t memory_budget_bytes = 0;  // for features and forests; 0: no limit
@@ -52,6 +68,16 @@ struct MatchStageReport {
   double seconds_pair_selection = 0;  // of which training the vocabulary
   double seconds = 0;
   std::vector<VerifiedPair> pairs;  // kept pairs only, without per-pair rejects
+  // The photos extracted again (PoorlyMatchedPhotoOptions), and what it changed.
+  struct ReextractedPhoto {
+    std::string name;
+    std::string reason;
+    int partners_before = 0, partners_after = 0;  // verified or planar pairs
+    int features_before = 0, features_after = 0;
+    double contrast_threshold = 0.0;
+  };
+  std::vector<ReextractedPhoto> reextracted;
+  double seconds_reextraction = 0;  // of which extracting and matching again
 };
 
 // Estimated bytes one feature holds while its image is being matched by `workers` workers.
@@ -62,10 +88,34 @@ Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int heigh
                                    int width_b, int height_b, const std::vector<FeatureMatch>& putative,
                                    const TwoViewOptions& options);
 
+// Why a photo is extracted again.
+enum class ReextractionReason {
+  kNone,
+  kPoorlyMatched,        // fewer verified partners than min_partners
+  kAsTexturePoor,        // no more features than a poorly matched photo that has fewer than the
+                         // set's median count: its partners need it richer as much as it does
+  kTheSetMatchesPoorly,  // the set's median photo is poorly matched: every photo is
+};
+// Per photo, from its verified partners (pairs verified as general or planar) and its feature
+// count: a photo with fewer than min_partners partners (the project's other photos when there
+// are fewer) is poorly matched. A poorly matched photo with fewer features than the set's median
+// is texture-poor, and so is every photo with no more features than it (two texture-poor objects
+// in a textured set, a dark stretch of a walk): they are extracted again too. When the median
+// photo is poorly matched, every photo is. A poorly matched photo with many features (an
+// unrelated photo in the folder) is extracted again alone.
+std::vector<ReextractionReason> PhotosToExtractAgain(const std::vector<int>& partners,
+                                                     const std::vector<int>& feature_counts, int min_partners);
+std::string ReextractionReasonText(ReextractionReason reason, int partners, int min_partners);
+
 // The settings under which PROJECT/stages.txt records the stage (stage_record.h).
 std::string MatchStageSettings(const MatchStageOptions& options);
 
+// Writes PROJECT/matches/matches.txt and PROJECT/matches/report.json (the photos extracted again,
+// MatchStageReportJson), after removing the richer features an earlier run left.
 Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageOptions& options);
+
+// The report's photos extracted again, as the JSON object PROJECT/matches/report.json holds.
+std::string MatchStageReportJson(const MatchStageReport& report);
 
 // Writes PROJECT/matches/matches.txt (atomically) from pairs in the stage's order (image_a <
 // image_b, indices into `images`); pairs with too few inliers are left out.

@@ -16,6 +16,12 @@ namespace reconar {
 
 namespace fs = std::filesystem;
 
+std::string Project::MatchedFeaturePath(const std::string& image_name) const {
+  std::error_code error;
+  const std::string richer = RicherFeaturePath(image_name);
+  return fs::exists(richer, error) ? richer : FeaturePath(image_name);
+}
+
 Status Project::WriteImageList(const std::vector<ProjectImage>& images) const {
   RECONAR_RETURN_IF_ERROR(CreateDirectories(FeaturesDir()));
   std::ostringstream out;

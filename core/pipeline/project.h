@@ -1,5 +1,6 @@
 #pragma once
-// A project folder: features/ (one .rfeat per image plus images.txt), matches/ (matches.txt),
+// A project folder: features/ (one .rfeat per image plus images.txt, and a .more.rfeat for each
+// photo the match stage extracted again), matches/ (matches.txt, report.json),
 // sparse/ (the sparse model, see sfm_stage.h), map/ (the localisation map, map_stage.h) and report.json.
 // images.txt lists, one image per line, "name width height focal_px focal_source path"; names are
 // unique within a project and key every other file.
@@ -31,7 +32,15 @@ class Project {
   std::string FeaturesDir() const { return root_ + "/features"; }
   std::string MatchesDir() const { return root_ + "/matches"; }
   std::string ImageListPath() const { return FeaturesDir() + "/images.txt"; }
+  // The feature stage's features of a photo.
   std::string FeaturePath(const std::string& image_name) const { return FeaturesDir() + "/" + image_name + ".rfeat"; }
+  // A poorly matched photo's features extracted again by the match stage at a lower contrast
+  // threshold (match_stage.h), when it did so.
+  std::string RicherFeaturePath(const std::string& image_name) const {
+    return FeaturesDir() + "/" + image_name + ".more.rfeat";
+  }
+  // The features the project's matches index: the richer ones where they exist.
+  std::string MatchedFeaturePath(const std::string& image_name) const;
   std::string MatchesPath() const { return MatchesDir() + "/matches.txt"; }
   std::string SparseDir() const { return root_ + "/sparse"; }
   std::string ReportPath() const { return root_ + "/report.json"; }

@@ -117,11 +117,11 @@ std::string ReadOr(const std::string& path, const std::string& fallback) {
 }
 
 struct StageReports {
-  std::string sparse_text, tags_text, dense_text, mesh_text;
+  std::string matching_text, sparse_text, tags_text, dense_text, mesh_text;
 };
 
 StageReports ReadStageReports(const Project& project) {
-  return {ReadOr(project.SparseDir() + "/report.json", "null"), ReadOr(project.TagsJsonPath(), "null"),
+  return {ReadOr(project.MatchesDir() + "/report.json", "null"), ReadOr(project.SparseDir() + "/report.json", "null"), ReadOr(project.TagsJsonPath(), "null"),
           ReadOr(project.root() + "/dense/report.json", "null"), ReadOr(project.MeshDir() + "/report.json", "null")};
 }
 
@@ -178,6 +178,7 @@ std::string ReportJson(const StageReports& reports, const ReconstructOptions& op
   const auto raw_or_null = [](const std::string& text, const char* name) {
     return ParseJson(text, name).ok() ? text : std::string("null");
   };
+  json.Key("matching").Raw(raw_or_null(reports.matching_text, "matches/report.json"));
   json.Key("sparse").Raw(raw_or_null(reports.sparse_text, "sparse/report.json"));
   json.Key("tags").Raw(raw_or_null(reports.tags_text, "tags.json"));
   json.Key("dense").Raw(raw_or_null(reports.dense_text, "dense/report.json"));
@@ -257,19 +258,13 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       summary->note = feature_note;
       RECONAR_ASSIGN_OR_RETURN(const FeatureStageReport r, RunFeatureStage(image_paths, &project, features));
       for (const std::string& skipped : r.skipped) std::fprintf(stderr, "warning: skipped %s\n", skipped.c_str());
-      int texture_poor = 0;
-      for (const ImageFeatureSummary& image : r.extracted)
-        texture_poor += image.contrast_threshold < sift.contrast_threshold;
-      if (texture_poor > 0) {
-        summary->note += (summary->note.empty() ? "" : "; ") + std::to_string(texture_poor) +
-                         " texture-poor photo(s) extracted again at a lower contrast threshold";
-      }
       return Status::Ok();
     };
     RECONAR_RETURN_IF_ERROR(runner.Run("features", FeatureStageSettings(features),
                                        FeaturesUpToDate(project, image_paths), false, run_features));
 
     MatchStageOptions matching = options.matching;
+    matching.poorly_matched.sift = features.sift;
     matching.num_threads = threads;
     matching.memory_budget_bytes = budget;
     matching.show_progress = options.show_progress;
@@ -278,6 +273,10 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       if (r.num_blocks > 1) {
         summary->note =
             "photos matched in " + std::to_string(r.num_blocks) + " blocks, two at a time, for the memory budget";
+      }
+      if (!r.reextracted.empty()) {
+        summary->note += std::string(summary->note.empty() ? "" : "; ") + std::to_string(r.reextracted.size()) +
+                         " poorly matched photo(s) extracted again at a lower contrast threshold (matches/report.json)";
       }
       return Status::Ok();
     };
@@ -324,14 +323,6 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
         summary->note += std::string(summary->note.empty() ? "" : "; ") + std::to_string(r.mapper.merges.size()) +
                          (r.mapper.merges.size() == 1 ? " model" : " models") + " merged into the largest";
       }
-      const int registered = r.mapper.models.empty() ? 0 : static_cast<int>(r.mapper.models[0].images.size());
-      const int photos = registered + static_cast<int>(r.mapper.unregistered.size());
-      if (2 * registered < photos && mapper.registration_min_verified_inliers >= mapper.registration_min_inliers) {
-        summary->note += std::string(summary->note.empty() ? "" : "; ") + "only " + std::to_string(registered) +
-                         " of " + std::to_string(photos) +
-                         " photos registered: for a scene with little texture, --texture-poor registers photos from "
-                         "fewer points";
-      }
       if (!with_tags) {
         RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagsJsonPath()));
         RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.TagLayoutPath()));
@@ -346,6 +337,7 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
         Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
                   {"min_verified_inliers", static_cast<double>(mapper.registration_min_verified_inliers)},
                   {"min_baseline_points", static_cast<double>(mapper.registration_min_baseline_points)},
+                  {"min_inlier_spread", mapper.registration_min_inlier_spread},
                   {"max_models", static_cast<double>(mapper.max_models)},
                   {"min_model_images", static_cast<double>(mapper.min_model_images)},
                   {"max_starts", static_cast<double>(mapper.init_max_starts)},
@@ -473,10 +465,5 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
   return report;
 }
 
-void UseTexturePoorSettings(ReconstructOptions* options) {
-  options->features.texture_poor_min_features = 1000;
-  options->sfm.mapper.registration_min_verified_inliers = 12;
-  options->sfm.mapper.registration_min_baseline_points = 5;
-}
 
 }  // namespace reconar

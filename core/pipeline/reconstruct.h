@@ -77,16 +77,6 @@ struct ReconstructOptions {
   Status Check() const;
 };
 
-// `--texture-poor`, for objects with little texture (a plaster figure on velvet, white walls):
-// photos under 1000 features are extracted again at a lower contrast threshold
-// (FeatureStageOptions::texture_poor_min_features); an image registers from 12 inliers when its
-// two-view matches agree with the pose (MapperOptions::registration_min_verified_inliers), or from
-// a registered neighbour's two-view geometry and 5 points (registration_min_baseline_points).
-// Not the default: on textured scenes the extra, weaker features cost matching time and, in a
-// localisation map, let a photo match a wrong place; and the weakly held views it adds made the map
-// of templeRing's 24 odd views less accurate (overlay error 2.7 px against 1.8; docs/figures.md).
-void UseTexturePoorSettings(ReconstructOptions* options);
-
 struct StageSummary {
   std::string name;
   bool reused = false;

@@ -156,7 +156,7 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   std::vector<MapperImage> images(list.size());
   for (size_t i = 0; i < list.size(); ++i) {
     index_of[list[i].name] = static_cast<int>(i);
-    const std::string path = project.FeaturePath(list[i].name);
+    const std::string path = project.MatchedFeaturePath(list[i].name);
     RECONAR_ASSIGN_OR_RETURN(const FeatureFile features, ReadFeatureFile(path));
     if (features.image_width != list[i].width || features.image_height != list[i].height) {
       return FileError(StatusCode::kCorruptData, path, "image size differs from " + project.ImageListPath());
@@ -321,6 +321,12 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   for (const MapperReport::Merge& merge : m.merges) {
     json->BeginObject().Key("initial_pair").String(merge.initial_pair).Key("images").Int(merge.num_images);
     json->Key("shared_points").Int(merge.num_shared_points).Key("inliers").Int(merge.num_inliers).EndObject();
+  }
+  json->EndArray();
+  json->Key("provisional").BeginArray();
+  for (const MapperReport::Provisional& p : m.provisional) {
+    json->BeginObject().Key("image").String(p.name).Key("evidence").String(p.evidence);
+    json->Key("inliers").Int(p.inliers).Key("kept").Bool(p.kept).EndObject();
   }
   json->EndArray();
   json->Key("unregistered").BeginArray();

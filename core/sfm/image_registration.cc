@@ -3,8 +3,8 @@
 #include <string>
 
 #include "core/geometry/absolute_pose.h"
+#include "core/sfm/provisional_registration.h"
 #include "core/sfm/tag_image_registration.h"
-#include "core/sfm/two_view_check.h"
 
 namespace reconar {
 
@@ -46,29 +46,27 @@ void AcceptRegistration(MapperModel* model, int image, const Rigid3& cam_from_wo
 namespace {
 
 // Empty when the pose has registration_min_inliers inliers, or fewer but verified as
-// MapperOptions says; otherwise why it is refused.
-std::string VerifyFewInliers(const MapperModel& model, int image, size_t num_correspondences,
+// provisional_registration.h says; otherwise why it is refused.
+std::string VerifyFewInliers(const MapperModel& model, int image, const std::vector<Eigen::Vector2d>& pixels,
                              const AbsolutePoseResult& pose, double focal, const MapperOptions& options) {
   if (pose.num_inliers >= options.registration_min_inliers) return "";
-  const std::string few = "the best pose has " + std::to_string(pose.num_inliers) + " inliers (" +
-                          std::to_string(options.registration_min_inliers) + " register without further checks)";
-  if (2 * static_cast<size_t>(pose.num_inliers) < num_correspondences) return few + " and they are under half";
-  const std::vector<TwoViewMatch> two_view = GatherTwoViewMatches(model, image);
-  const int consistent =
-      CountEpipolarConsistent(model, two_view, pose.cam_from_world, focal, options.registration_max_error_px);
-  if (static_cast<int>(two_view.size()) < options.registration_min_verified_inliers ||
-      consistent < options.registration_min_two_view_fraction * static_cast<double>(two_view.size())) {
-    return few + " and " + std::to_string(consistent) + " of its " + std::to_string(two_view.size()) +
-           " two-view matches to registered images lie on their epipolar lines";
-  }
-  return "";
+  WeakPose weak;
+  weak.cam_from_world = pose.cam_from_world;
+  weak.focal = focal;
+  weak.num_correspondences = static_cast<int>(pixels.size());
+  for (int index : pose.inliers) weak.inlier_pixels.push_back(pixels[static_cast<size_t>(index)]);
+  const std::string refused = CheckWeakPose(model, image, WeakEvidence::kFewInliers, weak, options);
+  if (refused.empty()) return "";
+  return "the best pose has " + std::to_string(pose.num_inliers) + " inliers (" +
+         std::to_string(options.registration_min_inliers) + " register without further checks), and " + refused;
 }
 
 }  // namespace
 
 bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, int image, const MapperOptions& options,
-                   bool* focal_changed) {
+                   bool* focal_changed, int* num_inliers) {
   *focal_changed = false;
+  if (num_inliers != nullptr) *num_inliers = 0;
   Reconstruction& rec = model->rec;
   SfmImage& img = rec.images[static_cast<size_t>(image)];
   std::vector<Eigen::Vector2d> pixels;
@@ -100,7 +98,7 @@ bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, i
   }
   std::string verification;
   if (result.ok() && result->success()) {
-    verification = VerifyFewInliers(*model, image, pixels.size(), *result,
+    verification = VerifyFewInliers(*model, image, pixels, *result,
                                     result->focal > 0.0 ? result->focal : camera.focal, options);
   }
   if (!result.ok() || !result->success() || !verification.empty()) {
@@ -135,6 +133,7 @@ bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, i
     observations.emplace_back(kp, model->point_of_track[static_cast<size_t>(t)]);
   }
   AcceptRegistration(model, image, result->cam_from_world, observations);
+  if (num_inliers != nullptr) *num_inliers = result->num_inliers;
   return true;
 }
 

@@ -22,9 +22,12 @@ void AcceptRegistration(MapperModel* model, int image, const Rigid3& cam_from_wo
 
 // Registers `image`; false, with the reason in model->failure[image], when no pose is found.
 // *focal_changed tells whether the registration set its camera's focal (the camera was not yet
-// confirmed by three images), after which the caller adjusts globally. An image with tags that
-// fails may still register by them (tag_image_registration.h).
+// confirmed by three images), after which the caller adjusts globally. *num_inliers, when given,
+// is the absolute pose's inlier count (0 for a registration by tags): under
+// MapperOptions::registration_min_inliers the registration is provisional
+// (provisional_registration.h). An image with tags that fails may still register by them
+// (tag_image_registration.h).
 bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, int image, const MapperOptions& options,
-                   bool* focal_changed);
+                   bool* focal_changed, int* num_inliers = nullptr);
 
 }  // namespace reconar

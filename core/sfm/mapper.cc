@@ -17,6 +17,7 @@
 #include "core/sfm/neighbour_registration.h"
 #include "core/sfm/next_image.h"
 #include "core/sfm/point_filter.h"
+#include "core/sfm/provisional_registration.h"
 #include "core/sfm/track_triangulation.h"
 
 namespace reconar {
@@ -87,6 +88,8 @@ class Mapper {
     final_adjustment.function_tolerance = opt_.final_ba_function_tolerance;
     final_adjustment.free = choice;
     RECONAR_RETURN_IF_ERROR(GlobalRefinement(final_adjustment));
+    // An image taken out by the final review leaves the model adjusted with it: adjust again.
+    while (taken_out_in_last_refinement_ > 0) RECONAR_RETURN_IF_ERROR(GlobalRefinement(final_adjustment));
     FinishReport();
     report_->seconds_total = SecondsSince(start);
     return Status::Ok();
@@ -105,6 +108,8 @@ class Mapper {
     model_.tried_with.assign(static_cast<size_t>(n), -1);
     model_.neighbour_tried_with.assign(static_cast<size_t>(n), -1);
     plain_tried_with_.assign(static_cast<size_t>(n), -1);
+    taken_out_.assign(static_cast<size_t>(n), 0);
+    taken_out_reason_.assign(static_cast<size_t>(n), "");
     for (int i = 0; i < n; ++i) {
       const MapperImage& in = images_[static_cast<size_t>(i)];
       if (in.width <= 0 || in.height <= 0 || !(in.focal_prior > 0.0)) {
@@ -224,22 +229,67 @@ class Mapper {
           if (candidate.visible <= plain_tried_with_[i]) continue;
           plain_tried_with_[i] = candidate.visible;
         } else {
+          if (taken_out_[i]) continue;  // a provisional pose that failed: the plain rule only
           model_.tried_with[i] = candidate.visible;
         }
         bool focal_changed = false;
-        if (!RegisterImage(&model_, images_, candidate.image, *rule, &focal_changed)) continue;
+        int inliers = 0;
+        if (!RegisterImage(&model_, images_, candidate.image, *rule, &focal_changed, &inliers)) continue;
+        if (inliers > 0 && inliers < opt_.registration_min_inliers)
+          AddProvisional(candidate.image, WeakEvidence::kFewInliers, inliers);
         RECONAR_RETURN_IF_ERROR(GrowAround(candidate.image, focal_changed));
         return true;
       }
     }
     for (int image : NeighbourRegistrationCandidates(model_, pairs_, model_.neighbour_tried_with)) {
+      if (taken_out_[static_cast<size_t>(image)]) continue;
       model_.neighbour_tried_with[static_cast<size_t>(image)] = model_.CountVisiblePoints(image);
       if (!RegisterImageFromNeighbour(&model_, pairs_, image, opt_)) continue;
       ++report_->num_registered_from_neighbour;
+      int observations = 0;
+      for (int point : model_.rec.images[static_cast<size_t>(image)].point3d_ids) observations += point >= 0 ? 1 : 0;
+      AddProvisional(image, WeakEvidence::kNeighbour, observations);
       RECONAR_RETURN_IF_ERROR(GrowAround(image, false));
       return true;
     }
     return false;
+  }
+
+  void AddProvisional(int image, WeakEvidence evidence, int inliers) {
+    provisional_.push_back({image, evidence, inliers, model_.rec.NumRegisteredImages()});
+    report_->provisional.push_back({images_[static_cast<size_t>(image)].name,
+                                    evidence == WeakEvidence::kFewInliers ? "few inliers" : "neighbour", inliers, true});
+  }
+
+  // Checks every provisional image against the adjusted model (provisional_registration.h) and
+  // takes out those that no longer hold, with the reason; they may come back only under the plain
+  // rule. Returns how many were taken out.
+  int ReviewProvisional() {
+    int taken_out = 0;
+    std::vector<ProvisionalImage> still;
+    for (const ProvisionalImage& p : provisional_) {
+      const std::string reason = ReviewProvisionalImage(model_, p, opt_);
+      if (reason.empty()) {
+        still.push_back(p);
+        continue;
+      }
+      const size_t i = static_cast<size_t>(p.image);
+      DeregisterImage(&model_, p.image, opt_);
+      taken_out_[i] = 1;
+      model_.tried_with[i] = model_.CountVisiblePoints(p.image);
+      taken_out_reason_[i] = "registered provisionally (" + std::to_string(p.inliers) + " points, " +
+                             (p.evidence == WeakEvidence::kFewInliers ? "an absolute pose"
+                                                                      : "a neighbour's two-view geometry") +
+                             ") and taken out at " + std::to_string(model_.rec.NumRegisteredImages()) +
+                             " registered images: " + reason;
+      model_.failure[i] = taken_out_reason_[i];
+      for (MapperReport::Provisional& r : report_->provisional) {
+        if (r.name == images_[i].name) r.kept = false;
+      }
+      ++taken_out;
+    }
+    provisional_ = std::move(still);
+    return taken_out;
   }
 
   // Triangulates the new image's tracks and adjusts around it (globally when its registration set
@@ -273,6 +323,7 @@ class Mapper {
     RECONAR_RETURN_IF_ERROR(Adjust(model_.RegisteredImages(), second));
     FilterPoints(&model_, model_.AllPoints(), opt_);
     if (chosen != nullptr) growth_distortion_ = second.free.distortion;
+    taken_out_in_last_refinement_ = ReviewProvisional();
     return Status::Ok();
   }
 
@@ -313,7 +364,10 @@ class Mapper {
     report_->mean_track_length = report_->num_points > 0 ? length_sum / report_->num_points : 0.0;
     report_->unregistered.clear();
     for (size_t i = 0; i < rec.images.size(); ++i) {
-      if (!rec.images[i].registered) report_->unregistered.push_back({rec.images[i].name, model_.failure[i]});
+      if (rec.images[i].registered) continue;
+      std::string reason = model_.failure[i];
+      if (taken_out_[i] && reason != taken_out_reason_[i]) reason = taken_out_reason_[i] + "; then " + reason;
+      report_->unregistered.push_back({rec.images[i].name, reason});
     }
   }
 
@@ -326,6 +380,10 @@ class Mapper {
   bool growth_distortion_ = false;  // the growth adjustments refine k1, k2 (GrowthRefinement's choice)
   MapperModel model_;
   std::vector<int> plain_tried_with_;  // per image: visible points at its last failure under the plain rule
+  std::vector<ProvisionalImage> provisional_;  // registered provisionally, in order, and not confirmed out
+  std::vector<char> taken_out_;                // per image: a provisional registration of it was taken out
+  std::vector<std::string> taken_out_reason_;  // ... and why
+  int taken_out_in_last_refinement_ = 0;
 };
 
 }  // namespace
@@ -347,6 +405,8 @@ Status MapperOptions::Check() const {
     return InvalidArgument("MapperOptions: registration_min_verified_inliers must be in [6, registration_min_inliers]");
   if (!(registration_min_two_view_fraction >= 0.0 && registration_min_two_view_fraction <= 1.0))
     return InvalidArgument("MapperOptions: registration_min_two_view_fraction must be in [0, 1]");
+  if (!(registration_min_inlier_spread >= 0.0 && registration_min_inlier_spread <= 1.0))
+    return InvalidArgument("MapperOptions: registration_min_inlier_spread must be in [0, 1]");
   if (max_models < 1) return InvalidArgument("MapperOptions: max_models < 1");
   if (min_model_images < 2) return InvalidArgument("MapperOptions: min_model_images < 2");
   if (init_max_starts < 1) return InvalidArgument("MapperOptions: init_max_starts < 1");
@@ -433,6 +493,22 @@ Result<bool> RunWithRestarts(const std::vector<MapperImage>& images, const std::
   return any;
 }
 
+// The points of `merged` seen by a registered image of `a` and one of `b`.
+int PointsSeenByBoth(const Reconstruction& merged, const Reconstruction& a, const Reconstruction& b) {
+  int count = 0;
+  for (const SfmPoint& point : merged.points) {
+    if (point.deleted) continue;
+    bool in_a = false, in_b = false;
+    for (const TrackElement& e : point.track) {
+      const size_t i = static_cast<size_t>(e.image_id);
+      in_a |= i < a.images.size() && a.images[i].registered;
+      in_b |= i < b.images.size() && b.images[i].registered;
+    }
+    count += in_a && in_b ? 1 : 0;
+  }
+  return count;
+}
+
 // Merges into the largest model every other model that aligns with it (model_merge.h), largest
 // first, each union grown again over every pair and adjusted as one; a merged model leaves
 // `models`. A model that does not align keeps why in its report (MapperReport::not_merged).
@@ -469,6 +545,14 @@ Status MergeIntoLargest(const std::vector<MapperImage>& images, const std::vecto
         other_report.not_merged = "the merged model failed: " + status.message();
         continue;
       }
+      Reconstruction merged_model = mapper.TakeResult();
+      const int joint_points = PointsSeenByBoth(merged_model, (*models)[main], (*models)[other]);
+      if (joint_points < options.merge_min_shared_points) {
+        other_report.not_merged = "aligned by " + std::to_string(alignment->num_inliers) +
+                                  " shared points, but the joined model has " + std::to_string(joint_points) +
+                                  " points seen from both (need " + std::to_string(options.merge_min_shared_points) + ")";
+        continue;
+      }
       const MapperReport& main_report = (*reports)[main];
       merged_report.initial_pair = main_report.initial_pair;
       merged_report.initial_image_a = main_report.initial_image_a;
@@ -486,7 +570,7 @@ Status MergeIntoLargest(const std::vector<MapperImage>& images, const std::vecto
       if (merged_report.first_ba_failure.empty()) merged_report.first_ba_failure = main_report.first_ba_failure;
       merged_report.num_failed_ba += main_report.num_failed_ba;
       merged_report.num_registered_from_neighbour += main_report.num_registered_from_neighbour;
-      (*models)[main] = mapper.TakeResult();
+      (*models)[main] = std::move(merged_model);
       (*reports)[main] = std::move(merged_report);
       models->erase(models->begin() + static_cast<std::ptrdiff_t>(other));
       reports->erase(reports->begin() + static_cast<std::ptrdiff_t>(other));

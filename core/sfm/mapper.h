@@ -61,19 +61,22 @@ struct MapperOptions {
   // Registration: P3P LO-RANSAC with this pixel threshold; a pose with this many inliers registers.
   double registration_max_error_px = 4.0;
   int registration_min_inliers = 30;
-  // A pose with fewer inliers, down to registration_min_verified_inliers, registers when they are
-  // at least half of the image's 2D-3D correspondences and the pose puts at least
+  // A pose with fewer inliers, down to registration_min_verified_inliers, registers provisionally
+  // (provisional_registration.h) when they are at least half of the image's 2D-3D
+  // correspondences, span registration_min_inlier_spread of the image, and the pose puts at least
   // registration_min_two_view_fraction of the image's matches to registered images on tracks
-  // without a point on their epipolar lines (of at least registration_min_verified_inliers such
-  // matches), after every candidate has been tried under the plain rule. Texture-poor objects and
-  // sparse rings rarely give 30 points in three views; 12 is `--texture-poor`'s
-  // (UseTexturePoorSettings), the default keeps the plain rule.
-  int registration_min_verified_inliers = 30;
+  // without a point on their epipolar lines (when there are registration_min_verified_inliers
+  // such matches); it is tried after every candidate has had its try under the plain rule, and
+  // checked again after every global adjustment. Texture-poor objects, sparse rings and dense
+  // video rarely give 30 points in three views. registration_min_verified_inliers =
+  // registration_min_inliers turns it off.
+  int registration_min_verified_inliers = 12;
   double registration_min_two_view_fraction = 0.5;
+  double registration_min_inlier_spread = 0.1;
   // Registration from a registered neighbour's two-view geometry (neighbour_registration.h) when
-  // the absolute pose fails: this many model points must agree on the baseline's length; 0 (the
-  // default) turns it off, `--texture-poor` (UseTexturePoorSettings) sets 5.
-  int registration_min_baseline_points = 0;
+  // the absolute pose fails, provisional as above: this many model points must agree on the
+  // baseline's length; 0 turns it off.
+  int registration_min_baseline_points = 5;
   // Registration by tags (images with MapperImage::tags only, tag_image_registration.h): a pose
   // that puts every corner of every tag the model holds within registration_max_error_px
   // registers with fewer inliers when that is at least two such tags, or one and this many other
@@ -140,10 +143,10 @@ struct MapperOptions {
   // With merge_models, another model is merged into the largest (model_merge.h) when a similarity
   // puts at least merge_min_shared_points of the 3D points they share through verified matches,
   // and half of them, within max_reprojection_error_px in both models' views; the union is then
-  // grown and adjusted as one (`--merge-models`). Off by default: on templeRing's 24 odd views it
-  // joins 21 + 3 views into 24, but the union's cameras are 1.74 mm from the truth against the 21's
-  // 1.32 mm, and localisation against it misses issue 15's 2 px overlay bar (docs/figures.md).
-  bool merge_models = false;
+  // grown and adjusted as one, and kept only when it verifies: at least merge_min_shared_points of
+  // its points are seen by images of both models (a wrong alignment leaves their tracks
+  // untriangulable). Models of unrelated scenes share no point and stay apart.
+  bool merge_models = true;
   int merge_min_shared_points = 12;
 
   Status Check() const;
@@ -166,6 +169,15 @@ struct MapperReport {
   int init_relaxations = 0;  // how often the initial-pair bounds were halved before one was found
   int init_pairs_scored = 0;              // pairs given a quick two-view score before the initial pair was found
   int num_registered_from_neighbour = 0;  // images registered from a neighbour's two-view geometry
+  // Provisional registrations (provisional_registration.h): every image registered so, still in
+  // the model or taken out again (then with the reason among `unregistered`).
+  struct Provisional {
+    std::string name;
+    std::string evidence;  // "few inliers" or "neighbour"
+    int inliers = 0;
+    bool kept = false;
+  };
+  std::vector<Provisional> provisional;
   std::vector<Unregistered> unregistered;
   // Every model built, the returned (largest) one first: its images and point count. An image in
   // another model is listed as unregistered with the reason "in model K".

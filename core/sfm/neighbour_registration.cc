@@ -8,6 +8,7 @@
 #include "core/geometry/absolute_pose.h"
 #include "core/sfm/image_registration.h"
 #include "core/sfm/pair_pose.h"
+#include "core/sfm/provisional_registration.h"
 #include "core/sfm/two_view_check.h"
 
 namespace reconar {
@@ -167,6 +168,14 @@ bool RegisterImageFromNeighbour(MapperModel* model, const std::vector<MapperPair
       reasons += "; with " + neighbour_name + ": " + std::to_string(agreeing) + " of " + std::to_string(pixels.size()) +
                  " points agree on the baseline length (need " +
                  std::to_string(options.registration_min_baseline_points) + " and half)";
+      continue;
+    }
+    std::vector<Eigen::Vector2d> agreeing_pixels;
+    for (int i : fit.inliers) agreeing_pixels.push_back(pixels[static_cast<size_t>(i)]);
+    const double spread = InlierSpread(agreeing_pixels, camera.width, camera.height);
+    if (spread < options.registration_min_inlier_spread) {
+      reasons += "; with " + neighbour_name + ": the " + std::to_string(agreeing) + " agreeing points span " +
+                 std::to_string(static_cast<int>(100.0 * spread + 0.5)) + " % of the image";
       continue;
     }
     const Rigid3 cam_from_world{R, offset + fit.length * image_from_neighbour.translation};

@@ -72,8 +72,6 @@ class SiftExtractor {
   static size_t RequiredArenaBytes(int width, int height, const SiftOptions& options);
 
   const SiftOptions& options() const { return options_; }
-  // For the next Extract calls (e.g. a lower one for a texture-poor photo); must be >= 0.
-  void set_contrast_threshold(double threshold) { options_.contrast_threshold = threshold; }
 
  private:
   SiftOptions options_;

@@ -64,7 +64,7 @@ TEST(ImageRegistrationTest, FewPointsRegisterWhenTheTwoViewMatchesAgree) {
   const testing::Scene scene = testing::RegistrationRing();
   MapperModel model = testing::TrueModelWithFewPointsSeenBy(scene, 3, 15);
   bool focal_changed = true;
-  ASSERT_TRUE(RegisterImage(&model, scene.images, 3, testing::TexturePoorMapperOptions(), &focal_changed))
+  ASSERT_TRUE(RegisterImage(&model, scene.images, 3, MapperOptions(), &focal_changed))
       << model.failure[3];
   const SfmImage& img = model.rec.images[3];
   EXPECT_LT(RotationAngle(img.cam_from_world.rotation, scene.poses[3].rotation) * 180.0 / M_PI, 0.3);
@@ -89,7 +89,7 @@ TEST(ImageRegistrationTest, FewPointsAgainstTheTwoViewMatchesAreRefused) {
       img.keypoints[kp] = scene.camera.Project(wrong * model.rec.points[static_cast<size_t>(point)].position);
   }
   bool focal_changed = true;
-  EXPECT_FALSE(RegisterImage(&model, scene.images, 3, testing::TexturePoorMapperOptions(), &focal_changed));
+  EXPECT_FALSE(RegisterImage(&model, scene.images, 3, MapperOptions(), &focal_changed));
   EXPECT_FALSE(model.rec.images[3].registered);
   EXPECT_NE(model.failure[3].find("on their epipolar lines"), std::string::npos) << model.failure[3];
 }

@@ -18,7 +18,7 @@ TEST(NeighbourRegistrationTest, FivePointsFixTheBaselineOfTheNeighboursTwoViewPo
   const std::vector<int> candidates = NeighbourRegistrationCandidates(model, scene.pairs, model.tried_with);
   ASSERT_EQ(candidates.size(), 1u);
   EXPECT_EQ(candidates[0], 3);
-  ASSERT_TRUE(RegisterImageFromNeighbour(&model, scene.pairs, 3, testing::TexturePoorMapperOptions()))
+  ASSERT_TRUE(RegisterImageFromNeighbour(&model, scene.pairs, 3, MapperOptions()))
       << model.failure[3];
   const SfmImage& img = model.rec.images[3];
   EXPECT_LT(RotationAngle(img.cam_from_world.rotation, scene.poses[3].rotation) * 180.0 / M_PI, 0.3);
@@ -33,7 +33,7 @@ TEST(NeighbourRegistrationTest, FivePointsFixTheBaselineOfTheNeighboursTwoViewPo
 TEST(NeighbourRegistrationTest, TooFewPointsOrWrongOnesAreRefusedWithAReason) {
   const testing::Scene scene = testing::RegistrationRing();
   MapperModel too_few = testing::TrueModelWithFewPointsSeenBy(scene, 3, 4);
-  EXPECT_FALSE(RegisterImageFromNeighbour(&too_few, scene.pairs, 3, testing::TexturePoorMapperOptions()));
+  EXPECT_FALSE(RegisterImageFromNeighbour(&too_few, scene.pairs, 3, MapperOptions()));
   EXPECT_FALSE(too_few.rec.images[3].registered);
 
   // Five points, three of them moved 1 % of the ring radius: no baseline length fits five.
@@ -48,16 +48,15 @@ TEST(NeighbourRegistrationTest, TooFewPointsOrWrongOnesAreRefusedWithAReason) {
     moved.rec.points[static_cast<size_t>(point)].position += Eigen::Vector3d(0.0, 0.1 * (shifted + 1), 0.0);
     ++shifted;
   }
-  EXPECT_FALSE(RegisterImageFromNeighbour(&moved, scene.pairs, 3, testing::TexturePoorMapperOptions()));
+  EXPECT_FALSE(RegisterImageFromNeighbour(&moved, scene.pairs, 3, MapperOptions()));
   EXPECT_NE(moved.failure[3].find("agree on the baseline length"), std::string::npos) << moved.failure[3];
 }
 
-// Off by default, and with 0.
+// Off with 0 (`--strict-registration`).
 TEST(NeighbourRegistrationTest, OffWhenNoPointsAreAskedFor) {
   const testing::Scene scene = testing::RegistrationRing();
   MapperModel model = testing::TrueModelWithFewPointsSeenBy(scene, 3, 5);
-  EXPECT_FALSE(RegisterImageFromNeighbour(&model, scene.pairs, 3, MapperOptions()));
-  MapperOptions options = testing::TexturePoorMapperOptions();
+  MapperOptions options;
   options.registration_min_baseline_points = 0;
   EXPECT_FALSE(RegisterImageFromNeighbour(&model, scene.pairs, 3, options));
 }

@@ -262,13 +262,6 @@ int TruePointOf(const Scene& scene, const SfmPoint& point) {
   return scene.point_of_keypoint[static_cast<size_t>(e.image_id)][static_cast<size_t>(e.keypoint_id)];
 }
 
-MapperOptions TexturePoorMapperOptions() {
-  MapperOptions options;
-  options.registration_min_verified_inliers = 12;
-  options.registration_min_baseline_points = 5;
-  return options;
-}
-
 Scene RegistrationRing() {
   SceneOptions o;
   o.num_cameras = 8;

@@ -80,10 +80,6 @@ MapperModel TrueModel(const Scene& scene);
 // Removes `image` from the model as if it had not been registered: no pose, no observation.
 void Unregister(MapperModel* model, int image);
 
-// The mapper options of `--texture-poor` (UseTexturePoorSettings): registration from 12 verified
-// inliers and from a neighbour's two-view geometry.
-MapperOptions TexturePoorMapperOptions();
-
 // The registration tests' scene: 8 cameras on the ring, 1000 points, 0.4 px noise.
 Scene RegistrationRing();
 
