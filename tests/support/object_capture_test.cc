@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace reconar::testing {
@@ -145,6 +146,42 @@ TEST(ObjectCaptureTest, TheRenderedObjectIsWhereTheTrueCamerasSeeIt) {
     EXPECT_GT(object, 200) << scene->views()[i].name;
     EXPECT_GT(empty, 2000) << scene->views()[i].name;
   }
+}
+
+// A square standing on the floor, facing the camera: its pixels spread by the texture's standard
+// deviation times the square's shade (no sensor noise, one sample per pixel).
+TEST(ObjectCaptureTest, TheTexturesStandardDeviationIsTheOptions) {
+  Mesh square;
+  square.positions = {{-0.1f, 0.0f, 0.0f}, {0.1f, 0.0f, 0.0f}, {0.1f, 0.2f, 0.0f}, {-0.1f, 0.2f, 0.0f}};
+  square.triangles = {{0, 1, 2}, {0, 2, 3}};
+  ObjectCaptureOptions options;
+  options.views = 1;
+  options.min_elevation_deg = options.max_elevation_deg = 0.0;
+  options.position_jitter_deg = options.distance_jitter = options.aim_jitter_deg = options.roll_jitter_deg = 0.0;
+  options.width = 160;
+  options.height = 120;
+  options.focal_px = 130.0;
+  options.supersampling = 1;
+  options.noise_sigma = 0.0;
+  const Result<ObjectCaptureScene> scene = ObjectCaptureScene::Create(square, options);
+  ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+  const Image<uint8_t> picture = scene->Render(0);
+  // The square's normal is +z, towards the camera; the light comes from (0.3, 1, 0.5).
+  const double shade = options.ambient + (1.0 - options.ambient) * Eigen::Vector3d(0.3, 1.0, 0.5).normalized().z();
+  double sum = 0.0, sum_squares = 0.0;
+  int count = 0;
+  for (int y = 35; y < 85; ++y) {  // well inside the square's 74 x 74 pixels round (79.5, 59.5)
+    for (int x = 55; x < 105; ++x) {
+      const double grey = picture.row(y)[3 * x];  // red: the clay's tint is 1 there
+      sum += grey;
+      sum_squares += grey * grey;
+      ++count;
+    }
+  }
+  const double mean = sum / count, deviation = std::sqrt(sum_squares / count - mean * mean);
+  std::printf("square: mean %.2f, standard deviation %.2f grey levels (shade %.3f)\n", mean, deviation, shade);
+  EXPECT_NEAR(mean, options.surface_level * shade, 1.0);
+  EXPECT_NEAR(deviation, options.texture_contrast * shade, 0.25 * options.texture_contrast * shade);
 }
 
 TEST(ObjectCaptureTest, RefusesUnusableOptionsAndCamerasUnderTheFloor) {
