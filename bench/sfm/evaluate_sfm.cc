@@ -95,34 +95,25 @@ int Run(int argc, char** argv) {
   double unit_scale = 1.0;
   std::string unit = "gt_units";
   std::string gt_source;
+  Result<GroundTruthByName> read = GroundTruthByName();
   if (!strecha_dir.empty()) {
     if (std::filesystem::is_directory(strecha_dir + "/gt_cameras")) strecha_dir += "/gt_cameras";
-    Result<GroundTruthByName> read = testing::ReadStrechaGroundTruth(strecha_dir);
-    if (!read.ok()) {
-      std::fprintf(stderr, "evaluate_sfm: %s\n", read.status().ToString().c_str());
-      return 2;
-    }
-    ground_truth = std::move(*read);
+    read = testing::ReadStrechaGroundTruth(strecha_dir);
     unit_scale = 1000.0;
     unit = "mm";
     gt_source = strecha_dir;
   } else if (!par_file.empty()) {
-    Result<GroundTruthByName> read = testing::ReadMiddleburyPar(par_file);
-    if (!read.ok()) {
-      std::fprintf(stderr, "evaluate_sfm: %s\n", read.status().ToString().c_str());
-      return 2;
-    }
-    ground_truth = std::move(*read);
+    read = testing::ReadMiddleburyPar(par_file);
     gt_source = par_file;
   } else if (!colmap_truth_dir.empty()) {
-    Result<GroundTruthByName> read = testing::ReadGroundTruthModel(colmap_truth_dir);
-    if (!read.ok()) {
-      std::fprintf(stderr, "evaluate_sfm: %s\n", read.status().ToString().c_str());
-      return 2;
-    }
-    ground_truth = std::move(*read);
+    read = testing::ReadGroundTruthModel(colmap_truth_dir);
     gt_source = colmap_truth_dir;
   }
+  if (!read.ok()) {
+    std::fprintf(stderr, "evaluate_sfm: %s\n", read.status().ToString().c_str());
+    return 2;
+  }
+  ground_truth = std::move(*read);
 
   // Points: file ERROR column and our own reprojection of every observation.
   double error_sum = 0.0;
