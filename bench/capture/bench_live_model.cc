@@ -20,7 +20,6 @@
 
 #include "core/base/median.h"
 #include "core/pipeline/reconstruct.h"
-#include "core/sfm/model_io.h"
 #include "render/ar/capture_session.h"
 #include "tests/support/corridor_walk.h"
 #include "tests/support/sfm_evaluation.h"
@@ -165,27 +164,10 @@ int main(int argc, char** argv) {
     if (!every_pair) {
       // The keyframes' true cameras as a COLMAP text model without points (OUT/capture/truth), for
       // scoring other tools or models on them.
-      reconar::Reconstruction truth_model;
-      for (const auto& [keyframe, frame] : frame_of_keyframe) {
-        const reconar::testing::GroundTruthCamera& camera = truth->at(frame);
-        if (truth_model.cameras.empty()) {
-          reconar::SfmCamera model_camera;
-          model_camera.width = camera.width;
-          model_camera.height = camera.height;
-          model_camera.focal = camera.K(0, 0);
-          model_camera.cx = camera.K(0, 2);
-          model_camera.cy = camera.K(1, 2);
-          truth_model.cameras.push_back(model_camera);
-        }
-        reconar::SfmImage image;
-        image.name = keyframe;
-        image.camera_id = 0;
-        image.registered = true;
-        image.cam_from_world.rotation = camera.cam_from_world_rotation;
-        image.cam_from_world.translation = camera.cam_from_world_translation;
-        truth_model.images.push_back(std::move(image));
-      }
-      const reconar::Status written = reconar::WriteColmapTextModel(truth_model, capture.project_dir + "/truth");
+      reconar::testing::GroundTruthByName keyframe_truth;
+      for (const auto& [keyframe, frame] : frame_of_keyframe) keyframe_truth[keyframe] = truth->at(frame);
+      const reconar::Status written =
+          reconar::testing::WriteGroundTruthModel(keyframe_truth, capture.project_dir + "/truth");
       if (!written.ok()) return Fail(written);
       keyframe_paths = report->keyframe_files;
       frame_of_default_keyframe = frame_of_keyframe;

@@ -5,7 +5,8 @@
 #
 # Usage: bench/sfm/compare_colmap.sh [--colmap-only | --reconar-only] DATASET_DIR [WORK_DIR]
 #   DATASET_DIR  a dataset of ../shared/data: Strecha (images/ + gt_cameras/) or Middlebury
-#                (*.png + *_par.txt); any other folder of images runs without ground truth.
+#                (*.png + *_par.txt), or a rendered set (bench/sfm/render_capture: images/ +
+#                truth/); any other folder of images runs without ground truth.
 #   WORK_DIR     where both projects go (default: a new /tmp/compare_colmap.XXXXXX).
 # Environment:
 #   BUILD_DIR     reconar build with -DRECONAR_BUILD_BENCH=ON (default: <repo>/build)
@@ -51,6 +52,8 @@ if [[ -d $dataset/images ]]; then images=$dataset/images; else images=$dataset; 
 gt_args=()
 if [[ -d $dataset/gt_cameras ]]; then
   gt_args=(--strecha "$dataset/gt_cameras")
+elif [[ -f $dataset/truth/images.txt ]]; then
+  gt_args=(--colmap-truth "$dataset/truth")
 else
   par=$(find "$dataset" -maxdepth 1 -name '*_par.txt' | sort | head -n 1)
   if [[ -n $par ]]; then gt_args=(--middlebury-par "$par"); fi

@@ -1,11 +1,13 @@
 // evaluate_sfm: accuracy of a sparse model (COLMAP text: ours or COLMAP's own) against ground
 // truth, as JSON on stdout.
 //
-//   evaluate_sfm MODEL_DIR [--strecha GT_DIR | --middlebury-par FILE]
+//   evaluate_sfm MODEL_DIR [--strecha GT_DIR | --middlebury-par FILE | --colmap-truth DIR]
 //
 // Images are matched to the ground truth by file name (the last path component of NAME in
 // images.txt). Centre errors are in millimetres for Strecha (metres in its files) and in
 // ground-truth units otherwise, after a 7-DoF similarity alignment of the camera centres.
+// --colmap-truth reads the true cameras from a COLMAP text model (render_capture's OUT_DIR/truth).
+// registered_fraction: the images matched to the truth over the truth's images.
 // Exit codes: 0 ok, 1 fewer than 3 images matched (no alignment), 2 bad usage or input.
 #include <cmath>
 #include <cstdio>
@@ -27,10 +29,11 @@ using testing::GroundTruthCamera;
 int Usage(const char* message) {
   if (message != nullptr) std::fprintf(stderr, "evaluate_sfm: %s\n", message);
   std::fprintf(stderr,
-               "usage: evaluate_sfm MODEL_DIR [--strecha GT_DIR | --middlebury-par FILE]\n"
+               "usage: evaluate_sfm MODEL_DIR [--strecha GT_DIR | --middlebury-par FILE | --colmap-truth DIR]\n"
                "  MODEL_DIR  cameras.txt, images.txt, points3D.txt (COLMAP text)\n"
                "  --strecha GT_DIR          Strecha gt_cameras/ (or the dataset folder holding it)\n"
-               "  --middlebury-par FILE     Middlebury *_par.txt\n");
+               "  --middlebury-par FILE     Middlebury *_par.txt\n"
+               "  --colmap-truth DIR        the true cameras as a COLMAP text model (render_capture OUT_DIR/truth)\n");
   return 2;
 }
 
@@ -60,7 +63,7 @@ struct ImageResult {
 };
 
 int Run(int argc, char** argv) {
-  std::string model_dir, strecha_dir, par_file;
+  std::string model_dir, strecha_dir, par_file, colmap_truth_dir;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
@@ -70,6 +73,8 @@ int Run(int argc, char** argv) {
       strecha_dir = argv[++i];
     } else if (arg == "--middlebury-par" && i + 1 < argc) {
       par_file = argv[++i];
+    } else if (arg == "--colmap-truth" && i + 1 < argc) {
+      colmap_truth_dir = argv[++i];
     } else if (!arg.empty() && arg[0] != '-' && model_dir.empty()) {
       model_dir = arg;
     } else {
@@ -77,7 +82,9 @@ int Run(int argc, char** argv) {
     }
   }
   if (model_dir.empty()) return Usage("missing MODEL_DIR");
-  if (!strecha_dir.empty() && !par_file.empty()) return Usage("give one ground truth");
+  const int truths = static_cast<int>(!strecha_dir.empty()) + static_cast<int>(!par_file.empty()) +
+                     static_cast<int>(!colmap_truth_dir.empty());
+  if (truths > 1) return Usage("give one ground truth");
 
   Result<Reconstruction> model = ReadColmapTextModel(model_dir);
   if (!model.ok()) {
@@ -88,26 +95,25 @@ int Run(int argc, char** argv) {
   double unit_scale = 1.0;
   std::string unit = "gt_units";
   std::string gt_source;
+  Result<GroundTruthByName> read = GroundTruthByName();
   if (!strecha_dir.empty()) {
     if (std::filesystem::is_directory(strecha_dir + "/gt_cameras")) strecha_dir += "/gt_cameras";
-    Result<GroundTruthByName> read = testing::ReadStrechaGroundTruth(strecha_dir);
-    if (!read.ok()) {
-      std::fprintf(stderr, "evaluate_sfm: %s\n", read.status().ToString().c_str());
-      return 2;
-    }
-    ground_truth = std::move(*read);
+    read = testing::ReadStrechaGroundTruth(strecha_dir);
     unit_scale = 1000.0;
     unit = "mm";
     gt_source = strecha_dir;
   } else if (!par_file.empty()) {
-    Result<GroundTruthByName> read = testing::ReadMiddleburyPar(par_file);
-    if (!read.ok()) {
-      std::fprintf(stderr, "evaluate_sfm: %s\n", read.status().ToString().c_str());
-      return 2;
-    }
-    ground_truth = std::move(*read);
+    read = testing::ReadMiddleburyPar(par_file);
     gt_source = par_file;
+  } else if (!colmap_truth_dir.empty()) {
+    read = testing::ReadGroundTruthModel(colmap_truth_dir);
+    gt_source = colmap_truth_dir;
   }
+  if (!read.ok()) {
+    std::fprintf(stderr, "evaluate_sfm: %s\n", read.status().ToString().c_str());
+    return 2;
+  }
+  ground_truth = std::move(*read);
 
   // Points: file ERROR column and our own reprojection of every observation.
   double error_sum = 0.0;
@@ -170,6 +176,8 @@ int Run(int argc, char** argv) {
   std::printf("  \"registered\": %zu,\n", model->images.size());
   std::printf("  \"total\": %s,\n", ground_truth.empty() ? "null" : std::to_string(ground_truth.size()).c_str());
   std::printf("  \"matched\": %zu,\n", matched.size());
+  const double registered_fraction = static_cast<double>(matched.size()) / ground_truth.size();
+  std::printf("  \"registered_fraction\": %s,\n", ground_truth.empty() ? "null" : Number(registered_fraction).c_str());
   std::printf("  \"num_points\": %zu,\n", model->points.size());
   std::printf("  \"mean_track_length\": %s,\n", Number(num_observations / num_points).c_str());
   std::printf("  \"centre_error_unit\": %s,\n", Quoted(unit).c_str());

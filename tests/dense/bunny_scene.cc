@@ -136,16 +136,6 @@ Status BunnySceneOptions::Check() const {
   return Status::Ok();
 }
 
-Eigen::Vector3d BoundingBoxCenter(const Mesh& mesh) {
-  Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY);
-  Eigen::Vector3f hi = Eigen::Vector3f::Constant(-INFINITY);
-  for (const Eigen::Vector3f& p : mesh.positions) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  return (0.5 * (lo + hi)).cast<double>();
-}
-
 Reconstruction MakeBunnyCameras(const Mesh& bunny, const BunnySceneOptions& options) {
   Reconstruction model;
   SfmCamera camera;

@@ -24,6 +24,7 @@
 #include "core/base/status.h"
 #include "core/mesh/mesh.h"
 #include "core/sfm/reconstruction.h"
+#include "tests/support/object_capture.h"  // BoundingBoxCenter: the point every camera looks at
 
 namespace reconar {
 namespace testing {
@@ -44,9 +45,6 @@ struct BunnySceneOptions {
   // InvalidArgument naming the first offending field.
   Status Check() const;
 };
-
-// The bunny's axis-aligned bounding-box centre (the point every camera looks at).
-Eigen::Vector3d BoundingBoxCenter(const Mesh& mesh);
 
 // One camera (index 0) and cameras_per_ring * 2 registered images "bunny_NNN.png" with their
 // exact poses, no keypoints and no points: the low ring first, then the high ring.

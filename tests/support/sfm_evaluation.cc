@@ -105,6 +105,55 @@ Result<CameraPoseErrors> CameraCenterErrors(const std::vector<CameraPose>& estim
   return errors;
 }
 
+Status WriteGroundTruthModel(const GroundTruthByName& truth, const std::string& dir) {
+  Reconstruction model;
+  for (const auto& [name, camera] : truth) {
+    const Eigen::Matrix3d& k = camera.K;
+    if (k(0, 1) != 0.0) return InvalidArgument(dir + ": " + name + " has a skewed K");
+    SfmCamera model_camera;
+    model_camera.width = camera.width;
+    model_camera.height = camera.height;
+    model_camera.focal = k(0, 0);
+    model_camera.aspect = k(1, 1) / k(0, 0);
+    model_camera.cx = k(0, 2);
+    model_camera.cy = k(1, 2);
+    const auto same = [&model_camera](const SfmCamera& other) {
+      return other.width == model_camera.width && other.height == model_camera.height &&
+             other.focal == model_camera.focal && other.aspect == model_camera.aspect && other.cx == model_camera.cx &&
+             other.cy == model_camera.cy;
+    };
+    const auto found = std::find_if(model.cameras.begin(), model.cameras.end(), same);
+    SfmImage image;
+    image.name = name;
+    image.camera_id = static_cast<int>(found - model.cameras.begin());
+    if (found == model.cameras.end()) model.cameras.push_back(model_camera);
+    image.registered = true;
+    image.cam_from_world.rotation = camera.cam_from_world_rotation;
+    image.cam_from_world.translation = camera.cam_from_world_translation;
+    model.images.push_back(std::move(image));
+  }
+  return WriteColmapTextModel(model, dir);
+}
+
+Result<GroundTruthByName> ReadGroundTruthModel(const std::string& dir) {
+  RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(dir));
+  GroundTruthByName truth;
+  for (const SfmImage& image : model.images) {
+    const SfmCamera& camera = model.cameras[static_cast<size_t>(image.camera_id)];
+    if (camera.k1 != 0.0 || camera.k2 != 0.0) {
+      return Unsupported(dir + "/cameras.txt: camera " + std::to_string(image.camera_id + 1) +
+                         " has distortion; ground truth is a pinhole");
+    }
+    GroundTruthCamera& truth_camera = truth[std::filesystem::path(image.name).filename().string()];
+    truth_camera.K << camera.focal, 0.0, camera.cx, 0.0, camera.fy(), camera.cy, 0.0, 0.0, 1.0;
+    truth_camera.cam_from_world_rotation = image.cam_from_world.rotation;
+    truth_camera.cam_from_world_translation = image.cam_from_world.translation;
+    truth_camera.width = camera.width;
+    truth_camera.height = camera.height;
+  }
+  return truth;
+}
+
 Result<GroundTruthByName> ReadStrechaGroundTruth(const std::string& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;

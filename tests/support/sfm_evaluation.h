@@ -65,6 +65,16 @@ struct ModelScore {
 Result<ModelScore> ScoreModelAgainstTruth(const std::string& model_dir, const GroundTruthByName& truth,
                                           const std::function<std::string(const std::string&)>& truth_name);
 
+// The true cameras as a COLMAP text model without points in `dir` (created; WriteColmapTextModel),
+// one camera per distinct K and size: so that other tools, and evaluate_sfm --colmap-truth, score
+// models of rendered captures. InvalidArgument for a skewed K.
+Status WriteGroundTruthModel(const GroundTruthByName& truth, const std::string& dir);
+
+// The registered images of the COLMAP text model in `dir` as ground truth, keyed by file name (the
+// last path component of their names). The reader's error for an unreadable model; Unsupported
+// naming the camera for one with distortion (GroundTruthCamera is a pinhole).
+Result<GroundTruthByName> ReadGroundTruthModel(const std::string& dir);
+
 // Every NAME.camera in `dir` (Strecha gt_cameras/), keyed by NAME.
 Result<GroundTruthByName> ReadStrechaGroundTruth(const std::string& dir);
 

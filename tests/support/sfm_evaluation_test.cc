@@ -125,5 +125,39 @@ TEST(SfmEvaluationTest, ReadsStrechaAndMiddleburyFiles) {
   EXPECT_FALSE(ReadStrechaGroundTruth((dir / "missing").string()).ok());
 }
 
+// Truth written as a COLMAP text model (two sizes of camera) reads back the same to the printed
+// digits, keyed by file name; a camera with distortion is refused.
+TEST(SfmEvaluationTest, GroundTruthRoundTripsThroughAColmapModel) {
+  std::mt19937 rng(7);
+  GroundTruthByName truth;
+  for (int i = 0; i < 4; ++i) {
+    GroundTruthCamera camera;
+    camera.width = i < 3 ? 640 : 320;
+    camera.height = i < 3 ? 480 : 240;
+    camera.K << 520.0 * camera.width / 640, 0.0, 0.5 * camera.width, 0.0, 521.0 * camera.width / 640,
+        0.5 * (camera.height - 1), 0.0, 0.0, 1.0;
+    camera.cam_from_world_rotation = RandomRotation(&rng);
+    camera.cam_from_world_translation = Eigen::Vector3d(0.1 * i, -0.2, 1.0 + i);
+    truth["view_" + std::to_string(i) + ".png"] = camera;
+  }
+  const fs::path dir = TempDir("truth_model");
+  ASSERT_TRUE(WriteGroundTruthModel(truth, dir.string()).ok());
+  const Result<GroundTruthByName> read = ReadGroundTruthModel(dir.string());
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  ASSERT_EQ(read->size(), truth.size());
+  for (const auto& [name, camera] : truth) {
+    const GroundTruthCamera& back = read->at(name);
+    EXPECT_EQ(back.width, camera.width);
+    EXPECT_EQ(back.height, camera.height);
+    EXPECT_LT((back.K - camera.K).norm(), 1e-9) << name;
+    EXPECT_LT(RotationAngleDeg(back.cam_from_world_rotation, camera.cam_from_world_rotation), 1e-9) << name;
+    EXPECT_LT((back.cam_from_world_translation - camera.cam_from_world_translation).norm(), 1e-12) << name;
+  }
+
+  std::ofstream(dir / "cameras.txt") << "1 RADIAL 640 480 520 320.5 240 0.1 0\n2 RADIAL 320 240 260 160.5 120 0 0\n";
+  const Result<GroundTruthByName> distorted = ReadGroundTruthModel(dir.string());
+  EXPECT_EQ(distorted.status().code(), StatusCode::kUnsupported);
+}
+
 }  // namespace
 }  // namespace reconar::testing
