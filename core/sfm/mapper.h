@@ -142,7 +142,8 @@ struct MapperOptions {
   int init_max_starts = 4;
   // With merge_models, another model is merged into the largest (model_merge.h) when a similarity
   // puts at least merge_min_shared_points of the 3D points they share through verified matches,
-  // and half of them, within max_reprojection_error_px in both models' views; the union is then
+  // and half of them, within max_reprojection_error_px in both models' views (else, when a verified
+  // pair between them gives the similarity: AlignModelsByTwoViewGeometry); the union is then
   // grown and adjusted as one, and kept only when it verifies: at least merge_min_shared_points of
   // its points are seen by images of both models (a wrong alignment leaves their tracks
   // untriangulable). Models of unrelated scenes share no point and stay apart.
@@ -194,6 +195,7 @@ struct MapperReport {
     int num_images = 0;
     int num_shared_points = 0;
     int num_inliers = 0;
+    std::string aligned_by;  // "shared points", or the pair whose two-view geometry aligned them
   };
   std::vector<Merge> merges;
   std::string not_merged;  // of a model not merged into the main one: why
