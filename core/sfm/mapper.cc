@@ -392,7 +392,7 @@ Status MapperOptions::Check() const {
   if (init_min_points < 8) return InvalidArgument("MapperOptions: init_min_points < 8");
   if (!(init_min_median_angle_deg >= 0.0)) return InvalidArgument("MapperOptions: init_min_median_angle_deg < 0");
   if (init_max_pairs_tried < 1) return InvalidArgument("MapperOptions: init_max_pairs_tried < 1");
-  if (init_max_pairs_scored < 1) return InvalidArgument("MapperOptions: init_max_pairs_scored < 1");
+  if (init_max_pairs_scored < 0) return InvalidArgument("MapperOptions: init_max_pairs_scored < 0");
   if (init_min_points_floor < 8 || init_min_points_floor > init_min_points) {
     return InvalidArgument("MapperOptions: init_min_points_floor must be in [8, init_min_points]");
   }

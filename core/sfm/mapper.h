@@ -48,12 +48,14 @@ struct MapperPair {
 
 struct MapperOptions {
   // Initial pair: at least this many tracks triangulated, with median triangulation angle at
-  // least init_min_median_angle_deg. Up to init_max_pairs_scored pairs get a quick two-view
-  // score (initial_pair.h) and up to init_max_pairs_tried of them a full try, per round.
+  // least init_min_median_angle_deg. The pairs get a quick two-view score (initial_pair.h) as far
+  // down the list as needed (up to init_max_pairs_scored; 0: all of them: in a dense capture of
+  // hundreds of photos the best-matched thousands may be neighbours without baseline), and up to
+  // init_max_pairs_tried of those that pass get a full try, per round.
   int init_min_points = 100;
   double init_min_median_angle_deg = 4.0;
   int init_max_pairs_tried = 20;
-  int init_max_pairs_scored = 500;
+  int init_max_pairs_scored = 0;
   // When no pair meets those bounds, both are halved and the pairs tried again, down to these
   // floors (COLMAP's mapper relaxes the same way): texture-poor rooms have few matches per pair.
   int init_min_points_floor = 25;
