@@ -46,8 +46,8 @@ Result<std::map<std::string, std::string>> WeaklyRegisteredPhotos(const Project&
   // The partners: of a registered photo, the photos that share a point with it in the model (its
   // pose rests on them); of one left out, those it has verified pairs with.
   std::map<std::string, std::string> partners;
-  const auto add_partner = [&](const std::string& partner, const std::string& photo) {
-    if (weak.count(partner) == 0) partners.emplace(partner, "sees points with " + photo + ", " + weak.at(photo));
+  const auto add_partner = [&](const std::string& partner, const char* how, const std::string& photo) {
+    if (weak.count(partner) == 0) partners.emplace(partner, how + photo + ", " + weak.at(photo));
   };
   RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(project.SparseDir()));
   std::set<std::string> registered;
@@ -61,12 +61,12 @@ Result<std::map<std::string, std::string>> WeaklyRegisteredPhotos(const Project&
     }
     for (const int other : others) {
       if (model.images[static_cast<size_t>(other)].name != image.name)
-        add_partner(model.images[static_cast<size_t>(other)].name, image.name);
+        add_partner(model.images[static_cast<size_t>(other)].name, "sees points with ", image.name);
     }
   }
   for (const MatchesFilePair& pair : pairs) {
     for (const auto& [photo, partner] : {std::make_pair(pair.name_a, pair.name_b), std::make_pair(pair.name_b, pair.name_a)}) {
-      if (weak.count(photo) != 0 && registered.count(photo) == 0) add_partner(partner, photo);
+      if (weak.count(photo) != 0 && registered.count(photo) == 0) add_partner(partner, "paired with ", photo);
     }
   }
   weak.insert(partners.begin(), partners.end());
