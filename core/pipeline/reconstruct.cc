@@ -87,7 +87,8 @@ class StageRunner {
       Add(summary);
       return Status::Ok();
     }
-    if (!IsSideStage(name)) redone_ = true;  // no later stage reads a side stage's outputs
+    // No later stage reads a side stage's outputs; of the tags' only mapping does (the caller's).
+    if (!IsSideStage(name) && name != "tags") redone_ = true;
     if (options_.show_progress) std::fprintf(stderr, "reconstruct: [%d] %s\n", index_, name.c_str());
     ReleaseFreeHeapMemory();
     ResetPeakResidentBytes();
@@ -279,6 +280,23 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     RECONAR_RETURN_IF_ERROR(runner.Run("features", FeatureStageSettings(features),
                                        FeaturesUpToDate(project, image_paths), false, run_features));
 
+    // Tags before matching: they read the photos alone, so matching again (below) keeps them.
+    const bool with_tags = options.tag_size_m > 0.0;
+    bool tags_redone = false;
+    if (with_tags) {
+      const auto run_tags = [&](StageSummary* summary) -> Status {
+        RECONAR_ASSIGN_OR_RETURN(const TagDetectionsFile detections, options.detect_tags(image_paths));
+        int with = 0;
+        for (const ImageTagObservations& image : detections.images) with += image.tags.empty() ? 0 : 1;
+        summary->note = std::to_string(with) + " of " + std::to_string(detections.images.size()) + " photos show a tag";
+        RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root() + "/tags"));
+        return WriteTagDetections(project.TagDetectionsPath(), detections);
+      };
+      RECONAR_RETURN_IF_ERROR(
+          runner.Run("tags", options.tag_family, Exists(project.TagDetectionsPath()), runner.redone(), run_tags));
+      tags_redone = !report.stages.back().reused;
+    }
+
     MatchStageOptions matching = options.matching;
     matching.poorly_matched.sift = features.sift;
     // Resumed after a second matching (below): continue from it.
@@ -300,20 +318,6 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     };
     RECONAR_RETURN_IF_ERROR(runner.Run("matching", MatchStageSettings(matching), Exists(project.MatchesPath()),
                                        runner.redone(), run_matching));
-
-    const bool with_tags = options.tag_size_m > 0.0;
-    if (with_tags) {
-      const auto run_tags = [&](StageSummary* summary) -> Status {
-        RECONAR_ASSIGN_OR_RETURN(const TagDetectionsFile detections, options.detect_tags(image_paths));
-        int with = 0;
-        for (const ImageTagObservations& image : detections.images) with += image.tags.empty() ? 0 : 1;
-        summary->note = std::to_string(with) + " of " + std::to_string(detections.images.size()) + " photos show a tag";
-        RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root() + "/tags"));
-        return WriteTagDetections(project.TagDetectionsPath(), detections);
-      };
-      RECONAR_RETURN_IF_ERROR(
-          runner.Run("tags", options.tag_family, Exists(project.TagDetectionsPath()), runner.redone(), run_tags));
-    }
 
     SfmStageOptions sfm = options.sfm;
     sfm.mapper.num_threads = threads;
@@ -370,7 +374,7 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     if (with_tags) mapping_settings += " " + Settings({{"tag_mapping", 2.0}});
     const auto map_matches = [&]() {
       return runner.Run("mapping", mapping_settings + ExtractAgainDigest(matching.extract_again),
-                        Exists(project.SparseDir() + "/report.json"), runner.redone(), run_mapping);
+                        Exists(project.SparseDir() + "/report.json"), runner.redone() || tags_redone, run_mapping);
     };
     RECONAR_RETURN_IF_ERROR(map_matches());
     // The photos the mapper registered weakly, and their partners, extracted again and matched

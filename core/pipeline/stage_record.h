@@ -15,7 +15,9 @@
 
 namespace reconar {
 
-inline constexpr const char* kStageOrder[] = {"features", "matching", "tags", "mapping", "dense", "mesh"};
+// Tags read the photos alone; they come before matching so that matching again (reconstruct.h,
+// the photos mapped weakly) keeps them.
+inline constexpr const char* kStageOrder[] = {"features", "tags", "matching", "mapping", "dense", "mesh"};
 
 // Stages off the chain: each reads one chain stage's outputs and no later stage reads its own.
 struct SideStage {

@@ -36,12 +36,15 @@ TEST(StageRecord, AStageIsFinishedOnlyWithTheSameSettingsAndSurvivesARestart) {
 TEST(StageRecord, RecordingAStageDropsTheStagesAfterIt) {
   const Project project(testing::MakeTestDirectory("reconar_stage_record_order"));
   StageRecord record(project);
-  for (const char* stage : {"features", "matching", "tags", "mapping", "dense", "mesh"}) {
+  for (const char* stage : {"features", "tags", "matching", "mapping", "dense", "mesh"}) {
     ASSERT_TRUE(record.Record(stage, "x=1").ok());
   }
+  ASSERT_TRUE(record.Record("matching", "x=2").ok());  // matched again: the tags stand, the model goes
+  EXPECT_TRUE(record.Finished("tags", "x=1"));
+  EXPECT_FALSE(record.Finished("mapping", "x=1"));
   ASSERT_TRUE(record.Record("mapping", "x=2").ok());  // redone: dense and mesh read the old model
   EXPECT_TRUE(record.Finished("features", "x=1"));
-  EXPECT_TRUE(record.Finished("matching", "x=1"));
+  EXPECT_TRUE(record.Finished("matching", "x=2"));
   EXPECT_TRUE(record.Finished("tags", "x=1"));
   EXPECT_TRUE(record.Finished("mapping", "x=2"));
   EXPECT_FALSE(record.Finished("dense", "x=1"));
@@ -50,7 +53,7 @@ TEST(StageRecord, RecordingAStageDropsTheStagesAfterIt) {
   ASSERT_TRUE(record.Record("features", "x=3").ok());
   const StageRecord reread(project);
   EXPECT_TRUE(reread.Finished("features", "x=3"));
-  for (const char* stage : {"matching", "tags", "mapping", "dense", "mesh"}) {
+  for (const char* stage : {"tags", "matching", "mapping", "dense", "mesh"}) {
     EXPECT_FALSE(reread.Finished(stage, "x=1")) << stage;
     EXPECT_FALSE(reread.Finished(stage, "x=2")) << stage;
   }
