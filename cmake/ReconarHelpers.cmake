@@ -88,9 +88,10 @@ endfunction()
 # for tests that share a scene built once per process (SetUpTestSuite, a static built on first use):
 # one case per TEST would build it again in every case.
 # NATIVE_ONLY: the unit tests matching these GoogleTest patterns (e.g. Suite.Name*) are labelled
-# "native" instead: self-contained, run by scripts/test.sh but not under qemu. Only for tests that
-# check nothing architecture-specific that another unit test does not check under qemu (the SIMD
-# kernels' own tests, a lighter run of the same code path), and that take a minute or more there.
+# "native" instead: self-contained, run by scripts/test.sh but not by the qemu run (-L unit). Only
+# for tests that check nothing architecture-specific that another unit test does not check under
+# qemu (the SIMD kernels' own tests, a lighter run of the same code path), and that take a minute
+# or more there.
 function(reconar_add_test name)
   # RESOURCE_LOCK: tests holding the same lock never run at the same time (x_screen: they show
   # windows on, or read back, the one X server's screen under xvfb-run).
@@ -141,7 +142,7 @@ function(reconar_add_test name)
     endif()
     add_test(NAME ${name} COMMAND ${name} ${rest_filter})
     set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST} ${lock})
-    if(native_filter AND RECONAR_BUILD_E2E_TESTS)
+    if(native_filter)
       add_test(NAME ${name}_native COMMAND ${name} "--gtest_filter=${native_filter}")
       set_tests_properties(${name}_native PROPERTIES LABELS "${native_labels}" TIMEOUT ${ARG_TIMEOUT}
                            COST ${ARG_COST} ${lock})
@@ -155,7 +156,7 @@ function(reconar_add_test name)
   gtest_discover_tests(${name} ${rest_filter}
       PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST} ${lock}
       DISCOVERY_TIMEOUT 120)
-  if(native_filter AND RECONAR_BUILD_E2E_TESTS)
+  if(native_filter)
     gtest_discover_tests(${name} TEST_FILTER "${native_filter}"
         PROPERTIES LABELS "${native_labels}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST} ${lock}
         DISCOVERY_TIMEOUT 120)
