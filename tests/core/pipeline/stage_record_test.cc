@@ -59,6 +59,22 @@ TEST(StageRecord, RecordingAStageDropsTheStagesAfterIt) {
   }
 }
 
+// Tags and matching both read the photos' features, not each other: detecting the tags again
+// (or for the first time, after a capture recorded its features and matches) keeps the matches.
+TEST(StageRecord, TagsAndMatchingDoNotDropEachOther) {
+  const Project project(testing::MakeTestDirectory("reconar_stage_record_tags"));
+  StageRecord record(project);
+  for (const char* stage : {"features", "matching", "mapping", "map"}) ASSERT_TRUE(record.Record(stage, "x=1").ok());
+  ASSERT_TRUE(record.Record("tags", "x=1").ok());
+  EXPECT_TRUE(record.Finished("matching", "x=1"));
+  EXPECT_FALSE(record.Finished("mapping", "x=1")) << "mapping reads the tags";
+  EXPECT_FALSE(record.Finished("map", "x=1")) << "the map reads the model mapping made";
+  ASSERT_TRUE(record.Record("mapping", "x=1").ok());
+  ASSERT_TRUE(record.Record("matching", "x=2").ok());
+  EXPECT_TRUE(StageRecord(project).Finished("tags", "x=1"));
+  EXPECT_FALSE(StageRecord(project).Finished("mapping", "x=1"));
+}
+
 // The map is a side stage: it reads the model and nothing reads it.
 TEST(StageRecord, TheMapIsDroppedWithTheModelButNotWithTheDenseStages) {
   const Project project(testing::MakeTestDirectory("reconar_stage_record_side"));
