@@ -44,7 +44,11 @@ TriangleRaster RasterizeTriangles(const Mesh& mesh, const PinholeView& view, dou
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
         const double wa = edge(b, c, x, y) / area, wb = edge(c, a, x, y) / area, wc = edge(a, b, x, y) / area;
-        if (wa < 0.0 || wb < 0.0 || wc < 0.0) continue;
+        // A pixel on an edge two triangles share belongs to both (the z-buffer picks one): the
+        // weights there are 0 up to rounding, which differs between the two triangles' sums and
+        // with fused multiply-adds (aarch64), and a strict test left a crack of background.
+        constexpr double kOnEdge = -1e-9;
+        if (wa < kOnEdge || wb < kOnEdge || wc < kOnEdge) continue;
         const double inverse_z = wa * a.z() + wb * b.z() + wc * c.z();
         double& nearest = inverse_depth.row(y)[x];
         if (inverse_z <= nearest) continue;
