@@ -253,7 +253,6 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
                       " photo(s) at a time for the memory budget";
     }
     features.show_progress = options.show_progress;
-    const SiftOptions& sift = features.sift;
     const auto run_features = [&](StageSummary* summary) -> Status {
       summary->note = feature_note;
       RECONAR_ASSIGN_OR_RETURN(const FeatureStageReport r, RunFeatureStage(image_paths, &project, features));
