@@ -5,8 +5,9 @@
 // 2004, sec. 3.2), Marquardt scaling of the damping by diag(J^T J), analytic Jacobians
 // (bal_camera_model.h, radial_camera_model.h), and the Schur
 // complement that eliminates the points (Triggs et al., "Bundle Adjustment - A Modern
-// Synthesis", 2000, sec. 6.1; Brown 1958). The reduced camera system is solved with a dense
-// Cholesky factorisation or, optionally, a block-sparse LDL^T.
+// Synthesis", 2000, sec. 6.1; Brown 1958). The reduced camera system, in the unknowns of the
+// shared intrinsics when cameras share them, is solved with a dense Cholesky factorisation or a
+// sparse one (symmetric_block_system.h).
 #include <vector>
 
 #include "core/base/status.h"
@@ -28,12 +29,13 @@ struct BundleAdjustmentOptions : LmOptions {
   // diag(J^T J) is clamped to [min_diagonal, max_diagonal] before scaling the damping.
   double max_diagonal = 1e32;
   RobustLoss loss;
-  // Solver of the reduced camera system S dc = b (S is 9 * cameras square).
+  // Solver of the reduced camera system S dc = b: a block per free camera (its camera
+  // parameters, or only its pose when it shares its intrinsics) and one per intrinsics group.
   enum class LinearSolver {
-    kDenseCholesky,   // Eigen LLT on dense S: best for up to a few hundred cameras
-    kSparseCholesky,  // block-sparse S (camera pairs sharing a point), AMD camera ordering,
-                      // CHOLMOD supernodal Cholesky (Eigen SimplicialLDLT when built without
-                      // CHOLMOD): for larger problems with sparse camera graphs
+    kDenseCholesky,   // Eigen LLT on dense S: for small problems and dense camera graphs
+    kSparseCholesky,  // S's coupled blocks (camera pairs sharing a point, cameras and the groups
+                      // they see), AMD camera ordering with the groups last, CHOLMOD supernodal
+                      // Cholesky (Eigen SimplicialLDLT when built without CHOLMOD)
   };
   LinearSolver linear_solver = LinearSolver::kDenseCholesky;
   int num_threads = 1;  // <= 0: one per core
@@ -59,8 +61,8 @@ struct BundleAdjustmentConstancy {
   // the principal point of a RadialProblem camera).
   std::vector<int> constant_camera_parameters;
   // Shared intrinsics: empty, or one entry per camera; free cameras with the same non-negative
-  // group share the intrinsic parameters (index 6 onwards of the block: f, k1, k2 [, cx, cy]),
-  // which must start out equal. Dense solver only.
+  // group share the intrinsic parameters (index 6 onwards of the block: f, k1, k2 [, cx, cy, a]),
+  // which must start out equal.
   std::vector<int> intrinsics_group;
 };
 
