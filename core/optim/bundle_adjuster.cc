@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -78,6 +79,16 @@ class Solver {
   using MatI3 = Eigen::Matrix<double, kI, kP>;
   using MatII = Eigen::Matrix<double, kI, kI>;
   using VecI = Eigen::Matrix<double, kI, 1>;
+  // A camera pair of the reduced system (BuildReducedSystem) and a camera's coupling with a group.
+  struct CameraPair {
+    int camera = 0;           // i2
+    int first = 0, last = 0;  // its observation pairs: pair_observations_[first, last)
+    SymmetricBlockSystem::Block block;
+  };
+  struct Border {
+    int group = 0;
+    SymmetricBlockSystem::Block block;
+  };
 
  public:
   Solver(const BundleAdjustmentOptions& options, const BundleAdjustmentConstancy& constancy,
@@ -130,6 +141,9 @@ class Solver {
     for (const Vec3& g : gp_) m = std::max(m, g.cwiseAbs().maxCoeff());
     return m;
   }
+
+  BundleAdjustmentOptions::LinearSolver linear_solver() const { return linear_solver_; }
+  int reduced_unknowns() const { return system_.size(); }
 
   bool SolveStep(double radius) {
     lambda_ = 1.0 / radius;
@@ -330,49 +344,69 @@ class Solver {
   }
 
   // The rows of free camera i's block (its first R parameters: the pose, and its intrinsics
-  // when it shares none): its diagonal block, the blocks coupling it with the cameras i2 < i
+  // when it shares none): its diagonal block, the blocks coupling it with the cameras i2 <= i
   // that share a point with it, and those coupling it with the intrinsics groups. Every block
   // written here is written by no other camera's task.
   template <int R>
   void AddCameraRows(int i, double lambda) {
     const std::vector<BalObservation>& obs = problem_->observations;
-    const int block = camera_block_[static_cast<size_t>(i)];
     const int g = group_[static_cast<size_t>(i)];
     Mat99 sii = u_[static_cast<size_t>(i)];
     sii.diagonal() += lambda * dc_diag_[static_cast<size_t>(i)];
     for (int m : constant_parameters_) sii(m, m) = 1.0;  // row and column are zero
-    system_.Add(system_.Find(block, block), sii.template topLeftCorner<R, R>());
-    if (g >= 0) {
-      system_.Add(system_.Find(block, GroupBlock(g)), sii.template block<R, kI>(0, kPose));
+    system_.Add(diagonal_blocks_[static_cast<size_t>(i)], sii.template topLeftCorner<R, R>());
+    const auto borders_begin = borders_.begin() + border_offsets_[static_cast<size_t>(i)];
+    const auto borders_end = borders_.begin() + border_offsets_[static_cast<size_t>(i) + 1];
+    const auto border_of = [borders_begin, borders_end](int group) -> const SymmetricBlockSystem::Block& {
+      return std::find_if(borders_begin, borders_end, [group](const Border& b) { return b.group == group; })->block;
+    };
+    if (g >= 0) system_.Add(border_of(g), sii.template block<R, kI>(0, kPose));
+    // S(i, i2) -= sum_j Y_ij W_i2j^T over the two cameras' own parameters, a pair at a time.
+    for (int p = pair_offsets_[static_cast<size_t>(i)]; p < pair_offsets_[static_cast<size_t>(i) + 1]; ++p) {
+      const CameraPair& pair = pairs_[static_cast<size_t>(p)];
+      if (own_size_[static_cast<size_t>(pair.camera)] == kC) {
+        SubtractPairBlock<R, kC>(pair);
+      } else {
+        SubtractPairBlock<R, kPose>(pair);
+      }
     }
     Vec9 rhs = -gc_[static_cast<size_t>(i)];
     for (int q = by_cam_.offsets[i]; q < by_cam_.offsets[i + 1]; ++q) {
       const auto k = static_cast<size_t>(by_cam_.items[static_cast<size_t>(q)]);
       const int j = obs[k].point;
       if (const_pt_[static_cast<size_t>(j)]) continue;
-      const Mat93& y = y_[k];
-      rhs.noalias() += y * gp_[static_cast<size_t>(j)];
-      for (int q2 = by_pt_.offsets[j]; q2 < by_pt_.offsets[j + 1]; ++q2) {
-        const auto k2 = static_cast<size_t>(by_pt_.items[static_cast<size_t>(q2)]);
-        const int i2 = obs[k2].camera;
-        if (i2 > i || const_cam_[static_cast<size_t>(i2)]) continue;
-        // S(i, i2) -= Y_ij W_i2j^T over the two cameras' own parameters.
-        const SymmetricBlockSystem::Block pair = system_.Find(block, camera_block_[static_cast<size_t>(i2)]);
-        if (own_size_[static_cast<size_t>(i2)] == kC) {
-          system_.SubtractProduct(pair, y.template topRows<R>(), w_[k2]);
-        } else {
-          system_.SubtractProduct(pair, y.template topRows<R>(), w_[k2].template topRows<kPose>());
-        }
-      }
-      // The same over i2's shared intrinsics, summed over the group: -Y_ij Z_jg^T.
+      rhs.noalias() += y_[k] * gp_[static_cast<size_t>(j)];
+      // The same over the shared intrinsics of the cameras seeing j, summed per group: -Y_ij Z_jg^T.
       for (int e = point_groups_.offsets[j]; e < point_groups_.offsets[j + 1]; ++e) {
-        const int g2 = point_groups_.items[static_cast<size_t>(e)];
-        system_.SubtractProduct(system_.Find(block, GroupBlock(g2)), y.template topRows<R>(),
-                                z_[static_cast<size_t>(e)]);
+        system_.SubtractProduct(border_of(point_groups_.items[static_cast<size_t>(e)]),
+                                y_[k].template topRows<R>(), z_[static_cast<size_t>(e)]);
       }
     }
-    system_.Rhs(block) = rhs.template head<R>();
+    system_.Rhs(camera_block_[static_cast<size_t>(i)]) = rhs.template head<R>();
     if (g >= 0) group_rhs_[static_cast<size_t>(i)] = rhs.template tail<kI>();
+  }
+
+  // Sums Y_ij W_i2j^T over the points the pair shares, in the orientation the block is stored in,
+  // and subtracts it from the block once.
+  template <int R, int C>
+  void SubtractPairBlock(const CameraPair& pair) {
+    const auto first = pair_observations_.begin() + pair.first;
+    const auto last = pair_observations_.begin() + pair.last;
+    if (pair.block.transposed) {
+      Eigen::Matrix<double, C, R> sum = Eigen::Matrix<double, C, R>::Zero();
+      for (auto it = first; it != last; ++it) {
+        sum.noalias() += w_[static_cast<size_t>(it->second)].template topRows<C>().lazyProduct(
+            y_[static_cast<size_t>(it->first)].template topRows<R>().transpose());
+      }
+      system_.SubtractStored(pair.block, sum);
+    } else {
+      Eigen::Matrix<double, R, C> sum = Eigen::Matrix<double, R, C>::Zero();
+      for (auto it = first; it != last; ++it) {
+        sum.noalias() += y_[static_cast<size_t>(it->first)].template topRows<R>().lazyProduct(
+            w_[static_cast<size_t>(it->second)].template topRows<C>().transpose());
+      }
+      system_.SubtractStored(pair.block, sum);
+    }
   }
 
   // The blocks among the intrinsics groups and their right-hand sides: the sums of the
@@ -425,7 +459,8 @@ class Solver {
   // indices kPose.. of the camera block). Constant cameras have none (their step is zero); a
   // constant parameter keeps its unknown with a unit diagonal. The dense storage keeps the free
   // cameras in their order; the sparse one orders them by AMD on the camera graph, the groups
-  // last. The pattern and the symbolic factorisation are built once, before the iterations.
+  // last. The pattern, where each block is stored, the observation pairs behind each camera pair
+  // and the symbolic factorisation are all set up here, before the iterations.
   void BuildReducedSystem(const std::vector<int>& groups) {
     const std::vector<BalObservation>& obs = problem_->observations;
     camera_block_.assign(static_cast<size_t>(nc_), -1);
@@ -451,66 +486,103 @@ class Solver {
     block_sizes.insert(block_sizes.end(), static_cast<size_t>(num_groups_), kI);
     group_rhs_.assign(static_cast<size_t>(nc_), VecI::Zero());
 
-    // The groups of the free cameras that see each free point, and the blocks coupled through it.
+    // Per free point, the groups of the free cameras that see it (and the groups coupled
+    // through it).
     std::vector<std::pair<int, int>> coupled;
     point_groups_.offsets.assign(static_cast<size_t>(np_) + 1, 0);
     point_groups_.items.clear();
-    std::vector<int> seen;
-    size_t unique_bound = size_t{1} << 22;
     for (int j = 0; j < np_; ++j) {
-      seen.clear();
-      if (!const_pt_[static_cast<size_t>(j)]) {
-        for (int q = by_pt_.offsets[j]; q < by_pt_.offsets[j + 1]; ++q) {
-          const int i = obs[static_cast<size_t>(by_pt_.items[static_cast<size_t>(q)])].camera;
-          if (!const_cam_[static_cast<size_t>(i)]) seen.push_back(i);
-        }
-      }
-      std::sort(seen.begin(), seen.end());
-      seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
       const size_t first = point_groups_.items.size();
-      for (size_t a = 0; a < seen.size(); ++a) {
-        for (size_t b = 0; b < a; ++b) {
-          coupled.emplace_back(camera_block_[static_cast<size_t>(seen[a])], camera_block_[static_cast<size_t>(seen[b])]);
-        }
-        const int g = group_[static_cast<size_t>(seen[a])];
+      for (int q = by_pt_.offsets[j]; q < by_pt_.offsets[j + 1] && !const_pt_[static_cast<size_t>(j)]; ++q) {
+        const int g = group_[static_cast<size_t>(obs[static_cast<size_t>(by_pt_.items[static_cast<size_t>(q)])].camera)];
         if (g >= 0) point_groups_.items.push_back(g);
       }
-      std::sort(point_groups_.items.begin() + static_cast<std::ptrdiff_t>(first), point_groups_.items.end());
-      point_groups_.items.erase(
-          std::unique(point_groups_.items.begin() + static_cast<std::ptrdiff_t>(first), point_groups_.items.end()),
-          point_groups_.items.end());
+      const auto begin = point_groups_.items.begin() + static_cast<std::ptrdiff_t>(first);
+      std::sort(begin, point_groups_.items.end());
+      point_groups_.items.erase(std::unique(begin, point_groups_.items.end()), point_groups_.items.end());
       point_groups_.offsets[static_cast<size_t>(j) + 1] = static_cast<int>(point_groups_.items.size());
       for (size_t e = first; e < point_groups_.items.size(); ++e) {
-        for (int i : seen) coupled.emplace_back(camera_block_[static_cast<size_t>(i)], GroupBlock(point_groups_.items[e]));
         for (size_t e2 = first; e2 < e; ++e2) {
           coupled.emplace_back(GroupBlock(point_groups_.items[e2]), GroupBlock(point_groups_.items[e]));
         }
       }
-      // A camera pair is listed once per point the two share: drop the repeats now and then.
-      if (coupled.size() > unique_bound) {
-        SortUnique(&coupled);
-        unique_bound = std::max(unique_bound, 2 * coupled.size());
-      }
     }
-    for (int i = 0; i < nc_; ++i) {
-      if (group_[static_cast<size_t>(i)] >= 0) {
-        coupled.emplace_back(camera_block_[static_cast<size_t>(i)], GroupBlock(group_[static_cast<size_t>(i)]));
-      }
-    }
-    SortUnique(&coupled);
+    std::sort(coupled.begin(), coupled.end());
+    coupled.erase(std::unique(coupled.begin(), coupled.end()), coupled.end());
     z_.resize(point_groups_.items.size());
     zv_.resize(point_groups_.items.size());
-    const bool sparse = opt_.linear_solver == BundleAdjustmentOptions::LinearSolver::kSparseCholesky;
+
+    // Per free camera i, the free cameras i2 <= i it shares free points with, each with the
+    // observation pairs (k of i, k2 of i2) of those points, and the groups it is coupled with.
+    pair_offsets_.assign(static_cast<size_t>(nc_) + 1, 0);
+    border_offsets_.assign(static_cast<size_t>(nc_) + 1, 0);
+    std::vector<std::array<int, 3>> shared;  // (i2, k, k2)
+    std::vector<int> coupled_groups;
+    for (int i = 0; i < nc_; ++i) {
+      shared.clear();
+      coupled_groups.clear();
+      if (group_[static_cast<size_t>(i)] >= 0) coupled_groups.push_back(group_[static_cast<size_t>(i)]);
+      for (int q = by_cam_.offsets[i]; q < by_cam_.offsets[i + 1] && !const_cam_[static_cast<size_t>(i)]; ++q) {
+        const int k = by_cam_.items[static_cast<size_t>(q)];
+        const int j = obs[static_cast<size_t>(k)].point;
+        if (const_pt_[static_cast<size_t>(j)]) continue;
+        for (int q2 = by_pt_.offsets[j]; q2 < by_pt_.offsets[j + 1]; ++q2) {
+          const int k2 = by_pt_.items[static_cast<size_t>(q2)];
+          const int i2 = obs[static_cast<size_t>(k2)].camera;
+          if (i2 <= i && !const_cam_[static_cast<size_t>(i2)]) shared.push_back({i2, k, k2});
+        }
+        for (int e = point_groups_.offsets[j]; e < point_groups_.offsets[j + 1]; ++e) {
+          coupled_groups.push_back(point_groups_.items[static_cast<size_t>(e)]);
+        }
+      }
+      std::sort(shared.begin(), shared.end());
+      for (size_t a = 0; a < shared.size();) {
+        size_t b = a;
+        while (b < shared.size() && shared[b][0] == shared[a][0]) {
+          pair_observations_.emplace_back(shared[b][1], shared[b][2]);
+          ++b;
+        }
+        CameraPair pair;
+        pair.camera = shared[a][0];
+        pair.last = static_cast<int>(pair_observations_.size());
+        pair.first = pair.last - static_cast<int>(b - a);
+        pairs_.push_back(pair);
+        coupled.emplace_back(camera_block_[static_cast<size_t>(pair.camera)], camera_block_[static_cast<size_t>(i)]);
+        a = b;
+      }
+      pair_offsets_[static_cast<size_t>(i) + 1] = static_cast<int>(pairs_.size());
+      std::sort(coupled_groups.begin(), coupled_groups.end());
+      coupled_groups.erase(std::unique(coupled_groups.begin(), coupled_groups.end()), coupled_groups.end());
+      for (int g : coupled_groups) {
+        borders_.push_back({g, {}});
+        coupled.emplace_back(camera_block_[static_cast<size_t>(i)], GroupBlock(g));
+      }
+      border_offsets_[static_cast<size_t>(i) + 1] = static_cast<int>(borders_.size());
+    }
+    linear_solver_ = opt_.linear_solver;
+    if (linear_solver_ == BundleAdjustmentOptions::LinearSolver::kAuto) {
+      const SymmetricBlockSystem::Shape shape = SymmetricBlockSystem::ShapeOf(block_sizes, coupled);
+      const bool sparse = shape.unknowns >= BundleAdjustmentOptions::kMinSparseUnknowns &&
+                          shape.fill <= BundleAdjustmentOptions::kMaxSparseFill;
+      linear_solver_ = sparse ? BundleAdjustmentOptions::LinearSolver::kSparseCholesky
+                              : BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
+    }
+    const bool sparse = linear_solver_ == BundleAdjustmentOptions::LinearSolver::kSparseCholesky;
     system_.Build(block_sizes, coupled, num_groups_,
                   sparse ? SymmetricBlockSystem::Storage::kSparse : SymmetricBlockSystem::Storage::kDense);
-  }
-
-  static void SortUnique(std::vector<std::pair<int, int>>* pairs) {
-    for (auto& [a, b] : *pairs) {
-      if (a > b) std::swap(a, b);
+    diagonal_blocks_.resize(static_cast<size_t>(nc_));
+    for (int i = 0; i < nc_; ++i) {
+      const int block = camera_block_[static_cast<size_t>(i)];
+      if (block < 0) continue;
+      diagonal_blocks_[static_cast<size_t>(i)] = system_.Find(block, block);
+      for (int p = pair_offsets_[static_cast<size_t>(i)]; p < pair_offsets_[static_cast<size_t>(i) + 1]; ++p) {
+        CameraPair& pair = pairs_[static_cast<size_t>(p)];
+        pair.block = system_.Find(block, camera_block_[static_cast<size_t>(pair.camera)]);
+      }
+      for (int b = border_offsets_[static_cast<size_t>(i)]; b < border_offsets_[static_cast<size_t>(i) + 1]; ++b) {
+        borders_[static_cast<size_t>(b)].block = system_.Find(block, GroupBlock(borders_[static_cast<size_t>(b)].group));
+      }
     }
-    std::sort(pairs->begin(), pairs->end());
-    pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
   }
 
   void ApplyStep() {
@@ -571,7 +643,16 @@ class Solver {
     std::vector<int> items;    // group indices
   } point_groups_;
   std::vector<MatI3> z_, zv_;
+  // Per free camera: where its diagonal block is stored; the cameras i2 <= i it shares points
+  // with (pairs_[pair_offsets_[i] ..], by i2), each with its observation pairs (k of i, k2 of
+  // i2) and where S(i, i2) is stored; the groups it is coupled with and where those blocks are.
+  std::vector<SymmetricBlockSystem::Block> diagonal_blocks_;
+  std::vector<int> pair_offsets_, border_offsets_;
+  std::vector<CameraPair> pairs_;
+  std::vector<std::pair<int, int>> pair_observations_;
+  std::vector<Border> borders_;
   std::vector<VecI> group_rhs_;  // per grouped camera: the intrinsic rows of its right-hand side
+  BundleAdjustmentOptions::LinearSolver linear_solver_ = BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
   SymmetricBlockSystem system_;
   Eigen::VectorXd step_c_;
   std::vector<double> cand_cameras_, cand_points_;
@@ -645,6 +726,8 @@ Result<BundleAdjustmentSummary> SolveImpl(const BundleAdjustmentOptions& options
   Solver<Model> solver(options, constancy, problem);
   BundleAdjustmentSummary summary;
   static_cast<LmSummary&>(summary) = RunLm(solver, options);
+  summary.linear_solver = solver.linear_solver();
+  summary.reduced_unknowns = solver.reduced_unknowns();
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

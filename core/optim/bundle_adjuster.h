@@ -36,8 +36,17 @@ struct BundleAdjustmentOptions : LmOptions {
     kSparseCholesky,  // S's coupled blocks (camera pairs sharing a point, cameras and the groups
                       // they see), AMD camera ordering with the groups last, CHOLMOD supernodal
                       // Cholesky (Eigen SimplicialLDLT when built without CHOLMOD)
+    kAuto,            // sparse when S has at least kMinSparseUnknowns unknowns and its coupled
+                      // blocks fill at most kMaxSparseFill of its upper triangle, else dense
   };
-  LinearSolver linear_solver = LinearSolver::kDenseCholesky;
+  // The crossover of kAuto, measured on the mapper's global adjustments (docs/figures.md, "The
+  // bundle adjuster's linear solvers"): on a 400-photo corridor walk sparse took 0.78 of dense's
+  // time at 570 unknowns and fill 0.53, 0.20 at 2406 and 0.12, but 1.07 at fill 0.65; round the
+  // 320-photo bunny (fill 0.66 at the end) dense was faster at every size (sparse 1.1 to 1.5x).
+  // Under 500 unknowns either takes under 0.1 s.
+  static constexpr int kMinSparseUnknowns = 500;
+  static constexpr double kMaxSparseFill = 0.6;
+  LinearSolver linear_solver = LinearSolver::kAuto;
   int num_threads = 1;  // <= 0: one per core
 
   // InvalidArgument naming the first offending field.
@@ -50,6 +59,9 @@ struct BundleAdjustmentOptions : LmOptions {
 // max_consecutive_numeric_failures times in a row.
 struct BundleAdjustmentSummary : LmSummary {
   double seconds = 0.0;  // wall time of SolveBundleAdjustment (setup included)
+  // The solver that ran (kAuto resolved) and the size of its reduced system.
+  BundleAdjustmentOptions::LinearSolver linear_solver = BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
+  int reduced_unknowns = 0;
 };
 
 // Which parameter blocks are held constant; empty vectors mean every block is free, otherwise

@@ -6,6 +6,21 @@
 
 namespace reconar {
 
+SymmetricBlockSystem::Shape SymmetricBlockSystem::ShapeOf(const std::vector<int>& block_sizes,
+                                                           const std::vector<std::pair<int, int>>& coupled) {
+  Shape shape;
+  double stored = 0.0;
+  for (int size : block_sizes) {
+    shape.unknowns += size;
+    stored += 0.5 * size * (size + 1.0);
+  }
+  for (const auto& [a, b] : coupled) {
+    if (a != b) stored += static_cast<double>(block_sizes[static_cast<size_t>(a)]) * block_sizes[static_cast<size_t>(b)];
+  }
+  if (shape.unknowns > 0) shape.fill = stored / (0.5 * shape.unknowns * (shape.unknowns + 1.0));
+  return shape;
+}
+
 void SymmetricBlockSystem::Build(const std::vector<int>& block_sizes, const std::vector<std::pair<int, int>>& coupled,
                                  int border, Storage storage) {
   storage_ = storage;

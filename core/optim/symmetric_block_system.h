@@ -41,8 +41,17 @@ class SymmetricBlockSystem {
     bool diagonal = false;
   };
 
+  // The number of unknowns, and the share of the upper triangle (diagonal included) that the
+  // coupled blocks cover.
+  struct Shape {
+    int unknowns = 0;
+    double fill = 0.0;
+  };
+  static Shape ShapeOf(const std::vector<int>& block_sizes, const std::vector<std::pair<int, int>>& coupled);
+
   // block_sizes[k] unknowns in block k; `coupled` lists the pairs of blocks (either order,
-  // repeats allowed) whose A block may be non-zero besides the diagonal ones; the last `border`
+  // repeats allowed) whose A block may be non-zero besides the diagonal ones (ShapeOf: without
+  // repeats); the last `border`
   // blocks stay last in the sparse ordering.
   void Build(const std::vector<int>& block_sizes, const std::vector<std::pair<int, int>>& coupled, int border,
              Storage storage);
@@ -82,6 +91,11 @@ class SymmetricBlockSystem {
     } else {
       SubtractStoredProduct(block, a, b);
     }
+  }
+  // The stored block -= m, m in the stored orientation (of A(c, r) when `transposed`).
+  template <typename M>
+  void SubtractStored(const Block& block, const Eigen::MatrixBase<M>& m) {
+    AddStored<-1>(block, m);
   }
   // A(k, k)(i, i) = value (a constant unknown: its row and column are otherwise zero).
   void SetDiagonal(int k, int i, double value);
