@@ -78,15 +78,25 @@ function(reconar_add_test_pch)
   set_target_properties(reconar_test_pch_host PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/tests/support")
 endfunction()
 
-# reconar_add_test(NAME SOURCES ... [LINKS ...] [LABELS ...] [TIMEOUT seconds] [COST weight] [NO_PCH])
+# reconar_add_test(NAME SOURCES ... [LINKS ...] [LABELS ...] [TIMEOUT seconds] [COST weight] [NO_PCH]
+#                  [ONE_PROCESS] [NATIVE_ONLY gtest-pattern ...])
 # COST: ctest starts tests of higher cost first, so that long ones (e.g. under qemu) overlap the
 # short ones instead of trailing at the end of a parallel run.
 # A GoogleTest executable; each TEST becomes a CTest case (discovered through the cross emulator too).
 # Label "unit" for fast self-contained tests, "e2e" for tests on ../shared/data.
+# ONE_PROCESS: the executable is one CTest case (named NAME) running all its tests in one process,
+# for tests that share a scene built once per process (SetUpTestSuite, a static built on first use):
+# one case per TEST would build it again in every case.
+# NATIVE_ONLY: the unit tests matching these GoogleTest patterns (e.g. Suite.Name*) are labelled
+# "native" instead: self-contained, run by scripts/test.sh but not by the qemu run (-L unit). Only
+# for tests that check nothing architecture-specific that another unit test does not check under
+# qemu (the SIMD kernels' own tests, a lighter run of the same code path), and that take a minute
+# or more there.
 function(reconar_add_test name)
   # RESOURCE_LOCK: tests holding the same lock never run at the same time (x_screen: they show
   # windows on, or read back, the one X server's screen under xvfb-run).
-  cmake_parse_arguments(ARG "NO_PCH" "TIMEOUT;COST;RESOURCE_LOCK" "SOURCES;LINKS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_PCH;ONE_PROCESS" "TIMEOUT;COST;RESOURCE_LOCK" "SOURCES;LINKS;LABELS;NATIVE_ONLY"
+                        ${ARGN})
   if(NOT ARG_LABELS)
     set(ARG_LABELS unit)
   endif()
@@ -112,7 +122,43 @@ function(reconar_add_test name)
   if(ARG_RESOURCE_LOCK)
     set(lock RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
   endif()
-  gtest_discover_tests(${name}
+  # The GoogleTest filters of the two sets: every test but the native-only ones, and those.
+  set(native_filter)
+  if(ARG_NATIVE_ONLY)
+    if(NOT "unit" IN_LIST ARG_LABELS)
+      message(FATAL_ERROR "${name}: NATIVE_ONLY is for unit tests")
+    endif()
+    # Discovery with a filter (TEST_FILTER) is CMake 3.22's; an older CMake runs them all as unit.
+    if(NOT CMAKE_VERSION VERSION_LESS 3.22)
+      list(JOIN ARG_NATIVE_ONLY ":" native_filter)
+    endif()
+  endif()
+  set(native_labels "${ARG_LABELS}")
+  list(TRANSFORM native_labels REPLACE "^unit$" native)
+  if(ARG_ONE_PROCESS)
+    set(rest_filter)
+    if(native_filter)
+      set(rest_filter "--gtest_filter=-${native_filter}")
+    endif()
+    add_test(NAME ${name} COMMAND ${name} ${rest_filter})
+    set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST} ${lock})
+    if(native_filter)
+      add_test(NAME ${name}_native COMMAND ${name} "--gtest_filter=${native_filter}")
+      set_tests_properties(${name}_native PROPERTIES LABELS "${native_labels}" TIMEOUT ${ARG_TIMEOUT}
+                           COST ${ARG_COST} ${lock})
+    endif()
+    return()
+  endif()
+  set(rest_filter)
+  if(native_filter)
+    set(rest_filter TEST_FILTER "-${native_filter}")
+  endif()
+  gtest_discover_tests(${name} ${rest_filter}
       PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST} ${lock}
       DISCOVERY_TIMEOUT 120)
+  if(native_filter)
+    gtest_discover_tests(${name} TEST_FILTER "${native_filter}"
+        PROPERTIES LABELS "${native_labels}" TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST} ${lock}
+        DISCOVERY_TIMEOUT 120)
+  endif()
 endfunction()

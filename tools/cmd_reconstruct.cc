@@ -26,7 +26,7 @@ constexpr char kHelp[] =
     "  --threads N           worker threads (default: one per core)\n"
     "  --stages LIST         comma-separated subset of sparse,dense,mesh (default all)\n"
     "  --principal-point fixed|auto|refine, --fixed-distortion, --max-error PX,\n"
-    "  --strict-registration, --separate-models\n"
+    "  --strict-registration, --separate-models, --no-reextraction\n"
     "                        as `reconar sfm`\n"
     "  --ratio R, --min-inliers N, --checks N, --f-threshold T   matching (defaults 0.8, 30, 200, 0.006)\n"
     "  --exhaustive-up-to N, --window W, --retrieved R   the pairs matched, as `reconar match`\n"

@@ -17,7 +17,7 @@ namespace {
 
 const std::set<std::string> kFlags = {"no-tags-in-ba", "no-preview",           "force",           "json",
                                       "fixed-distortion", "no-fill",          "strict-registration",
-                                      "separate-models"};
+                                      "separate-models", "no-reextraction"};
 
 std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
@@ -113,6 +113,10 @@ Result<ReconstructOptions> OptionsFromArgs(const Args& args) {
   RECONAR_RETURN_IF_ERROR(ReadDenseAndMeshArgs(args, &options));
   RECONAR_RETURN_IF_ERROR(ReadStages(args, &options));
   options.force = args.Has("force");
+  if (args.Has("no-reextraction")) {
+    options.extract_weak_photos_again = false;
+    options.matching.poorly_matched.min_partners = 0;
+  }
   options.tag_family = args.Get("tag-family", options.tag_family);
   PhotoTagOptions tag_options;
   RECONAR_ASSIGN_OR_RETURN(tag_options.family, ParseTagFamily(options.tag_family));

@@ -109,6 +109,45 @@ void NoModel(const std::string& why, int iterations, AbsolutePoseResult* result)
   result->reason = "no pose found after " + std::to_string(iterations) + " RANSAC iterations: " + why;
 }
 
+// RANSAC on the outliers of the first pose (second_pose_from_outliers): the pose found there,
+// finished like the first, replaces it when it has more inliers, else becomes its alternative.
+Status TrySecondPose(const std::vector<Eigen::Vector2d>& points_px, const std::vector<Eigen::Vector3d>& world_points,
+                     const RadialCamera& camera, const AbsolutePoseOptions& options,
+                     const std::vector<PoseCorrespondence>& samples, const std::vector<int>& sample_to_input,
+                     const std::vector<char>& first_mask, AbsolutePoseResult* result) {
+  std::vector<PoseCorrespondence> outliers;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (!first_mask[i]) outliers.push_back(samples[i]);
+  }
+  if (static_cast<int>(outliers.size()) <= P3PEstimator::kMinSamples) return Status::Ok();
+  RansacOptions ransac = options.ransac;
+  ransac.max_residual = options.max_error_px / camera.focal;
+  RECONAR_ASSIGN_OR_RETURN(const auto report, (Ransac<P3PEstimator, PoseLocalEstimator>::Run(outliers, ransac)));
+  result->ransac_iterations += report.iterations;
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+  if (report.status != RansacStatus::kSuccess || !NearestPose(report.model, &R, &t)) return Status::Ok();
+  std::vector<double> residuals(samples.size());
+  P3PEstimator::Residuals(samples.data(), static_cast<int>(samples.size()), report.model, residuals.data());
+  const double t2 = ransac.max_residual * ransac.max_residual;
+  std::vector<char> mask(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) mask[i] = residuals[i] < t2 ? 1 : 0;
+  AbsolutePoseResult second;
+  FinishPose(points_px, world_points, camera, options, options.refine_focal, R, t,
+             MaskToIndices(mask, sample_to_input), &second);
+  if (second.num_inliers <= P3PEstimator::kMinSamples) return Status::Ok();
+  AlternativePose other;
+  if (second.num_inliers > result->num_inliers) {
+    second.ransac_iterations = result->ransac_iterations;
+    other = {result->cam_from_world, std::move(result->inliers)};
+    *result = std::move(second);
+  } else {
+    other = {second.cam_from_world, std::move(second.inliers)};
+  }
+  result->alternatives.push_back(std::move(other));
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status AbsolutePoseOptions::Check() const {
@@ -181,6 +220,10 @@ Result<AbsolutePoseResult> EstimateAbsolutePose(const std::vector<Eigen::Vector2
   }
   FinishPose(points_px, world_points, camera, options, options.refine_focal, R, t,
              MaskToIndices(report.inlier_mask, sample_to_input), &result);
+  if (options.second_pose_from_outliers) {
+    RECONAR_RETURN_IF_ERROR(TrySecondPose(points_px, world_points, camera, options, samples, sample_to_input,
+                                          report.inlier_mask, &result));
+  }
   return result;
 }
 

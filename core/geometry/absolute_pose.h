@@ -168,9 +168,21 @@ struct AbsolutePoseOptions {
   bool refine = true;
   bool refine_focal = false;  // EstimateAbsolutePose only; the unknown-focal path always refines the focal
   PoseRefinementOptions refinement;
+  // RANSAC keeps the pose of least truncated cost. Where the points lie near one plane, another
+  // pose (the planar flip) can fit nearly as many of them. With this on, RANSAC runs again on the
+  // first pose's outliers; the pose it finds, refined like the first, is taken when it has more
+  // inliers over all the correspondences, and otherwise returned as AbsolutePoseResult::alternative
+  // for the caller to weigh (EstimateAbsolutePose only).
+  bool second_pose_from_outliers = false;
 
   // InvalidArgument naming the first offending field.
   Status Check() const;
+};
+
+// A second pose that also explains many of the correspondences (second_pose_from_outliers).
+struct AlternativePose {
+  Rigid3 cam_from_world;
+  std::vector<int> inliers;  // indices into the input, ascending
 };
 
 struct AbsolutePoseResult {
@@ -191,6 +203,7 @@ struct AbsolutePoseResult {
   int num_inliers = 0;
   double mean_inlier_error_px = 0.0;  // mean pixel reprojection error of the inliers
   int ransac_iterations = 0;
+  std::vector<AlternativePose> alternatives;  // at most one (second_pose_from_outliers)
   bool refined = false;              // the refinement ran and its result was kept
   NormalLmSummary refinement;        // valid when `refined`
 

@@ -408,7 +408,23 @@ Result<LiveReconstructionReport> LiveReconstruction::Finish() {
   RECONAR_RETURN_IF_ERROR(WriteMatchesFile(project_, images_, pairs_));
   StageRecord record(project_);
   RECONAR_RETURN_IF_ERROR(record.Record("features", FeatureStageSettings(options_.features)));
-  RECONAR_RETURN_IF_ERROR(record.Record("matching", MatchStageSettings(options_.matching)));
+  // The matches count as the match stage's only when it would not extract a keyframe again
+  // (match_stage.h): otherwise `reconstruct` matches anew, as it would the same photos.
+  std::vector<int> partners(images_.size(), 0), feature_counts(images_.size(), 0);
+  for (const VerifiedPair& pair : pairs_) {
+    if (pair.geometry.config == TwoViewGeometry::Config::kTooFewInliers) continue;
+    ++partners[static_cast<size_t>(pair.image_a)];
+    ++partners[static_cast<size_t>(pair.image_b)];
+  }
+  for (size_t i = 0; i < images_.size() && i < mapper_images_.size(); ++i)
+    feature_counts[i] = static_cast<int>(mapper_images_[i].keypoints.size());
+  const int min_partners =
+      std::min(options_.matching.poorly_matched.min_partners, static_cast<int>(images_.size()) - 1);
+  bool reextraction_needed = false;
+  for (const ReextractionReason reason : PhotosToExtractAgain(partners, feature_counts, min_partners))
+    reextraction_needed |= reason != ReextractionReason::kNone;
+  report.matches_reusable = !reextraction_needed;
+  if (!reextraction_needed) RECONAR_RETURN_IF_ERROR(record.Record("matching", MatchStageSettings(options_.matching)));
 
   const std::string live_dir = project_.LiveDir();
   RECONAR_RETURN_IF_ERROR(CreateDirectories(live_dir));

@@ -98,6 +98,9 @@ struct LiveReconstructionReport {
   int maps_published = 0;     // LiveReconstructionOptions::publish_map
   double seconds_maps = 0.0;  // the worker's time building them
   std::string error;  // a failure that stopped the worker (the keyframes stay on disk)
+  // The keyframes' matches stand as the match stage's (`reconstruct` reuses them); false when the
+  // match stage would extract some keyframe again (PhotosToExtractAgain), so that it matches anew.
+  bool matches_reusable = true;
 };
 
 // The directions from which a model's object has been seen, for the capture's coverage indicator:

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -63,6 +64,24 @@ Result<std::vector<std::pair<int, int>>> ChoosePairs(const Project& project, con
   return pairs;
 }
 
+}  // namespace
+
+std::string ExtractAgainDigest(const std::map<std::string, std::string>& names) {
+  if (names.empty()) return "";
+  uint64_t hash = 0xcbf29ce484222325ull;
+  for (const auto& entry : names) {
+    for (const char c : entry.first + '\n') {
+      hash ^= static_cast<unsigned char>(c);
+      hash *= 0x100000001b3ull;
+    }
+  }
+  char text[40];
+  std::snprintf(text, sizeof(text), " again=%zu:%016llx", names.size(), static_cast<unsigned long long>(hash));
+  return text;
+}
+
+namespace {
+
 // Per image: the pairs it is in that verified (as a general or a planar two-view geometry).
 std::vector<int> VerifiedPartners(const std::vector<std::optional<VerifiedPair>>& results, size_t num_images) {
   std::vector<int> partners(num_images, 0);
@@ -112,6 +131,7 @@ std::string ReextractionReasonText(ReextractionReason reason, int partners, int 
       return matched + ", but has no more features than a poorly matched photo with fewer than the set's median";
     case ReextractionReason::kTheSetMatchesPoorly:
       return matched + "; the set's median photo matched with fewer than " + std::to_string(min_partners);
+    case ReextractionReason::kAskedFor: return "asked for";
   }
   return "";
 }
@@ -142,7 +162,7 @@ std::string MatchStageSettings(const MatchStageOptions& options) {
                                 {"f_threshold", options.two_view.f_threshold_fraction},
                                 {"poorly_matched_partners", options.poorly_matched.min_partners},
                                 {"poorly_matched_contrast", options.poorly_matched.contrast_threshold}}) +
-         " pairs=" + options.pairs.Describe();
+         " pairs=" + options.pairs.Describe() + ExtractAgainDigest(options.extract_again);
 }
 
 Status WriteMatchesFile(const Project& project, const std::vector<ProjectImage>& images,
@@ -329,7 +349,11 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
   const auto reextraction_start = Clock::now();
   const std::vector<int> partners_before = VerifiedPartners(results, images.size());
   const int needed = std::min(options.poorly_matched.min_partners, n - 1);
-  const std::vector<ReextractionReason> reasons = PhotosToExtractAgain(partners_before, feature_counts, needed);
+  std::vector<ReextractionReason> reasons = PhotosToExtractAgain(partners_before, feature_counts, needed);
+  for (size_t i = 0; i < images.size(); ++i) {
+    if (reasons[i] == ReextractionReason::kNone && options.extract_again.count(images[i].name) != 0)
+      reasons[i] = ReextractionReason::kAskedFor;
+  }
   std::vector<char> rematch(pairs.size(), 0);
   {
     FeatureStageOptions richer;
@@ -361,7 +385,9 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
       MatchStageReport::ReextractedPhoto photo;
       photo.name = images[i].name;
       photo.partners_before = partners_before[i];
-      photo.reason = ReextractionReasonText(reasons[i], partners_before[i], needed);
+      photo.reason = reasons[i] == ReextractionReason::kAskedFor
+                         ? options.extract_again.at(images[i].name)
+                         : ReextractionReasonText(reasons[i], partners_before[i], needed);
       photo.features_before = static_cast<int>(before.count);
       photo.features_after = features_after;
       photo.contrast_threshold = richer.sift.contrast_threshold;
@@ -379,6 +405,7 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
     }
   }
   report.seconds_reextraction = std::chrono::duration<double>(Clock::now() - reextraction_start).count();
+  report.extract_again = options.extract_again;
 
   report.num_images = static_cast<int>(images.size());
   report.num_pairs = static_cast<int>(pairs.size());
@@ -413,6 +440,10 @@ std::string MatchStageReportJson(const MatchStageReport& report) {
     json.Key("features_before").Int(photo.features_before).Key("features_after").Int(photo.features_after);
     json.Key("contrast_threshold").Double(photo.contrast_threshold).EndObject();
   }
+  json.EndArray();
+  json.Key("extract_again").BeginArray();
+  for (const auto& [name, reason] : report.extract_again)
+    json.BeginObject().Key("image").String(name).Key("reason").String(reason).EndObject();
   json.EndArray().EndObject();
   return json.str() + "\n";
 }

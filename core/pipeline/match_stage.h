@@ -13,6 +13,7 @@
 // are cut into consecutive blocks and each pair of blocks is matched with only its two blocks in
 // memory; the pairs and the file are the same either way.
 #include <Eigen/Core>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,10 @@ struct MatchStageOptions {
   PairSelectionOptions pairs;
   TwoViewOptions two_view;
   PoorlyMatchedPhotoOptions poorly_matched;
+  // Photos to extract again as the poorly matched ones are, whatever their partners, with why
+  // (by name; reconstruct.h: the photos the mapper could register only provisionally, or not at
+  // all, and their partners). Names not in the project are ignored.
+  std::map<std::string, std::string> extract_again;
   int num_threads = 0;  // pairs in parallel; <= 0: one per core
   bool show_progress = true;
   size_t memory_budget_bytes = 0;  // for features and forests; 0: no limit
@@ -77,6 +82,7 @@ struct MatchStageReport {
     double contrast_threshold = 0.0;
   };
   std::vector<ReextractedPhoto> reextracted;
+  std::map<std::string, std::string> extract_again;  // MatchStageOptions::extract_again, as asked
   double seconds_reextraction = 0;  // of which extracting and matching again
 };
 
@@ -95,6 +101,7 @@ enum class ReextractionReason {
   kAsTexturePoor,        // no more features than a poorly matched photo that has fewer than the
                          // set's median count: its partners need it richer as much as it does
   kTheSetMatchesPoorly,  // the set's median photo is poorly matched: every photo is
+  kAskedFor,             // named in MatchStageOptions::extract_again
 };
 // Per photo, from its verified partners (pairs verified as general or planar) and its feature
 // count: a photo with fewer than min_partners partners (the project's other photos when there
@@ -113,6 +120,10 @@ std::string MatchStageSettings(const MatchStageOptions& options);
 // Writes PROJECT/matches/matches.txt and PROJECT/matches/report.json (the photos extracted again,
 // MatchStageReportJson), after removing the richer features an earlier run left.
 Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageOptions& options);
+
+// " again=COUNT:DIGEST" naming MatchStageOptions::extract_again in a stage record (a 64-bit FNV-1a
+// digest of the names), or nothing for none.
+std::string ExtractAgainDigest(const std::map<std::string, std::string>& names);
 
 // The report's photos extracted again, as the JSON object PROJECT/matches/report.json holds.
 std::string MatchStageReportJson(const MatchStageReport& report);

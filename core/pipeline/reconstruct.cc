@@ -16,6 +16,7 @@
 #include "core/io/image_io.h"
 #include "core/pipeline/map_stage.h"
 #include "core/pipeline/stage_record.h"
+#include "core/pipeline/weak_registrations.h"
 #include "core/sfm/model_io.h"
 
 namespace reconar {
@@ -83,10 +84,11 @@ class StageRunner {
       summary.reused = true;
       if (options_.show_progress)
         std::fprintf(stderr, "reconstruct: [%d] %s: finished earlier, reused\n", index_, name.c_str());
-      report_->stages.push_back(summary);
+      Add(summary);
       return Status::Ok();
     }
-    if (!IsSideStage(name)) redone_ = true;  // no later stage reads a side stage's outputs
+    // No later stage reads a side stage's outputs; of the tags' only mapping does (the caller's).
+    if (!IsSideStage(name) && name != "tags") redone_ = true;
     if (options_.show_progress) std::fprintf(stderr, "reconstruct: [%d] %s\n", index_, name.c_str());
     ReleaseFreeHeapMemory();
     ResetPeakResidentBytes();
@@ -96,13 +98,28 @@ class StageRunner {
     // A stage that resets the peak itself (per phase) reports its own maximum in the summary.
     summary.peak_rss_bytes = std::max(summary.peak_rss_bytes, PeakResidentBytes());
     RECONAR_RETURN_IF_ERROR(record_.Record(name, settings));
-    report_->stages.push_back(summary);
+    Add(summary);
     return Status::Ok();
   }
   // A stage redone in this run: the ones after it must be redone too.
   bool redone() const { return redone_; }
 
  private:
+  // A stage run a second time (matching and mapping, for the photos mapped weakly) is one entry:
+  // its times added, its peak the higher, its notes joined.
+  void Add(const StageSummary& summary) {
+    for (StageSummary& earlier : report_->stages) {
+      if (earlier.name != summary.name) continue;
+      earlier.reused = earlier.reused && summary.reused;
+      earlier.seconds += summary.seconds;
+      earlier.peak_rss_bytes = std::max(earlier.peak_rss_bytes, summary.peak_rss_bytes);
+      if (!summary.note.empty() && summary.note != earlier.note)
+        earlier.note += (earlier.note.empty() ? "" : "; then ") + summary.note;
+      return;
+    }
+    report_->stages.push_back(summary);
+  }
+
   const ReconstructOptions& options_;
   ReconstructReport* report_;
   StageRecord record_;
@@ -262,27 +279,9 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     RECONAR_RETURN_IF_ERROR(runner.Run("features", FeatureStageSettings(features),
                                        FeaturesUpToDate(project, image_paths), false, run_features));
 
-    MatchStageOptions matching = options.matching;
-    matching.poorly_matched.sift = features.sift;
-    matching.num_threads = threads;
-    matching.memory_budget_bytes = budget;
-    matching.show_progress = options.show_progress;
-    const auto run_matching = [&](StageSummary* summary) -> Status {
-      RECONAR_ASSIGN_OR_RETURN(const MatchStageReport r, RunMatchStage(project, matching));
-      if (r.num_blocks > 1) {
-        summary->note =
-            "photos matched in " + std::to_string(r.num_blocks) + " blocks, two at a time, for the memory budget";
-      }
-      if (!r.reextracted.empty()) {
-        summary->note += std::string(summary->note.empty() ? "" : "; ") + std::to_string(r.reextracted.size()) +
-                         " poorly matched photo(s) extracted again at a lower contrast threshold (matches/report.json)";
-      }
-      return Status::Ok();
-    };
-    RECONAR_RETURN_IF_ERROR(runner.Run("matching", MatchStageSettings(matching), Exists(project.MatchesPath()),
-                                       runner.redone(), run_matching));
-
+    // Tags before matching: they read the photos alone, so matching again (below) keeps them.
     const bool with_tags = options.tag_size_m > 0.0;
+    bool tags_redone = false;
     if (with_tags) {
       const auto run_tags = [&](StageSummary* summary) -> Status {
         RECONAR_ASSIGN_OR_RETURN(const TagDetectionsFile detections, options.detect_tags(image_paths));
@@ -294,7 +293,30 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       };
       RECONAR_RETURN_IF_ERROR(
           runner.Run("tags", options.tag_family, Exists(project.TagDetectionsPath()), runner.redone(), run_tags));
+      tags_redone = !report.stages.back().reused;
     }
+
+    MatchStageOptions matching = options.matching;
+    matching.poorly_matched.sift = features.sift;
+    // Resumed after a second matching (below): continue from it.
+    if (options.extract_weak_photos_again) matching.extract_again = RecordedExtractAgain(project);
+    matching.num_threads = threads;
+    matching.memory_budget_bytes = budget;
+    matching.show_progress = options.show_progress;
+    const auto run_matching = [&](StageSummary* summary) -> Status {
+      RECONAR_ASSIGN_OR_RETURN(const MatchStageReport r, RunMatchStage(project, matching));
+      if (r.num_blocks > 1) {
+        summary->note =
+            "photos matched in " + std::to_string(r.num_blocks) + " blocks, two at a time, for the memory budget";
+      }
+      if (!r.reextracted.empty()) {
+        summary->note += std::string(summary->note.empty() ? "" : "; ") + std::to_string(r.reextracted.size()) +
+                         " photo(s) extracted again at a lower contrast threshold (matches/report.json says why)";
+      }
+      return Status::Ok();
+    };
+    RECONAR_RETURN_IF_ERROR(runner.Run("matching", MatchStageSettings(matching), Exists(project.MatchesPath()),
+                                       runner.redone(), run_matching));
 
     SfmStageOptions sfm = options.sfm;
     sfm.mapper.num_threads = threads;
@@ -349,8 +371,25 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     // Tag projects map differently since images register by their known tags and the world tag is
     // fitted as a square (version 2): their recorded mapping is not reused. Others are unchanged.
     if (with_tags) mapping_settings += " " + Settings({{"tag_mapping", 2.0}});
-    RECONAR_RETURN_IF_ERROR(runner.Run("mapping", mapping_settings, Exists(project.SparseDir() + "/report.json"),
-                                       runner.redone(), run_mapping));
+    const auto map_matches = [&]() {
+      return runner.Run("mapping", mapping_settings + ExtractAgainDigest(matching.extract_again),
+                        Exists(project.SparseDir() + "/report.json"), runner.redone() || tags_redone, run_mapping);
+    };
+    RECONAR_RETURN_IF_ERROR(map_matches());
+    // The photos the mapper registered weakly, and their partners, extracted again and matched
+    // again, and the photos mapped again (weak_registrations.h): once.
+    if (options.extract_weak_photos_again && matching.extract_again.empty()) {
+      RECONAR_ASSIGN_OR_RETURN(const auto weak, WeaklyRegisteredPhotos(project));
+      if (!weak.empty()) {
+        if (options.show_progress)
+          std::fprintf(stderr, "reconstruct: %zu photo(s) registered weakly or not at all, or paired with them: "
+                       "extracting them again\n", weak.size());
+        matching.extract_again = weak;
+        RECONAR_RETURN_IF_ERROR(runner.Run("matching", MatchStageSettings(matching), Exists(project.MatchesPath()),
+                                           runner.redone(), run_matching));
+        RECONAR_RETURN_IF_ERROR(map_matches());
+      }
+    }
 
     MapStageOptions map = options.map;
     map.build.num_threads = threads;

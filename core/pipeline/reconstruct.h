@@ -72,6 +72,10 @@ struct ReconstructOptions {
   size_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
   int num_threads = 0;  // 0: one per core
   bool force = false;   // redo every stage
+  // The photos the mapper registers only provisionally or not at all, and their partners, are
+  // extracted again at the lower contrast threshold, matched again and mapped again, once
+  // (weak_registrations.h). `--no-reextraction` turns it off, with the match stage's own rule.
+  bool extract_weak_photos_again = true;
   bool show_progress = true;
 
   Status Check() const;

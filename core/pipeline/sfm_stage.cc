@@ -320,7 +320,8 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("merged").BeginArray();
   for (const MapperReport::Merge& merge : m.merges) {
     json->BeginObject().Key("initial_pair").String(merge.initial_pair).Key("images").Int(merge.num_images);
-    json->Key("shared_points").Int(merge.num_shared_points).Key("inliers").Int(merge.num_inliers).EndObject();
+    json->Key("shared_points").Int(merge.num_shared_points).Key("inliers").Int(merge.num_inliers);
+    json->Key("aligned_by").String(merge.aligned_by).EndObject();
   }
   json->EndArray();
   json->Key("provisional").BeginArray();

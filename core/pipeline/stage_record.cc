@@ -26,17 +26,19 @@ bool StageRecord::Finished(const std::string& stage, const std::string& settings
 
 Status StageRecord::Record(const std::string& stage, const std::string& settings) {
   stages_[stage] = settings;
-  bool after = false;
   std::set<std::string> replaced = {stage};
-  for (const char* name : kStageOrder) {
-    if (after) {
-      stages_.erase(name);
-      replaced.insert(name);
+  for (bool grew = true; grew;) {  // the stages reading a replaced one, until none is added
+    grew = false;
+    for (const StageInputs& reader : kStageInputs) {
+      if (replaced.count(reader.stage) != 0) continue;
+      for (const char* input : reader.inputs) {
+        if (input == nullptr || replaced.count(input) == 0) continue;
+        replaced.insert(reader.stage);
+        stages_.erase(reader.stage);
+        grew = true;
+        break;
+      }
     }
-    after |= stage == name;
-  }
-  for (const SideStage& side : kSideStages) {
-    if (side.stage != stage && replaced.count(side.input) != 0) stages_.erase(side.stage);
   }
   std::string text;
   for (const auto& [name, value] : stages_) text += name + " " + value + "\n";

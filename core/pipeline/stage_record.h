@@ -3,8 +3,7 @@
 // sfm`, or of `reconar reconstruct` after an interruption) reuses a stage only when it finished
 // with the same settings. A stage is recorded after its outputs are written (atomically), so a
 // killed run never records a stage it did not finish; recording a stage drops the record of every
-// stage after it in kStageOrder, whose inputs it has just replaced, and of the side stages
-// (kSideStages) that read it or a dropped stage.
+// stage that reads it (kStageInputs).
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -15,20 +14,29 @@
 
 namespace reconar {
 
-inline constexpr const char* kStageOrder[] = {"features", "matching", "tags", "mapping", "dense", "mesh"};
-
-// Stages off the chain: each reads one chain stage's outputs and no later stage reads its own.
-struct SideStage {
+// What each stage reads of the others (the photos aside). Recording a stage drops the record of
+// every stage that reads it, directly or through another, since its inputs were just replaced.
+// Tags read the photos alone (the features stand for them: a new set of photos is extracted
+// again), so matching again (reconstruct.h, the photos mapped weakly) keeps them, and tags
+// detected after a capture recorded its matches keep those.
+struct StageInputs {
   const char* stage;
-  const char* input;
+  const char* inputs[2];
 };
-inline constexpr SideStage kSideStages[] = {{"map", "mapping"}};
+inline constexpr StageInputs kStageInputs[] = {
+    {"features", {nullptr, nullptr}}, {"tags", {"features", nullptr}}, {"matching", {"features", nullptr}},
+    {"mapping", {"tags", "matching"}},  {"dense", {"mapping", nullptr}}, {"mesh", {"dense", nullptr}},
+    {"map", {"mapping", nullptr}},
+};
 
+// A stage off the chain: no other stage reads it (the localisation map).
 inline bool IsSideStage(const std::string& stage) {
-  for (const SideStage& side : kSideStages) {
-    if (stage == side.stage) return true;
+  for (const StageInputs& other : kStageInputs) {
+    for (const char* input : other.inputs) {
+      if (input != nullptr && stage == input) return false;
+    }
   }
-  return false;
+  return true;
 }
 
 class StageRecord {

@@ -5,6 +5,7 @@
 #include "core/geometry/absolute_pose.h"
 #include "core/sfm/provisional_registration.h"
 #include "core/sfm/tag_image_registration.h"
+#include "core/sfm/two_view_check.h"
 
 namespace reconar {
 
@@ -61,6 +62,33 @@ std::string VerifyFewInliers(const MapperModel& model, int image, const std::vec
          std::to_string(options.registration_min_inliers) + " register without further checks), and " + refused;
 }
 
+// Of the pose and its alternative (AbsolutePoseResult::alternatives: the planar flip of a room's
+// walls or a facade fits nearly as many points), the one that explains more of the image: its
+// 2D-3D inliers plus its matches to registered images on tracks without a point that lie on their
+// epipolar lines under it. The wrong one of two such poses leaves most of those matches off.
+void TakeTheBetterExplainedPose(const MapperModel& model, int image, double focal, const MapperOptions& options,
+                                AbsolutePoseResult* pose) {
+  if (pose->alternatives.empty()) return;
+  AlternativePose& other = pose->alternatives[0];
+  if (other.inliers.size() + pose->inliers.size() == 0) return;
+  const std::vector<TwoViewMatch> two_view = GatherTwoViewMatches(model, image);
+  const auto explained = [&](const Rigid3& cam_from_world, size_t inliers) {
+    return static_cast<int>(inliers) +
+           CountEpipolarConsistent(model, two_view, cam_from_world, focal, options.registration_max_error_px);
+  };
+  if (explained(other.cam_from_world, other.inliers.size()) <=
+      explained(pose->cam_from_world, pose->inliers.size()))
+    return;
+  std::swap(pose->cam_from_world, other.cam_from_world);
+  std::swap(pose->inliers, other.inliers);
+  pose->num_inliers = static_cast<int>(pose->inliers.size());
+  if (pose->num_inliers < options.registration_min_verified_inliers) {
+    pose->outcome = AbsolutePoseResult::Outcome::kTooFewInliers;
+    pose->reason = "of two poses the one that explains more has " + std::to_string(pose->num_inliers) +
+                   " inliers, need " + std::to_string(options.registration_min_verified_inliers);
+  }
+}
+
 }  // namespace
 
 bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, int image, const MapperOptions& options,
@@ -92,9 +120,13 @@ bool RegisterImage(MapperModel* model, const std::vector<MapperImage>& images, i
   pose_options.max_error_px = options.registration_max_error_px * (focal_confirmed ? 1.0 : 2.0);
   pose_options.min_inliers = options.registration_min_verified_inliers;
   pose_options.refine_focal = !focal_confirmed;
+  pose_options.second_pose_from_outliers = focal_confirmed;  // weighed by TakeTheBetterExplainedPose
   auto result = EstimateAbsolutePose(pixels, world, pose_camera, pose_options);
   if (result.ok() && !result->success() && !focal_confirmed) {
     result = EstimateAbsolutePoseUnknownFocal(pixels, world, pose_camera, pose_options);
+  }
+  if (result.ok() && result->success()) {
+    TakeTheBetterExplainedPose(*model, image, result->focal > 0.0 ? result->focal : camera.focal, options, &*result);
   }
   std::string verification;
   if (result.ok() && result->success()) {

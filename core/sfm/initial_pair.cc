@@ -90,7 +90,9 @@ Status InitializeFromBestPair(MapperModel* model, const std::vector<MapperImage>
   // meet the bounds are tried; they are scored in batches, as far down the list as needed, so that
   // a dense sequence, whose best-matched pairs are neighbours without baseline, reaches the wider
   // pairs further down. A model no third image can join is kept only as the last resort.
-  const size_t max_scored = std::min(order.size(), static_cast<size_t>(options.init_max_pairs_scored));
+  const size_t max_scored = options.init_max_pairs_scored > 0
+                                ? std::min(order.size(), static_cast<size_t>(options.init_max_pairs_scored))
+                                : order.size();
   constexpr size_t kBatch = 32;
   size_t num_scored = 0;  // the first pairs of `order` that have their quick score
   auto angles_of = [&](size_t k) -> const std::vector<double>& { return quick.angles[static_cast<size_t>(order[k])]; };

@@ -392,7 +392,7 @@ Status MapperOptions::Check() const {
   if (init_min_points < 8) return InvalidArgument("MapperOptions: init_min_points < 8");
   if (!(init_min_median_angle_deg >= 0.0)) return InvalidArgument("MapperOptions: init_min_median_angle_deg < 0");
   if (init_max_pairs_tried < 1) return InvalidArgument("MapperOptions: init_max_pairs_tried < 1");
-  if (init_max_pairs_scored < 1) return InvalidArgument("MapperOptions: init_max_pairs_scored < 1");
+  if (init_max_pairs_scored < 0) return InvalidArgument("MapperOptions: init_max_pairs_scored < 0");
   if (init_min_points_floor < 8 || init_min_points_floor > init_min_points) {
     return InvalidArgument("MapperOptions: init_min_points_floor must be in [8, init_min_points]");
   }
@@ -493,6 +493,11 @@ Result<bool> RunWithRestarts(const std::vector<MapperImage>& images, const std::
   return any;
 }
 
+// A join by a pair's two-view geometry (AlignModelsByTwoViewGeometry) needs this many points on
+// each side to agree on the baseline, as a registration from a neighbour's geometry does
+// (MapperOptions::registration_min_baseline_points' default); the joined model is verified after.
+constexpr int kMinTwoViewJoinPoints = 5;
+
 // The points of `merged` seen by a registered image of `a` and one of `b`.
 int PointsSeenByBoth(const Reconstruction& merged, const Reconstruction& a, const Reconstruction& b) {
   int count = 0;
@@ -531,10 +536,15 @@ Status MergeIntoLargest(const std::vector<MapperImage>& images, const std::vecto
     for (size_t k = 1; k < order.size() && !merged; ++k) {
       const size_t other = order[k];
       MapperReport& other_report = (*reports)[other];
-      const Result<ModelAlignment> alignment = AlignModels((*models)[main], (*models)[other], pairs, merge_options);
+      Result<ModelAlignment> alignment = AlignModels((*models)[main], (*models)[other], pairs, merge_options);
       if (!alignment.ok()) {
-        other_report.not_merged = alignment.status().message();
-        continue;
+        const Result<ModelAlignment> by_pair = AlignModelsByTwoViewGeometry(
+            (*models)[main], (*models)[other], pairs, options, kMinTwoViewJoinPoints);
+        if (!by_pair.ok()) {
+          other_report.not_merged = alignment.status().message() + "; " + by_pair.status().message();
+          continue;
+        }
+        alignment = by_pair;
       }
       const Reconstruction seed = CombineRegisteredImages((*models)[main], (*models)[other], alignment->to_from_from);
       MapperReport merged_report;
@@ -561,8 +571,12 @@ Status MergeIntoLargest(const std::vector<MapperImage>& images, const std::vecto
       merged_report.init_relaxations = main_report.init_relaxations;
       merged_report.init_pairs_scored = main_report.init_pairs_scored;
       merged_report.merges = main_report.merges;
-      merged_report.merges.push_back({other_report.initial_pair, (*models)[other].NumRegisteredImages(),
-                                      alignment->num_shared_points, alignment->num_inliers});
+      merged_report.merges.push_back(
+          {other_report.initial_pair, (*models)[other].NumRegisteredImages(), alignment->num_shared_points,
+           alignment->num_inliers,
+           alignment->pair_to_image < 0 ? std::string("shared points")
+                                        : "the two-view geometry of " + images[static_cast<size_t>(alignment->pair_to_image)].name +
+                                              " + " + images[static_cast<size_t>(alignment->pair_from_image)].name});
       merged_report.seconds_total += main_report.seconds_total;
       merged_report.seconds_ba += main_report.seconds_ba;
       merged_report.num_local_ba += main_report.num_local_ba;

@@ -48,12 +48,14 @@ struct MapperPair {
 
 struct MapperOptions {
   // Initial pair: at least this many tracks triangulated, with median triangulation angle at
-  // least init_min_median_angle_deg. Up to init_max_pairs_scored pairs get a quick two-view
-  // score (initial_pair.h) and up to init_max_pairs_tried of them a full try, per round.
+  // least init_min_median_angle_deg. The pairs get a quick two-view score (initial_pair.h) as far
+  // down the list as needed (up to init_max_pairs_scored; 0: all of them: in a dense capture of
+  // hundreds of photos the best-matched thousands may be neighbours without baseline), and up to
+  // init_max_pairs_tried of those that pass get a full try, per round.
   int init_min_points = 100;
   double init_min_median_angle_deg = 4.0;
   int init_max_pairs_tried = 20;
-  int init_max_pairs_scored = 500;
+  int init_max_pairs_scored = 0;
   // When no pair meets those bounds, both are halved and the pairs tried again, down to these
   // floors (COLMAP's mapper relaxes the same way): texture-poor rooms have few matches per pair.
   int init_min_points_floor = 25;
@@ -142,7 +144,8 @@ struct MapperOptions {
   int init_max_starts = 4;
   // With merge_models, another model is merged into the largest (model_merge.h) when a similarity
   // puts at least merge_min_shared_points of the 3D points they share through verified matches,
-  // and half of them, within max_reprojection_error_px in both models' views; the union is then
+  // and half of them, within max_reprojection_error_px in both models' views (else, when a verified
+  // pair between them gives the similarity: AlignModelsByTwoViewGeometry); the union is then
   // grown and adjusted as one, and kept only when it verifies: at least merge_min_shared_points of
   // its points are seen by images of both models (a wrong alignment leaves their tracks
   // untriangulable). Models of unrelated scenes share no point and stay apart.
@@ -194,6 +197,7 @@ struct MapperReport {
     int num_images = 0;
     int num_shared_points = 0;
     int num_inliers = 0;
+    std::string aligned_by;  // "shared points", or the pair whose two-view geometry aligned them
   };
   std::vector<Merge> merges;
   std::string not_merged;  // of a model not merged into the main one: why

