@@ -18,8 +18,8 @@ constexpr char kHelp[] =
     "and minimises 1/2 sum rho(|reprojection error|^2) with Levenberg-Marquardt over the Schur\n"
     "complement of the points.\n"
     "  --bal FILE            the BAL problem (text)\n"
-    "  --solver S            reduced camera system: dense, sparse or auto (default auto: dense up to\n"
-    "                        200 cameras, sparse beyond)\n"
+    "  --solver S            reduced camera system: dense, sparse or auto (default auto: sparse for\n"
+    "                        500 unknowns or more when their coupled blocks fill at most 60 %)\n"
     "  --loss L              trivial, huber or cauchy (default trivial)\n"
     "  --loss-scale S        robust loss scale in pixels (default 1)\n"
     "  --max-iterations N    LM iterations, accepted and rejected (default 100)\n"
@@ -28,16 +28,12 @@ constexpr char kHelp[] =
     "                        initial_cost, final_cost, iterations, seconds, termination\n"
     "exit codes: 0 ok (also when stopped by --max-iterations), 1 numeric failure, 2 bad usage or input\n";
 
-constexpr int kMaxDenseCameras = 200;  // --solver auto
-
-Result<BundleAdjustmentOptions::LinearSolver> SolverFromArgs(const Args& args, int num_cameras) {
+Result<BundleAdjustmentOptions::LinearSolver> SolverFromArgs(const Args& args) {
   using LinearSolver = BundleAdjustmentOptions::LinearSolver;
   const std::string name = args.Get("solver", "auto");
   if (name == "dense") return LinearSolver::kDenseCholesky;
   if (name == "sparse") return LinearSolver::kSparseCholesky;
-  if (name == "auto") {
-    return num_cameras <= kMaxDenseCameras ? LinearSolver::kDenseCholesky : LinearSolver::kSparseCholesky;
-  }
+  if (name == "auto") return LinearSolver::kAuto;
   return InvalidArgument("--solver expects dense, sparse or auto, got '" + name + "'");
 }
 
@@ -73,9 +69,8 @@ void PrintJson(const std::string& path, const BalProblem& problem, const BundleA
   std::printf("%s\n", json.str().c_str());
 }
 
-void PrintSummary(const std::string& path, const BalProblem& problem, const BundleAdjustmentOptions& options,
-                  const BundleAdjustmentSummary& s) {
-  const bool dense = options.linear_solver == BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
+void PrintSummary(const std::string& path, const BalProblem& problem, const BundleAdjustmentSummary& s) {
+  const bool dense = s.linear_solver == BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
   std::printf("%s: %d cameras, %d points, %zu observations\n", path.c_str(), problem.num_cameras(),
               problem.num_points(), problem.observations.size());
   std::printf("cost (1/2 sum of squared residuals): %.2f -> %.2f in %d iterations (%d accepted), %.2f s, %s solver\n",
@@ -106,22 +101,20 @@ int RunBundleAdjust(int argc, char** argv, int first) {
   auto threads = args.GetThreads();
   if (!threads.ok()) return Fail(threads.status());
   options.num_threads = *threads;
-  // Check the solver name before the (possibly long) read; `auto` is resolved after it.
-  if (auto solver = SolverFromArgs(args, 0); !solver.ok()) return Fail(solver.status());
+  auto solver = SolverFromArgs(args);  // before the (possibly long) read
+  if (!solver.ok()) return Fail(solver.status());
+  options.linear_solver = *solver;
 
   const std::string path = args.Get("bal");
   auto problem = ReadBalProblem(path);
   if (!problem.ok()) return Fail(problem.status());
-  auto solver = SolverFromArgs(args, problem->num_cameras());
-  if (!solver.ok()) return Fail(solver.status());
-  options.linear_solver = *solver;
 
   auto summary = SolveBundleAdjustment(options, {}, &*problem);
   if (!summary.ok()) return Fail(summary.status());
   if (args.Has("json")) {
     PrintJson(path, *problem, *summary);
   } else {
-    PrintSummary(path, *problem, options, *summary);
+    PrintSummary(path, *problem, *summary);
   }
   const bool failed = summary->termination == BundleAdjustmentSummary::Termination::kNumericFailure;
   if (failed) std::fprintf(stderr, "reconar: error: %s: bundle adjustment failed numerically\n", path.c_str());

@@ -1,25 +1,22 @@
 #include "core/optim/bundle_adjuster.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/LU>
-#include <Eigen/OrderingMethods>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 #include <algorithm>
-#include <optional>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <functional>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include "core/base/thread_pool.h"
 #include "core/math/lm_loop.h"
 #include "core/optim/bal_camera_model.h"
-#include "core/optim/cholmod_ldlt.h"
 #include "core/optim/radial_camera_model.h"
+#include "core/optim/symmetric_block_system.h"
 
 namespace reconar {
 namespace {
@@ -46,18 +43,6 @@ using Vec3 = Eigen::Vector3d;
 // The 9x9 block products below use lazyProduct: with 9 + 9 + depth >= 20 Eigen would otherwise
 // route these fixed-size products through its general (blocked GEMM) kernel, which costs more
 // than the arithmetic at this size.
-
-// SimplicialLDLT whose numeric factorisation reads our upper-triangular, naturally ordered S in
-// place: Eigen 3.4's factorize() builds a temporary SparseMatrix header (a heap allocation) on
-// every call even when it then uses the input directly. Its work vectors are on the stack up to
-// EIGEN_STACK_ALLOCATION_LIMIT (128 KiB: about 1800 cameras), on the heap beyond.
-class InPlaceLdlt : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper,
-                                                 Eigen::NaturalOrdering<int>> {
- public:
-  void FactorizeInPlace(const Eigen::SparseMatrix<double>& upper) {
-    this->template factorize_preordered<true>(upper);
-  }
-};
 
 // Observations grouped by camera or by point (compressed rows).
 struct Grouping {
@@ -87,6 +72,23 @@ class Solver {
   using Mat93 = Eigen::Matrix<double, kC, kP>;
   using Mat29 = Eigen::Matrix<double, 2, kC, Eigen::RowMajor>;
   using Vec9 = Eigen::Matrix<double, kC, 1>;
+  // A camera block is the pose (angle-axis, translation) and then the intrinsics, which cameras
+  // may share (BundleAdjustmentConstancy::intrinsics_group).
+  static constexpr int kPose = 6;
+  static constexpr int kI = kC - kPose;
+  using MatI3 = Eigen::Matrix<double, kI, kP>;
+  using MatII = Eigen::Matrix<double, kI, kI>;
+  using VecI = Eigen::Matrix<double, kI, 1>;
+  // A camera pair of the reduced system (BuildReducedSystem) and a camera's coupling with a group.
+  struct CameraPair {
+    int camera = 0;           // i2
+    int first = 0, last = 0;  // its observation pairs: pair_observations_[first, last)
+    SymmetricBlockSystem::Block block;
+  };
+  struct Border {
+    int group = 0;
+    SymmetricBlockSystem::Block block;
+  };
 
  public:
   Solver(const BundleAdjustmentOptions& options, const BundleAdjustmentConstancy& constancy,
@@ -117,12 +119,9 @@ class Solver {
     dc_diag_.resize(static_cast<size_t>(nc_));
     dp_diag_.resize(static_cast<size_t>(np_));
     step_p_.resize(static_cast<size_t>(np_));
-    const int n = kC * nc_;
-    rhs_.resize(n);
-    step_c_.resize(n);
-    solution_.resize(n);
-    BuildReducedSystemLayout();
-    BuildSharedIntrinsics(constancy.intrinsics_group);
+    step_c_.setZero(kC * nc_);
+    for (Mat93& y : y_) y.setZero();
+    BuildReducedSystem(constancy.intrinsics_group);
     cand_cameras_ = problem->cameras;
     cand_points_ = problem->points;
     const int threads = ThreadPool::ResolveThreadCount(options.num_threads);
@@ -142,6 +141,9 @@ class Solver {
     for (const Vec3& g : gp_) m = std::max(m, g.cwiseAbs().maxCoeff());
     return m;
   }
+
+  BundleAdjustmentOptions::LinearSolver linear_solver() const { return linear_solver_; }
+  int reduced_unknowns() const { return system_.size(); }
 
   bool SolveStep(double radius) {
     lambda_ = 1.0 / radius;
@@ -274,13 +276,16 @@ class Solver {
         }
         dp_diag_[static_cast<size_t>(j)] =
             v.diagonal().cwiseMax(opt_.min_diagonal).cwiseMin(opt_.max_diagonal);
+        SumGroupIntrinsicsBlocks(j);
       }
     });
   }
 
   // Solves (J^T J + lambda D) dx = -J^T r by eliminating the points: with U, V, W the camera,
   // point and cross blocks, S = U - W V^-1 W^T, S dc = -gc + W V^-1 gp, then
-  // dp = V^-1 (-gp - W^T dc). False if the Cholesky factorisation of S fails.
+  // dp = V^-1 (-gp - W^T dc). Shared intrinsics replace the camera parameters x by x = P y, P a
+  // 0/1 matrix mapping each shared parameter to its group's column, and the system by
+  // P^T S P y = P^T b, assembled here directly in y. False if its factorisation fails.
   bool SolveSchur(double lambda) {
     ParallelRange(np_, 256, [this, lambda](int begin, int end) {
       for (int j = begin; j < end; ++j) {
@@ -296,71 +301,35 @@ class Solver {
           const auto k = static_cast<size_t>(by_pt_.items[static_cast<size_t>(q)]);
           y_[k].noalias() = w_[k] * vinv;
         }
+        for (int e = point_groups_.offsets[j]; e < point_groups_.offsets[j + 1]; ++e) {
+          zv_[static_cast<size_t>(e)].noalias() = z_[static_cast<size_t>(e)] * vinv;
+        }
       }
     });
-    const std::vector<BalObservation>& obs = problem_->observations;
-    if (sparse_) {
-      std::fill(s_sparse_.valuePtr(), s_sparse_.valuePtr() + s_sparse_.nonZeros(), 0.0);
-    } else {
-      s_dense_.setZero();
-    }
-    double* const values = sparse_ ? s_sparse_.valuePtr() : s_dense_.data();
-    // Task i adds the blocks S(i, i2) for i2 <= i (original numbering), so every block of the
-    // stored (upper) triangle is written by exactly one task.
-    ParallelRange(nc_, 1, [this, lambda, &obs, values](int begin, int end) {
+    system_.SetZero();
+    ParallelRange(nc_, 1, [this, lambda](int begin, int end) {
       for (int i = begin; i < end; ++i) {
-        auto rhs = rhs_.segment<kC>(kC * cam_pos_[static_cast<size_t>(i)]);
-        const PairBlock& diag = FindPair(i, i);
-        if (const_cam_[static_cast<size_t>(i)]) {
-          AddBlock(diag, Mat99::Identity(), values);
-          rhs.setZero();
-          continue;
-        }
-        Mat99 sii = u_[static_cast<size_t>(i)];
-        sii.diagonal() += lambda * dc_diag_[static_cast<size_t>(i)];
-        for (int m : constant_parameters_) sii(m, m) = 1.0;  // row and column are zero
-        AddBlock(diag, sii, values);
-        rhs = -gc_[static_cast<size_t>(i)];
-        for (int q = by_cam_.offsets[i]; q < by_cam_.offsets[i + 1]; ++q) {
-          const auto k = static_cast<size_t>(by_cam_.items[static_cast<size_t>(q)]);
-          const int j = obs[k].point;
-          rhs.noalias() += y_[k] * gp_[static_cast<size_t>(j)];
-          for (int q2 = by_pt_.offsets[j]; q2 < by_pt_.offsets[j + 1]; ++q2) {
-            const auto k2 = static_cast<size_t>(by_pt_.items[static_cast<size_t>(q2)]);
-            const int i2 = obs[k2].camera;
-            if (i2 > i || const_cam_[static_cast<size_t>(i2)]) continue;
-            // S(i, i2) -= Y_ij W_i2j^T, stored as is or transposed.
-            const PairBlock& p = FindPair(i, i2);
-            if (p.transposed) {
-              Block(p, values).noalias() -= w_[k2].lazyProduct(y_[k].transpose());
-            } else {
-              Block(p, values).noalias() -= y_[k].lazyProduct(w_[k2].transpose());
-            }
-          }
+        if (const_cam_[static_cast<size_t>(i)]) continue;
+        if (own_size_[static_cast<size_t>(i)] == kC) {
+          AddCameraRows<kC>(i, lambda);
+        } else {
+          AddCameraRows<kPose>(i, lambda);
         }
       }
     });
-    if (sparse_) {
-      if (use_cholmod_) {
-        if (!cholmod_.Factorize(s_sparse_.valuePtr())) return false;
-        cholmod_.Solve(rhs_.data(), solution_.data());
-      } else {
-        ldlt_.FactorizeInPlace(s_sparse_);  // reads the upper triangle only
-        if (ldlt_.info() != Eigen::Success) return false;
-        solution_ = ldlt_.solve(rhs_);
-      }
-    } else if (!reduced_index_.empty()) {
-      if (!SolveShared()) return false;
-    } else {
-      dense_llt_->compute(s_dense_);  // reads the upper triangle only
-      if (dense_llt_->info() != Eigen::Success) return false;
-      solution_ = rhs_;
-      dense_llt_->solveInPlace(solution_);
-    }
+    AddGroupBlocks(lambda);
+    if (!system_.Factorize()) return false;
+    system_.Solve();
     for (int i = 0; i < nc_; ++i) {
-      step_c_.segment<kC>(kC * i) = solution_.segment<kC>(kC * cam_pos_[static_cast<size_t>(i)]);
+      if (const_cam_[static_cast<size_t>(i)]) continue;
+      auto step = step_c_.segment<kC>(kC * i);
+      const int own = own_size_[static_cast<size_t>(i)];
+      step.head(own) = system_.Solution(camera_block_[static_cast<size_t>(i)]);
+      const int g = group_[static_cast<size_t>(i)];
+      if (g >= 0) step.template tail<kI>() = system_.Solution(GroupBlock(g));
     }
     if (!step_c_.allFinite()) return false;
+    const std::vector<BalObservation>& obs = problem_->observations;
     ParallelRange(np_, 256, [this, &obs](int begin, int end) {
       for (int j = begin; j < end; ++j) {
         Vec3 b = -gp_[static_cast<size_t>(j)];
@@ -374,63 +343,246 @@ class Solver {
     return true;
   }
 
-  // Shared intrinsics replace the camera parameters x by x = P y, P a 0/1 matrix mapping each
-  // shared parameter to one column; the reduced system becomes P^T S P y = P^T b, assembled here
-  // from the upper triangle of S (S_ab with a < b contributes to (P^T S P)_pq and, when p = q,
-  // twice).
-  void BuildSharedIntrinsics(const std::vector<int>& groups) {
-    bool any = false;
-    for (int g : groups) any |= g >= 0;
-    if (!any) return;
-    const int n = kC * nc_;
-    reduced_index_.assign(static_cast<size_t>(n), -1);
-    std::vector<int> group_first_column;
-    int m = 0;
-    for (int i = 0; i < nc_; ++i) {
-      const int g = const_cam_[static_cast<size_t>(i)] ? -1 : groups[static_cast<size_t>(i)];
-      for (int k = 0; k < kC; ++k) {
-        int& index = reduced_index_[static_cast<size_t>(kC * i + k)];
-        if (k < 6 || g < 0) {
-          index = m++;
-          continue;
-        }
-        if (static_cast<size_t>(g) >= group_first_column.size()) group_first_column.resize(static_cast<size_t>(g) + 1, -1);
-        int& first = group_first_column[static_cast<size_t>(g)];
-        if (first < 0) {
-          first = m;
-          m += kC - 6;
-        }
-        index = first + (k - 6);
+  // The rows of free camera i's block (its first R parameters: the pose, and its intrinsics
+  // when it shares none): its diagonal block, the blocks coupling it with the cameras i2 <= i
+  // that share a point with it, and those coupling it with the intrinsics groups. Every block
+  // written here is written by no other camera's task.
+  template <int R>
+  void AddCameraRows(int i, double lambda) {
+    const std::vector<BalObservation>& obs = problem_->observations;
+    const int g = group_[static_cast<size_t>(i)];
+    Mat99 sii = u_[static_cast<size_t>(i)];
+    sii.diagonal() += lambda * dc_diag_[static_cast<size_t>(i)];
+    for (int m : constant_parameters_) sii(m, m) = 1.0;  // row and column are zero
+    system_.Add(diagonal_blocks_[static_cast<size_t>(i)], sii.template topLeftCorner<R, R>());
+    const auto borders_begin = borders_.begin() + border_offsets_[static_cast<size_t>(i)];
+    const auto borders_end = borders_.begin() + border_offsets_[static_cast<size_t>(i) + 1];
+    const auto border_of = [borders_begin, borders_end](int group) -> const SymmetricBlockSystem::Block& {
+      return std::find_if(borders_begin, borders_end, [group](const Border& b) { return b.group == group; })->block;
+    };
+    if (g >= 0) system_.Add(border_of(g), sii.template block<R, kI>(0, kPose));
+    // S(i, i2) -= sum_j Y_ij W_i2j^T over the two cameras' own parameters, a pair at a time.
+    for (int p = pair_offsets_[static_cast<size_t>(i)]; p < pair_offsets_[static_cast<size_t>(i) + 1]; ++p) {
+      const CameraPair& pair = pairs_[static_cast<size_t>(p)];
+      if (own_size_[static_cast<size_t>(pair.camera)] == kC) {
+        SubtractPairBlock<R, kC>(pair);
+      } else {
+        SubtractPairBlock<R, kPose>(pair);
       }
     }
-    s_reduced_.resize(m, m);
-    rhs_reduced_.resize(m);
-    reduced_llt_.emplace(m);
+    Vec9 rhs = -gc_[static_cast<size_t>(i)];
+    for (int q = by_cam_.offsets[i]; q < by_cam_.offsets[i + 1]; ++q) {
+      const auto k = static_cast<size_t>(by_cam_.items[static_cast<size_t>(q)]);
+      const int j = obs[k].point;
+      if (const_pt_[static_cast<size_t>(j)]) continue;
+      rhs.noalias() += y_[k] * gp_[static_cast<size_t>(j)];
+      // The same over the shared intrinsics of the cameras seeing j, summed per group: -Y_ij Z_jg^T.
+      for (int e = point_groups_.offsets[j]; e < point_groups_.offsets[j + 1]; ++e) {
+        system_.SubtractProduct(border_of(point_groups_.items[static_cast<size_t>(e)]),
+                                y_[k].template topRows<R>(), z_[static_cast<size_t>(e)]);
+      }
+    }
+    system_.Rhs(camera_block_[static_cast<size_t>(i)]) = rhs.template head<R>();
+    if (g >= 0) group_rhs_[static_cast<size_t>(i)] = rhs.template tail<kI>();
   }
 
-  bool SolveShared() {
-    const int n = kC * nc_;
-    s_reduced_.setZero();
-    rhs_reduced_.setZero();
-    for (int b = 0; b < n; ++b) {
-      const int q = reduced_index_[static_cast<size_t>(b)];
-      rhs_reduced_[q] += rhs_[b];
-      for (int a = 0; a <= b; ++a) {
-        const double v = s_dense_(a, b);
-        if (v == 0.0) continue;
-        const int p = reduced_index_[static_cast<size_t>(a)];
-        if (p == q) {
-          s_reduced_(p, p) += a == b ? v : 2.0 * v;
-        } else {
-          s_reduced_(std::min(p, q), std::max(p, q)) += v;
+  // Sums Y_ij W_i2j^T over the points the pair shares, in the orientation the block is stored in,
+  // and subtracts it from the block once.
+  template <int R, int C>
+  void SubtractPairBlock(const CameraPair& pair) {
+    const auto first = pair_observations_.begin() + pair.first;
+    const auto last = pair_observations_.begin() + pair.last;
+    if (pair.block.transposed) {
+      Eigen::Matrix<double, C, R> sum = Eigen::Matrix<double, C, R>::Zero();
+      for (auto it = first; it != last; ++it) {
+        sum.noalias() += w_[static_cast<size_t>(it->second)].template topRows<C>().lazyProduct(
+            y_[static_cast<size_t>(it->first)].template topRows<R>().transpose());
+      }
+      system_.SubtractStored(pair.block, sum);
+    } else {
+      Eigen::Matrix<double, R, C> sum = Eigen::Matrix<double, R, C>::Zero();
+      for (auto it = first; it != last; ++it) {
+        sum.noalias() += y_[static_cast<size_t>(it->first)].template topRows<R>().lazyProduct(
+            w_[static_cast<size_t>(it->second)].template topRows<C>().transpose());
+      }
+      system_.SubtractStored(pair.block, sum);
+    }
+  }
+
+  // The blocks among the intrinsics groups and their right-hand sides: the sums of the
+  // cameras' own intrinsic blocks and, per point, -Z_jg V_j^-1 Z_jg2^T.
+  void AddGroupBlocks(double lambda) {
+    if (num_groups_ == 0) return;
+    for (int i = 0; i < nc_; ++i) {
+      const int g = group_[static_cast<size_t>(i)];
+      if (g < 0) continue;
+      MatII d = u_[static_cast<size_t>(i)].template bottomRightCorner<kI, kI>();
+      d.diagonal() += lambda * dc_diag_[static_cast<size_t>(i)].template tail<kI>();
+      system_.Add(system_.Find(GroupBlock(g), GroupBlock(g)), d);
+      system_.Rhs(GroupBlock(g)) += group_rhs_[static_cast<size_t>(i)];
+    }
+    for (int j = 0; j < np_; ++j) {
+      for (int e = point_groups_.offsets[j]; e < point_groups_.offsets[j + 1]; ++e) {
+        const int g = point_groups_.items[static_cast<size_t>(e)];
+        for (int e2 = e; e2 < point_groups_.offsets[j + 1]; ++e2) {
+          const int g2 = point_groups_.items[static_cast<size_t>(e2)];
+          system_.SubtractProduct(system_.Find(GroupBlock(g), GroupBlock(g2)), zv_[static_cast<size_t>(e)],
+                                  z_[static_cast<size_t>(e2)]);
         }
       }
     }
-    reduced_llt_->compute(s_reduced_);
-    if (reduced_llt_->info() != Eigen::Success) return false;
-    reduced_llt_->solveInPlace(rhs_reduced_);
-    for (int a = 0; a < n; ++a) solution_[a] = rhs_reduced_[reduced_index_[static_cast<size_t>(a)]];
-    return true;
+    for (int m : constant_parameters_) {
+      if (m < kPose) continue;
+      for (int g = 0; g < num_groups_; ++g) system_.SetDiagonal(GroupBlock(g), m - kPose, 1.0);
+    }
+  }
+
+  // Z_jg = sum of W_ij's intrinsic rows over the cameras i of group g that see point j.
+  void SumGroupIntrinsicsBlocks(int j) {
+    const int first = point_groups_.offsets[j], last = point_groups_.offsets[j + 1];
+    if (first == last) return;
+    for (int e = first; e < last; ++e) z_[static_cast<size_t>(e)].setZero();
+    const std::vector<BalObservation>& obs = problem_->observations;
+    for (int q = by_pt_.offsets[j]; q < by_pt_.offsets[j + 1]; ++q) {
+      const auto k = static_cast<size_t>(by_pt_.items[static_cast<size_t>(q)]);
+      const int g = group_[static_cast<size_t>(obs[k].camera)];
+      if (g < 0) continue;
+      const auto it = std::lower_bound(point_groups_.items.begin() + first, point_groups_.items.begin() + last, g);
+      z_[static_cast<size_t>(it - point_groups_.items.begin())] += w_[k].template bottomRows<kI>();
+    }
+  }
+
+  int GroupBlock(int g) const { return num_free_cameras_ + g; }
+
+  // The unknowns of the reduced system, in blocks: one per free camera (its pose, and its own
+  // intrinsics when it shares none), then one per intrinsics group (the shared intrinsics,
+  // indices kPose.. of the camera block). Constant cameras have none (their step is zero); a
+  // constant parameter keeps its unknown with a unit diagonal. The dense storage keeps the free
+  // cameras in their order; the sparse one orders them by AMD on the camera graph, the groups
+  // last. The pattern, where each block is stored, the observation pairs behind each camera pair
+  // and the symbolic factorisation are all set up here, before the iterations.
+  void BuildReducedSystem(const std::vector<int>& groups) {
+    const std::vector<BalObservation>& obs = problem_->observations;
+    camera_block_.assign(static_cast<size_t>(nc_), -1);
+    group_.assign(static_cast<size_t>(nc_), -1);
+    own_size_.assign(static_cast<size_t>(nc_), kC);
+    std::vector<int> group_of_id;  // caller's group id -> ours
+    std::vector<int> block_sizes;
+    for (int i = 0; i < nc_; ++i) {
+      if (const_cam_[static_cast<size_t>(i)]) continue;
+      camera_block_[static_cast<size_t>(i)] = num_free_cameras_++;
+      const int id = groups.empty() ? -1 : groups[static_cast<size_t>(i)];
+      if (id < 0) {
+        block_sizes.push_back(kC);
+        continue;
+      }
+      if (static_cast<size_t>(id) >= group_of_id.size()) group_of_id.resize(static_cast<size_t>(id) + 1, -1);
+      int& g = group_of_id[static_cast<size_t>(id)];
+      if (g < 0) g = num_groups_++;
+      group_[static_cast<size_t>(i)] = g;
+      own_size_[static_cast<size_t>(i)] = kPose;
+      block_sizes.push_back(kPose);
+    }
+    block_sizes.insert(block_sizes.end(), static_cast<size_t>(num_groups_), kI);
+    group_rhs_.assign(static_cast<size_t>(nc_), VecI::Zero());
+
+    // Per free point, the groups of the free cameras that see it (and the groups coupled
+    // through it).
+    std::vector<std::pair<int, int>> coupled;
+    point_groups_.offsets.assign(static_cast<size_t>(np_) + 1, 0);
+    point_groups_.items.clear();
+    for (int j = 0; j < np_; ++j) {
+      const size_t first = point_groups_.items.size();
+      for (int q = by_pt_.offsets[j]; q < by_pt_.offsets[j + 1] && !const_pt_[static_cast<size_t>(j)]; ++q) {
+        const int g = group_[static_cast<size_t>(obs[static_cast<size_t>(by_pt_.items[static_cast<size_t>(q)])].camera)];
+        if (g >= 0) point_groups_.items.push_back(g);
+      }
+      const auto begin = point_groups_.items.begin() + static_cast<std::ptrdiff_t>(first);
+      std::sort(begin, point_groups_.items.end());
+      point_groups_.items.erase(std::unique(begin, point_groups_.items.end()), point_groups_.items.end());
+      point_groups_.offsets[static_cast<size_t>(j) + 1] = static_cast<int>(point_groups_.items.size());
+      for (size_t e = first; e < point_groups_.items.size(); ++e) {
+        for (size_t e2 = first; e2 < e; ++e2) {
+          coupled.emplace_back(GroupBlock(point_groups_.items[e2]), GroupBlock(point_groups_.items[e]));
+        }
+      }
+    }
+    std::sort(coupled.begin(), coupled.end());
+    coupled.erase(std::unique(coupled.begin(), coupled.end()), coupled.end());
+    z_.resize(point_groups_.items.size());
+    zv_.resize(point_groups_.items.size());
+
+    // Per free camera i, the free cameras i2 <= i it shares free points with, each with the
+    // observation pairs (k of i, k2 of i2) of those points, and the groups it is coupled with.
+    pair_offsets_.assign(static_cast<size_t>(nc_) + 1, 0);
+    border_offsets_.assign(static_cast<size_t>(nc_) + 1, 0);
+    std::vector<std::array<int, 3>> shared;  // (i2, k, k2)
+    std::vector<int> coupled_groups;
+    for (int i = 0; i < nc_; ++i) {
+      shared.clear();
+      coupled_groups.clear();
+      if (group_[static_cast<size_t>(i)] >= 0) coupled_groups.push_back(group_[static_cast<size_t>(i)]);
+      for (int q = by_cam_.offsets[i]; q < by_cam_.offsets[i + 1] && !const_cam_[static_cast<size_t>(i)]; ++q) {
+        const int k = by_cam_.items[static_cast<size_t>(q)];
+        const int j = obs[static_cast<size_t>(k)].point;
+        if (const_pt_[static_cast<size_t>(j)]) continue;
+        for (int q2 = by_pt_.offsets[j]; q2 < by_pt_.offsets[j + 1]; ++q2) {
+          const int k2 = by_pt_.items[static_cast<size_t>(q2)];
+          const int i2 = obs[static_cast<size_t>(k2)].camera;
+          if (i2 <= i && !const_cam_[static_cast<size_t>(i2)]) shared.push_back({i2, k, k2});
+        }
+        for (int e = point_groups_.offsets[j]; e < point_groups_.offsets[j + 1]; ++e) {
+          coupled_groups.push_back(point_groups_.items[static_cast<size_t>(e)]);
+        }
+      }
+      std::sort(shared.begin(), shared.end());
+      for (size_t a = 0; a < shared.size();) {
+        size_t b = a;
+        while (b < shared.size() && shared[b][0] == shared[a][0]) {
+          pair_observations_.emplace_back(shared[b][1], shared[b][2]);
+          ++b;
+        }
+        CameraPair pair;
+        pair.camera = shared[a][0];
+        pair.last = static_cast<int>(pair_observations_.size());
+        pair.first = pair.last - static_cast<int>(b - a);
+        pairs_.push_back(pair);
+        coupled.emplace_back(camera_block_[static_cast<size_t>(pair.camera)], camera_block_[static_cast<size_t>(i)]);
+        a = b;
+      }
+      pair_offsets_[static_cast<size_t>(i) + 1] = static_cast<int>(pairs_.size());
+      std::sort(coupled_groups.begin(), coupled_groups.end());
+      coupled_groups.erase(std::unique(coupled_groups.begin(), coupled_groups.end()), coupled_groups.end());
+      for (int g : coupled_groups) {
+        borders_.push_back({g, {}});
+        coupled.emplace_back(camera_block_[static_cast<size_t>(i)], GroupBlock(g));
+      }
+      border_offsets_[static_cast<size_t>(i) + 1] = static_cast<int>(borders_.size());
+    }
+    linear_solver_ = opt_.linear_solver;
+    if (linear_solver_ == BundleAdjustmentOptions::LinearSolver::kAuto) {
+      const SymmetricBlockSystem::Shape shape = SymmetricBlockSystem::ShapeOf(block_sizes, coupled);
+      const bool sparse = shape.unknowns >= BundleAdjustmentOptions::kMinSparseUnknowns &&
+                          shape.fill <= BundleAdjustmentOptions::kMaxSparseFill;
+      linear_solver_ = sparse ? BundleAdjustmentOptions::LinearSolver::kSparseCholesky
+                              : BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
+    }
+    const bool sparse = linear_solver_ == BundleAdjustmentOptions::LinearSolver::kSparseCholesky;
+    system_.Build(block_sizes, coupled, num_groups_,
+                  sparse ? SymmetricBlockSystem::Storage::kSparse : SymmetricBlockSystem::Storage::kDense);
+    diagonal_blocks_.resize(static_cast<size_t>(nc_));
+    for (int i = 0; i < nc_; ++i) {
+      const int block = camera_block_[static_cast<size_t>(i)];
+      if (block < 0) continue;
+      diagonal_blocks_[static_cast<size_t>(i)] = system_.Find(block, block);
+      for (int p = pair_offsets_[static_cast<size_t>(i)]; p < pair_offsets_[static_cast<size_t>(i) + 1]; ++p) {
+        CameraPair& pair = pairs_[static_cast<size_t>(p)];
+        pair.block = system_.Find(block, camera_block_[static_cast<size_t>(pair.camera)]);
+      }
+      for (int b = border_offsets_[static_cast<size_t>(i)]; b < border_offsets_[static_cast<size_t>(i) + 1]; ++b) {
+        borders_[static_cast<size_t>(b)].block = system_.Find(block, GroupBlock(borders_[static_cast<size_t>(b)].group));
+      }
+    }
   }
 
   void ApplyStep() {
@@ -481,152 +633,28 @@ class Solver {
   std::vector<Mat33> v_, vinv_;
   std::vector<Vec9> gc_, dc_diag_;
   std::vector<Vec3> gp_, dp_diag_, step_p_;
-  // Where block S(i, i2) of the reduced camera system lives: values[offset + b * stride + a]
-  // holds entry (a, b) of the block, transposed when the block is stored as S(i2, i).
-  struct PairBlock {
-    int camera = 0;  // i2
-    bool transposed = false;
-    std::ptrdiff_t offset = 0;
-    std::ptrdiff_t stride = 0;
-  };
-
-  const PairBlock& FindPair(int i, int i2) const {
-    const auto first = pairs_.begin() + pair_offsets_[static_cast<size_t>(i)];
-    const auto last = pairs_.begin() + pair_offsets_[static_cast<size_t>(i) + 1];
-    const auto it =
-        std::lower_bound(first, last, i2, [](const PairBlock& p, int c) { return p.camera < c; });
-    return *it;
-  }
-
-  using BlockMap = Eigen::Map<Mat99, Eigen::Unaligned, Eigen::OuterStride<>>;
-  static BlockMap Block(const PairBlock& p, double* values) {
-    return BlockMap(values + p.offset, kC, kC, Eigen::OuterStride<>(p.stride));
-  }
-  static void AddBlock(const PairBlock& p, const Mat99& m, double* values) {
-    if (p.transposed) {
-      Block(p, values) += m.transpose();
-    } else {
-      Block(p, values) += m;
-    }
-  }
-
-  // Camera positions in the reduced system (identity for dense; approximate minimum degree on
-  // the camera graph, Amestoy, Davis & Duff 1996, for sparse), the block pattern, and the
-  // symbolic factorisation: all done once, before the iterations.
-  void BuildReducedSystemLayout() {
-    const int n = kC * nc_;
-    sparse_ = opt_.linear_solver == BundleAdjustmentOptions::LinearSolver::kSparseCholesky;
-    const std::vector<BalObservation>& obs = problem_->observations;
-    std::vector<std::vector<int>> neighbours(static_cast<size_t>(nc_));
-    for (int i = 0; i < nc_; ++i) neighbours[static_cast<size_t>(i)].push_back(i);
-    for (int j = 0; j < np_; ++j) {
-      for (int q = by_pt_.offsets[j]; q < by_pt_.offsets[j + 1]; ++q) {
-        for (int q2 = by_pt_.offsets[j]; q2 < by_pt_.offsets[j + 1]; ++q2) {
-          const int i = obs[static_cast<size_t>(by_pt_.items[static_cast<size_t>(q)])].camera;
-          const int i2 = obs[static_cast<size_t>(by_pt_.items[static_cast<size_t>(q2)])].camera;
-          if (i2 < i) neighbours[static_cast<size_t>(i)].push_back(i2);
-        }
-      }
-    }
-    for (std::vector<int>& v : neighbours) {
-      std::sort(v.begin(), v.end());
-      v.erase(std::unique(v.begin(), v.end()), v.end());
-    }
-    cam_pos_.resize(static_cast<size_t>(nc_));
-    for (int i = 0; i < nc_; ++i) cam_pos_[static_cast<size_t>(i)] = i;
-    if (sparse_ && nc_ > 1) {
-      std::vector<Eigen::Triplet<int>> triplets;
-      for (int i = 0; i < nc_; ++i) {
-        for (int i2 : neighbours[static_cast<size_t>(i)]) {
-          triplets.emplace_back(i, i2, 1);
-          triplets.emplace_back(i2, i, 1);
-        }
-      }
-      Eigen::SparseMatrix<int> graph(nc_, nc_);
-      graph.setFromTriplets(triplets.begin(), triplets.end());
-      Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> pinv;
-      Eigen::AMDOrdering<int> amd;
-      amd(graph, pinv);  // pinv.indices()[new position] = camera
-      if (pinv.size() == nc_) {
-        for (int p = 0; p < nc_; ++p) cam_pos_[static_cast<size_t>(pinv.indices()[p])] = p;
-      }
-    }
-    // Stored upper triangle: block (pr, pc) with pr <= pc; per block column, sorted row blocks.
-    std::vector<std::vector<int>> column_blocks(static_cast<size_t>(nc_));
-    for (int i = 0; i < nc_; ++i) {
-      for (int i2 : neighbours[static_cast<size_t>(i)]) {
-        const int a = cam_pos_[static_cast<size_t>(i)], b = cam_pos_[static_cast<size_t>(i2)];
-        column_blocks[static_cast<size_t>(std::max(a, b))].push_back(std::min(a, b));
-      }
-    }
-    for (std::vector<int>& v : column_blocks) std::sort(v.begin(), v.end());
-    if (sparse_) {
-      Eigen::VectorXi column_sizes(n);
-      for (int pc = 0; pc < nc_; ++pc) {
-        const auto len = static_cast<int>(column_blocks[static_cast<size_t>(pc)].size());
-        column_sizes.segment<kC>(kC * pc).setConstant(kC * len);
-      }
-      s_sparse_.resize(n, n);
-      s_sparse_.reserve(column_sizes);
-      for (int pc = 0; pc < nc_; ++pc) {
-        for (int b = 0; b < kC; ++b) {
-          for (int pr : column_blocks[static_cast<size_t>(pc)]) {
-            for (int a = 0; a < kC; ++a) s_sparse_.insert(kC * pr + a, kC * pc + b) = 0.0;
-          }
-        }
-      }
-      s_sparse_.makeCompressed();
-      // CHOLMOD's supernodal factorisation when built with it; Eigen's simplicial LDL^T otherwise
-      // (or if CHOLMOD refuses the pattern).
-      use_cholmod_ = SparseCholesky::IsAvailable() &&
-                     cholmod_.Analyze(n, s_sparse_.outerIndexPtr(), s_sparse_.innerIndexPtr()).ok();
-      if (!use_cholmod_) ldlt_.analyzePattern(s_sparse_);
-    } else {
-      s_dense_.resize(n, n);
-      // Constructed in place: Eigen's LLT leaves its status member unset until compute(), so
-      // copying a fresh one reads an indeterminate value (UBSan reports it).
-      dense_llt_.emplace(n);
-    }
-    pair_offsets_.assign(static_cast<size_t>(nc_) + 1, 0);
-    for (int i = 0; i < nc_; ++i) {
-      pair_offsets_[static_cast<size_t>(i) + 1] =
-          pair_offsets_[static_cast<size_t>(i)] +
-          static_cast<int>(neighbours[static_cast<size_t>(i)].size());
-      for (int i2 : neighbours[static_cast<size_t>(i)]) {
-        const int a = cam_pos_[static_cast<size_t>(i)], b = cam_pos_[static_cast<size_t>(i2)];
-        const int pr = std::min(a, b), pc = std::max(a, b);
-        PairBlock p;
-        p.camera = i2;
-        p.transposed = a > b;
-        if (sparse_) {
-          const std::vector<int>& rows = column_blocks[static_cast<size_t>(pc)];
-          const auto rank = std::lower_bound(rows.begin(), rows.end(), pr) - rows.begin();
-          p.offset = s_sparse_.outerIndexPtr()[kC * pc] + kC * rank;
-          p.stride = kC * static_cast<std::ptrdiff_t>(rows.size());
-        } else {
-          p.offset = static_cast<std::ptrdiff_t>(kC) * pc * n + kC * pr;
-          p.stride = n;
-        }
-        pairs_.push_back(p);
-      }
-    }
-  }
-
-  bool sparse_ = false;
-  std::vector<int> reduced_index_;  // shared intrinsics: column of each camera parameter, or empty
-  Eigen::MatrixXd s_reduced_;
-  Eigen::VectorXd rhs_reduced_;
-  std::optional<Eigen::LLT<Eigen::MatrixXd, Eigen::Upper>> reduced_llt_;
-  std::vector<int> cam_pos_;
-  std::vector<int> pair_offsets_;
-  std::vector<PairBlock> pairs_;
-  Eigen::MatrixXd s_dense_;
-  std::optional<Eigen::LLT<Eigen::MatrixXd, Eigen::Upper>> dense_llt_;
-  Eigen::SparseMatrix<double> s_sparse_;
-  InPlaceLdlt ldlt_;
-  SparseCholesky cholmod_;
-  bool use_cholmod_ = false;
-  Eigen::VectorXd rhs_, step_c_, solution_;
+  // The reduced system (BuildReducedSystem): per camera its block (-1 when constant), its
+  // intrinsics group (-1 for none) and the size of its own part of the camera block (kPose or
+  // kC); per point the groups of its free observers (sorted) with Z_jg and Z_jg V_j^-1.
+  std::vector<int> camera_block_, group_, own_size_;
+  int num_free_cameras_ = 0, num_groups_ = 0;
+  struct {
+    std::vector<int> offsets;  // size points + 1
+    std::vector<int> items;    // group indices
+  } point_groups_;
+  std::vector<MatI3> z_, zv_;
+  // Per free camera: where its diagonal block is stored; the cameras i2 <= i it shares points
+  // with (pairs_[pair_offsets_[i] ..], by i2), each with its observation pairs (k of i, k2 of
+  // i2) and where S(i, i2) is stored; the groups it is coupled with and where those blocks are.
+  std::vector<SymmetricBlockSystem::Block> diagonal_blocks_;
+  std::vector<int> pair_offsets_, border_offsets_;
+  std::vector<CameraPair> pairs_;
+  std::vector<std::pair<int, int>> pair_observations_;
+  std::vector<Border> borders_;
+  std::vector<VecI> group_rhs_;  // per grouped camera: the intrinsic rows of its right-hand side
+  BundleAdjustmentOptions::LinearSolver linear_solver_ = BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
+  SymmetricBlockSystem system_;
+  Eigen::VectorXd step_c_;
   std::vector<double> cand_cameras_, cand_points_;
   double cost_ = 0.0;
   double lambda_ = 0.0;  // damping of the last SolveStep
@@ -687,9 +715,6 @@ Result<BundleAdjustmentSummary> SolveImpl(const BundleAdjustmentOptions& options
     if (constancy.intrinsics_group.size() != static_cast<size_t>(problem->num_cameras())) {
       return InvalidArgument("SolveBundleAdjustment: intrinsics_group size != camera count");
     }
-    if (options.linear_solver != BundleAdjustmentOptions::LinearSolver::kDenseCholesky) {
-      return InvalidArgument("SolveBundleAdjustment: shared intrinsics need the dense solver");
-    }
   }
   for (int m : constancy.constant_camera_parameters) {
     if (m < 0 || m >= Model::Problem::kCameraSize) {
@@ -701,6 +726,8 @@ Result<BundleAdjustmentSummary> SolveImpl(const BundleAdjustmentOptions& options
   Solver<Model> solver(options, constancy, problem);
   BundleAdjustmentSummary summary;
   static_cast<LmSummary&>(summary) = RunLm(solver, options);
+  summary.linear_solver = solver.linear_solver();
+  summary.reduced_unknowns = solver.reduced_unknowns();
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

@@ -5,8 +5,9 @@
 // 2004, sec. 3.2), Marquardt scaling of the damping by diag(J^T J), analytic Jacobians
 // (bal_camera_model.h, radial_camera_model.h), and the Schur
 // complement that eliminates the points (Triggs et al., "Bundle Adjustment - A Modern
-// Synthesis", 2000, sec. 6.1; Brown 1958). The reduced camera system is solved with a dense
-// Cholesky factorisation or, optionally, a block-sparse LDL^T.
+// Synthesis", 2000, sec. 6.1; Brown 1958). The reduced camera system, in the unknowns of the
+// shared intrinsics when cameras share them, is solved with a dense Cholesky factorisation or a
+// sparse one (symmetric_block_system.h).
 #include <vector>
 
 #include "core/base/status.h"
@@ -28,14 +29,24 @@ struct BundleAdjustmentOptions : LmOptions {
   // diag(J^T J) is clamped to [min_diagonal, max_diagonal] before scaling the damping.
   double max_diagonal = 1e32;
   RobustLoss loss;
-  // Solver of the reduced camera system S dc = b (S is 9 * cameras square).
+  // Solver of the reduced camera system S dc = b: a block per free camera (its camera
+  // parameters, or only its pose when it shares its intrinsics) and one per intrinsics group.
   enum class LinearSolver {
-    kDenseCholesky,   // Eigen LLT on dense S: best for up to a few hundred cameras
-    kSparseCholesky,  // block-sparse S (camera pairs sharing a point), AMD camera ordering,
-                      // CHOLMOD supernodal Cholesky (Eigen SimplicialLDLT when built without
-                      // CHOLMOD): for larger problems with sparse camera graphs
+    kDenseCholesky,   // Eigen LLT on dense S: for small problems and dense camera graphs
+    kSparseCholesky,  // S's coupled blocks (camera pairs sharing a point, cameras and the groups
+                      // they see), AMD camera ordering with the groups last, CHOLMOD supernodal
+                      // Cholesky (Eigen SimplicialLDLT when built without CHOLMOD)
+    kAuto,            // sparse when S has at least kMinSparseUnknowns unknowns and its coupled
+                      // blocks fill at most kMaxSparseFill of its upper triangle, else dense
   };
-  LinearSolver linear_solver = LinearSolver::kDenseCholesky;
+  // The crossover of kAuto, measured on the mapper's global adjustments (docs/figures.md, "The
+  // bundle adjuster's linear solvers"): on a 400-photo corridor walk sparse took 0.78 of dense's
+  // time at 570 unknowns and fill 0.53, 0.20 at 2406 and 0.12, but 1.07 at fill 0.65; round the
+  // 320-photo bunny (fill 0.66 at the end) dense was faster at every size (sparse 1.1 to 1.5x).
+  // Under 500 unknowns either takes under 0.1 s.
+  static constexpr int kMinSparseUnknowns = 500;
+  static constexpr double kMaxSparseFill = 0.6;
+  LinearSolver linear_solver = LinearSolver::kAuto;
   int num_threads = 1;  // <= 0: one per core
 
   // InvalidArgument naming the first offending field.
@@ -48,6 +59,9 @@ struct BundleAdjustmentOptions : LmOptions {
 // max_consecutive_numeric_failures times in a row.
 struct BundleAdjustmentSummary : LmSummary {
   double seconds = 0.0;  // wall time of SolveBundleAdjustment (setup included)
+  // The solver that ran (kAuto resolved) and the size of its reduced system.
+  BundleAdjustmentOptions::LinearSolver linear_solver = BundleAdjustmentOptions::LinearSolver::kDenseCholesky;
+  int reduced_unknowns = 0;
 };
 
 // Which parameter blocks are held constant; empty vectors mean every block is free, otherwise
@@ -59,8 +73,8 @@ struct BundleAdjustmentConstancy {
   // the principal point of a RadialProblem camera).
   std::vector<int> constant_camera_parameters;
   // Shared intrinsics: empty, or one entry per camera; free cameras with the same non-negative
-  // group share the intrinsic parameters (index 6 onwards of the block: f, k1, k2 [, cx, cy]),
-  // which must start out equal. Dense solver only.
+  // group share the intrinsic parameters (index 6 onwards of the block: f, k1, k2 [, cx, cy, a]),
+  // which must start out equal.
   std::vector<int> intrinsics_group;
 };
 

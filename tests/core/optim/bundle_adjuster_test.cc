@@ -65,10 +65,9 @@ INSTANTIATE_TEST_SUITE_P(
              (std::get<1>(param_info.param) == LinearSolver::kDenseCholesky ? "Dense" : "Sparse");
     });
 
-TEST(BundleAdjusterTest, SparseAndDenseSolversAgree) {
-  // A sparse camera graph: 30 cameras in a row, each point seen by 3 consecutive cameras.
+// A sparse camera graph: cameras in a row, each point seen by 3 consecutive cameras.
+BalProblem MakeChain(int num_cameras) {
   BalProblem truth;
-  const int num_cameras = 30;
   const BalProblem ring = testing::MakeSyntheticBal(num_cameras, 1, 21);
   truth.cameras = ring.cameras;
   for (int j = 0; j < 40 * num_cameras; ++j) {
@@ -81,6 +80,11 @@ TEST(BundleAdjusterTest, SparseAndDenseSolversAgree) {
       truth.observations.push_back({i, j, uv[0], uv[1]});
     }
   }
+  return truth;
+}
+
+TEST(BundleAdjusterTest, SparseAndDenseSolversAgree) {
+  const BalProblem truth = MakeChain(30);
   BalProblem dense = truth;
   testing::PerturbBal(&dense, 22, 2);
   BalProblem sparse = dense;
@@ -96,6 +100,35 @@ TEST(BundleAdjusterTest, SparseAndDenseSolversAgree) {
   EXPECT_NEAR(rd->final_cost, rs->final_cost, 1e-9 * rd->initial_cost);
   EXPECT_LT(MaxAbsDiff(dense.cameras, sparse.cameras), 1e-6);
   EXPECT_LT(MaxAbsDiff(dense.points, sparse.points), 1e-6);
+}
+
+// kAuto: sparse from kMinSparseUnknowns unknowns when the coupled blocks fill at most
+// kMaxSparseFill of the reduced system, dense otherwise.
+TEST(BundleAdjusterTest, AutoSolverFollowsSizeAndFill) {
+  using Options = BundleAdjustmentOptions;
+  BundleAdjustmentOptions options;
+  options.max_iterations = 1;
+  ASSERT_EQ(options.linear_solver, LinearSolver::kAuto);
+  // 58 free cameras of 9 parameters in a chain: 522 unknowns, 3 blocks of 58 in a row coupled.
+  BalProblem chain = MakeChain(60);
+  BundleAdjustmentConstancy constancy = FirstTwoCamerasConstant(chain);
+  Result<BundleAdjustmentSummary> r = SolveBundleAdjustment(options, constancy, &chain);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->reduced_unknowns, 58 * 9);
+  static_assert(58 * 9 >= Options::kMinSparseUnknowns);
+  EXPECT_EQ(r->linear_solver, LinearSolver::kSparseCholesky);
+  // Sharing the intrinsics leaves 58 poses and one f, k1, k2: too small for the sparse solver.
+  constancy.intrinsics_group.assign(60, 0);
+  r = SolveBundleAdjustment(options, constancy, &chain);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->reduced_unknowns, 58 * 6 + 3);
+  EXPECT_EQ(r->linear_solver, LinearSolver::kDenseCholesky);
+  // Every camera pair shares points: dense at any size.
+  BalProblem all_pairs = testing::MakeSyntheticBal(60, 100, 3);
+  r = SolveBundleAdjustment(options, FirstTwoCamerasConstant(all_pairs), &all_pairs);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->reduced_unknowns, 58 * 9);
+  EXPECT_EQ(r->linear_solver, LinearSolver::kDenseCholesky);
 }
 
 TEST(BundleAdjusterTest, ThreadCountDoesNotChangeResult) {
