@@ -112,7 +112,7 @@ void NoModel(const std::string& why, int iterations, AbsolutePoseResult* result)
 // RANSAC on the outliers of the first pose (second_pose_from_outliers): the pose found there,
 // finished like the first, replaces it when it has more inliers, else becomes its alternative.
 Status TrySecondPose(const std::vector<Eigen::Vector2d>& points_px, const std::vector<Eigen::Vector3d>& world_points,
-                     const RadialCamera& camera, const AbsolutePoseOptions& options,
+                     const RadialCamera& camera, const AbsolutePoseOptions& options, const RansacOptions& ransac,
                      const std::vector<PoseCorrespondence>& samples, const std::vector<int>& sample_to_input,
                      const std::vector<char>& first_mask, AbsolutePoseResult* result) {
   std::vector<PoseCorrespondence> outliers;
@@ -120,8 +120,6 @@ Status TrySecondPose(const std::vector<Eigen::Vector2d>& points_px, const std::v
     if (!first_mask[i]) outliers.push_back(samples[i]);
   }
   if (static_cast<int>(outliers.size()) <= P3PEstimator::kMinSamples) return Status::Ok();
-  RansacOptions ransac = options.ransac;
-  ransac.max_residual = options.max_error_px / camera.focal;
   RECONAR_ASSIGN_OR_RETURN(const auto report, (Ransac<P3PEstimator, PoseLocalEstimator>::Run(outliers, ransac)));
   result->ransac_iterations += report.iterations;
   Eigen::Matrix3d R;
@@ -221,7 +219,7 @@ Result<AbsolutePoseResult> EstimateAbsolutePose(const std::vector<Eigen::Vector2
   FinishPose(points_px, world_points, camera, options, options.refine_focal, R, t,
              MaskToIndices(report.inlier_mask, sample_to_input), &result);
   if (options.second_pose_from_outliers) {
-    RECONAR_RETURN_IF_ERROR(TrySecondPose(points_px, world_points, camera, options, samples, sample_to_input,
+    RECONAR_RETURN_IF_ERROR(TrySecondPose(points_px, world_points, camera, options, ransac, samples, sample_to_input,
                                           report.inlier_mask, &result));
   }
   return result;
