@@ -297,7 +297,7 @@ void WriteSfmReportFields(const SfmStageReport& sfm, JsonWriter* json) {
   json->Key("distortion_refined").Bool(m.distortion_refined);
   json->Key("aspect_refined").Bool(m.aspect_refined);
   json->Key("tracks").Int(m.num_tracks);
-  json->Key("inconsistent_tracks_dropped").Int(m.num_inconsistent_tracks);
+  json->Key("conflicting_matches_left_out").Int(m.num_conflicting_matches);
   json->Key("seconds_mapping").Double(sfm.seconds_mapping);
   json->Key("seconds_bundle_adjustment").Double(m.seconds_ba);
   json->Key("local_bundle_adjustments").Int(m.num_local_ba);

@@ -141,7 +141,7 @@ class Mapper {
     }
     model_.SetTracks(BuildTracks(num_keypoints, matches));
     report_->num_tracks = static_cast<int>(model_.tracks.tracks.size());
-    report_->num_inconsistent_tracks = model_.tracks.num_inconsistent;
+    report_->num_conflicting_matches = model_.tracks.num_conflicting_matches;
     return Status::Ok();
   }
 

@@ -164,7 +164,7 @@ struct MapperReport {
   int num_registered = 0;
   int num_points = 0;
   int num_tracks = 0;
-  int num_inconsistent_tracks = 0;
+  int num_conflicting_matches = 0;
   std::string initial_pair;  // "a.jpg + b.jpg"
   int initial_image_a = -1, initial_image_b = -1;
   int init_starts = 1;       // how often the model was started (a failed start is built again)

@@ -100,8 +100,8 @@ void ExpectRingReconstructed(const SceneOptions& scene_options, const MapperOpti
   std::printf("  %zu pairs, %d true + %d wrong matches; %.2f s (BA %.2f s), %d local + %d global BA\n",
               scene.pairs.size(), scene.num_true_matches, scene.num_wrong_matches, seconds, report.seconds_ba,
               report.num_local_ba, report.num_global_ba);
-  std::printf("  %d tracks (%d inconsistent), %d points, mean track %.2f, mean error %.3f px, initial %s\n",
-              report.num_tracks, report.num_inconsistent_tracks, report.num_points, report.mean_track_length,
+  std::printf("  %d tracks (%d conflicting matches left out), %d points, mean track %.2f, mean error %.3f px, initial %s\n",
+              report.num_tracks, report.num_conflicting_matches, report.num_points, report.mean_track_length,
               report.mean_reprojection_error_px, report.initial_pair.c_str());
 
   // Every image registered; the report agrees with the model.
@@ -109,7 +109,7 @@ void ExpectRingReconstructed(const SceneOptions& scene_options, const MapperOpti
   for (const auto& u : report.unregistered) ADD_FAILURE() << u.name << " unregistered: " << u.reason;
   ExpectModelConsistent(model, report, n);
   EXPECT_FALSE(report.initial_pair.empty());
-  EXPECT_GT(report.num_inconsistent_tracks, 0);  // the true-true wrong matches merge tracks
+  EXPECT_GT(report.num_conflicting_matches, 0);  // the true-true wrong matches merge tracks
   EXPECT_GE(report.seconds_total, report.seconds_ba);
   ASSERT_FALSE(progress.empty());
   EXPECT_EQ(progress.back(), std::make_pair(static_cast<int>(n), static_cast<int>(n)));

@@ -63,13 +63,13 @@ TEST(BuildTracksTest, EmptyInput) {
   const TrackSet none = BuildTracks({}, {});
   EXPECT_TRUE(none.tracks.empty());
   EXPECT_TRUE(none.track_of.empty());
-  EXPECT_EQ(none.num_inconsistent, 0);
+  EXPECT_EQ(none.num_conflicting_matches, 0);
 
   // Images with keypoints but no pairs, and a pair without matches: no tracks, all -1.
   const std::vector<int> num_keypoints = {3, 0, 2};
   const TrackSet unmatched = BuildTracks(num_keypoints, {Pair(0, 2, {})});
   EXPECT_TRUE(unmatched.tracks.empty());
-  EXPECT_EQ(unmatched.num_inconsistent, 0);
+  EXPECT_EQ(unmatched.num_conflicting_matches, 0);
   ExpectConsistent(num_keypoints, unmatched);
   EXPECT_EQ(unmatched.track_of[0], std::vector<int>({-1, -1, -1}));
   EXPECT_TRUE(unmatched.track_of[1].empty());
@@ -88,7 +88,7 @@ TEST(BuildTracksTest, ChainAcrossFourImagesIsOneTrackSortedByImage) {
   const TrackSet set = BuildTracks(num_keypoints, pairs);
   ExpectConsistent(num_keypoints, set);
   ASSERT_EQ(set.tracks.size(), 1u);
-  EXPECT_EQ(set.num_inconsistent, 0);
+  EXPECT_EQ(set.num_conflicting_matches, 0);
   EXPECT_EQ(Elements(set.tracks[0]), (std::vector<std::pair<int, int>>{{0, 2}, {1, 4}, {2, 0}, {3, 1}}));
   // Unmatched keypoints stay -1.
   EXPECT_EQ(set.track_of[0], std::vector<int>({-1, -1, 0}));
@@ -109,7 +109,7 @@ TEST(BuildTracksTest, SeveralTracksAndRedundantMatches) {
   };
   const TrackSet set = BuildTracks(num_keypoints, pairs);
   ExpectConsistent(num_keypoints, set);
-  EXPECT_EQ(set.num_inconsistent, 0);
+  EXPECT_EQ(set.num_conflicting_matches, 0);
   ASSERT_EQ(set.tracks.size(), 3u);
   std::set<std::vector<std::pair<int, int>>> got;
   for (const auto& track : set.tracks) got.insert(Elements(track));
@@ -126,10 +126,11 @@ TEST(BuildTracksTest, SeveralTracksAndRedundantMatches) {
   EXPECT_NE(set.track_of[0][0], set.track_of[0][1]);
 }
 
-TEST(BuildTracksTest, ComponentWithTwoKeypointsOfOneImageIsDropped) {
-  // Good track: 0:0 1:0 2:0. Bad component: 0:1 - 1:1 - 2:1 - 0:2 (a wrong match 2:1-0:2 closes
-  // the chain back on image 0 at another keypoint). A second bad component: 1:2 matched to both
-  // 2:2 and 2:3 (one-to-many). Another good track after them: 1:3 2:4.
+TEST(BuildTracksTest, AMatchThatWouldJoinTwoKeypointsOfOneImageIsLeftOut) {
+  // Pairs are joined strongest first: (1, 2) with 5 matches, (0, 1) with 2, (2, 0) with 1.
+  // In (1, 2), 1:2 is matched to both 2:2 and 2:3 (one-to-many): the second is left out. In
+  // (2, 0), the wrong match 2:1-0:2 would close the chain 0:1 1:1 2:1 back on image 0 at another
+  // keypoint: left out, and the chain stays a track.
   const std::vector<int> num_keypoints = {3, 4, 5};
   const std::vector<PairMatches> pairs = {
       Pair(0, 1, {{0, 0}, {1, 1}}),
@@ -138,32 +139,52 @@ TEST(BuildTracksTest, ComponentWithTwoKeypointsOfOneImageIsDropped) {
   };
   const TrackSet set = BuildTracks(num_keypoints, pairs);
   ExpectConsistent(num_keypoints, set);
-  EXPECT_EQ(set.num_inconsistent, 2);
-  ASSERT_EQ(set.tracks.size(), 2u);
+  EXPECT_EQ(set.num_conflicting_matches, 2);
   std::set<std::vector<std::pair<int, int>>> got;
   for (const auto& track : set.tracks) got.insert(Elements(track));
   const std::set<std::vector<std::pair<int, int>>> expected = {
       {{0, 0}, {1, 0}, {2, 0}},
+      {{0, 1}, {1, 1}, {2, 1}},
+      {{1, 2}, {2, 2}},
       {{1, 3}, {2, 4}},
   };
   EXPECT_EQ(got, expected);
-  // Every keypoint of a dropped component is -1, like an unmatched one.
-  EXPECT_EQ(set.track_of[0][1], -1);
+  // A keypoint whose only match was left out is in no track, like an unmatched one.
   EXPECT_EQ(set.track_of[0][2], -1);
-  EXPECT_EQ(set.track_of[1][1], -1);
-  EXPECT_EQ(set.track_of[2][1], -1);
-  EXPECT_EQ(set.track_of[1][2], -1);
-  EXPECT_EQ(set.track_of[2][2], -1);
   EXPECT_EQ(set.track_of[2][3], -1);
 }
 
-TEST(BuildTracksTest, SelfPairMatchIsInconsistent) {
-  // A pair of an image with itself linking two different keypoints makes a repeated image.
+TEST(BuildTracksTest, TheStrongerPairsDecideWhichMatchIsLeftOut) {
+  // (0, 1) with 3 matches and (1, 2) with 2 make the tracks 0:0 1:0 2:0 and 0:1 1:1 2:1; the one
+  // wrong match 0:0-2:1 of the weak pair (0, 2) would join them. Taken in the input's order it
+  // would come first and cost both true matches of (1, 2) instead.
+  const std::vector<int> num_keypoints = {3, 3, 2};
+  const std::vector<PairMatches> pairs = {
+      Pair(0, 2, {{0, 1}}),
+      Pair(0, 1, {{0, 0}, {1, 1}, {2, 2}}),
+      Pair(1, 2, {{0, 0}, {1, 1}}),
+  };
+  const TrackSet set = BuildTracks(num_keypoints, pairs);
+  ExpectConsistent(num_keypoints, set);
+  EXPECT_EQ(set.num_conflicting_matches, 1);
+  std::set<std::vector<std::pair<int, int>>> got;
+  for (const auto& track : set.tracks) got.insert(Elements(track));
+  const std::set<std::vector<std::pair<int, int>>> expected = {
+      {{0, 0}, {1, 0}, {2, 0}},
+      {{0, 1}, {1, 1}, {2, 1}},
+      {{0, 2}, {1, 2}},
+  };
+  EXPECT_EQ(got, expected);
+}
+
+TEST(BuildTracksTest, ASelfPairMatchIsLeftOut) {
+  // A pair of an image with itself linking two different keypoints would repeat the image.
   const std::vector<int> num_keypoints = {2, 1};
   const TrackSet set = BuildTracks(num_keypoints, {Pair(0, 0, {{0, 1}}), Pair(0, 1, {{1, 0}})});
   ExpectConsistent(num_keypoints, set);
-  EXPECT_TRUE(set.tracks.empty());
-  EXPECT_EQ(set.num_inconsistent, 1);
+  EXPECT_EQ(set.num_conflicting_matches, 1);
+  ASSERT_EQ(set.tracks.size(), 1u);
+  EXPECT_EQ(Elements(set.tracks[0]), (std::vector<std::pair<int, int>>{{0, 1}, {1, 0}}));
 }
 
 TEST(BuildTracksTest, LargeRandomChainsMatchTheConstruction) {
@@ -206,7 +227,7 @@ TEST(BuildTracksTest, LargeRandomChainsMatchTheConstruction) {
   }
   const TrackSet set = BuildTracks(num_keypoints, pairs);
   ExpectConsistent(num_keypoints, set);
-  EXPECT_EQ(set.num_inconsistent, 0);
+  EXPECT_EQ(set.num_conflicting_matches, 0);
   std::set<std::vector<std::pair<int, int>>> got, expected(truth.begin(), truth.end());
   for (const auto& track : set.tracks) got.insert(Elements(track));
   EXPECT_EQ(got.size(), set.tracks.size());
