@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "tracker/calibration.h"
+#include "core/io/intrinsics_file.h"
 
 namespace reconar::tools {
 

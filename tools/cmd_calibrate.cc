@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/base/json_writer.h"
+#include "core/io/intrinsics_file.h"
 #include "core/pipeline/project.h"
 #include "tools/commands.h"
 #include "tracker/calibration.h"

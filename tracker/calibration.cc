@@ -1,11 +1,9 @@
 #include "tracker/calibration.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <limits>
 #include <map>
-#include <sstream>
 #include <utility>
 
 #include <Eigen/Cholesky>
@@ -13,8 +11,6 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
-#include "core/base/atomic_file.h"
-#include "core/base/number_format.h"
 #include "core/geometry/homography_four_point.h"
 #include "core/math/lm_loop.h"
 #include "tracker/tag_pose.h"
@@ -28,7 +24,6 @@ using Matrix26d = Eigen::Matrix<double, 2, 6>;
 
 enum Intrinsic { kFx = 0, kFy, kCx, kCy, kK1, kK2 };
 constexpr int kNumIntrinsics = 6;
-constexpr const char* kIntrinsicNames[kNumIntrinsics] = {"fx", "fy", "cx", "cy", "k1", "k2"};
 
 // A planar tag instance or a board view: object points in the target frame and their pixels
 // (already in the (0, 0)-centre convention).
@@ -706,72 +701,6 @@ Result<CalibrationReport> CalibrateIntrinsics(const CalibrationObservations& obs
   report.num_targets = static_cast<int>(targets.size());
   report.num_corners = num_corners;
   return report;
-}
-
-Status WriteIntrinsics(const std::string& path, const CameraIntrinsics& intrinsics) {
-  const double values[] = {intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy, intrinsics.k1, intrinsics.k2};
-  for (double v : values) {
-    if (!std::isfinite(v)) return InvalidArgument(path + ": refusing to write non-finite intrinsics");
-  }
-  if (!intrinsics.valid() || intrinsics.width < 0 || intrinsics.height < 0) {
-    return InvalidArgument(path + ": refusing to write intrinsics with fx, fy <= 0 or a negative size");
-  }
-  std::string text =
-      "# reconar camera intrinsics. Pixels: the centre of the top-left pixel is (0, 0), x right, y down.\n"
-      "# A camera point X (z forward) maps to p = X.xy / X.z, d = 1 + k1 |p|^2 + k2 |p|^4,\n"
-      "# u = fx d p.x + cx, v = fy d p.y + cy. width and height are 0 when unknown.\n"
-      "# fx fy cx cy k1 k2 width height\n";
-  for (double v : values) text += FormatShortest(v) + " ";
-  text += std::to_string(intrinsics.width) + " " + std::to_string(intrinsics.height) + "\n";
-  return WriteFileAtomically(path, text);
-}
-
-Result<CameraIntrinsics> ReadIntrinsics(const std::string& path) {
-  RECONAR_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::istringstream lines(text);
-  std::string line;
-  int line_number = 0;
-  while (std::getline(lines, line)) {
-    ++line_number;
-    const size_t start = line.find_first_not_of(" \t\r");
-    if (start == std::string::npos || line[start] == '#') continue;
-    const std::string where = path + ":" + std::to_string(line_number);
-    std::vector<std::string> fields;
-    std::istringstream words(line);
-    for (std::string word; words >> word;) fields.push_back(word);
-    if (fields.size() != 8) {
-      return CorruptData(where + ": expected 8 fields \"fx fy cx cy k1 k2 width height\", found " +
-                         std::to_string(fields.size()));
-    }
-    Vector6d values;
-    for (int k = 0; k < 6; ++k) {
-      const std::string& field = fields[k];
-      const auto result = std::from_chars(field.data(), field.data() + field.size(), values(k));
-      if (result.ec != std::errc() || result.ptr != field.data() + field.size() || !std::isfinite(values(k))) {
-        return CorruptData(where + ": " + kIntrinsicNames[k] + " '" + field + "' is not a finite number");
-      }
-    }
-    int size[2];
-    for (int k = 0; k < 2; ++k) {
-      const std::string& field = fields[6 + k];
-      const auto result = std::from_chars(field.data(), field.data() + field.size(), size[k]);
-      if (result.ec != std::errc() || result.ptr != field.data() + field.size() || size[k] < 0) {
-        return CorruptData(where + ": " + (k == 0 ? "width" : "height") + " '" + field +
-                           "' is not a non-negative integer");
-      }
-    }
-    const CameraIntrinsics intrinsics = ToIntrinsics(values, size[0], size[1]);
-    if (!intrinsics.valid()) return CorruptData(where + ": fx and fy must be positive");
-    while (std::getline(lines, line)) {
-      ++line_number;
-      const size_t next = line.find_first_not_of(" \t\r");
-      if (next != std::string::npos && line[next] != '#') {
-        return CorruptData(path + ":" + std::to_string(line_number) + ": unexpected second data line");
-      }
-    }
-    return intrinsics;
-  }
-  return CorruptData(path + ": no data line \"fx fy cx cy k1 k2 width height\"");
 }
 
 }  // namespace reconar

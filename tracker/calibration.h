@@ -38,7 +38,7 @@
 #include "core/math/rigid3.h"
 #include "core/math/robust_loss.h"
 #include "tracker/tag_detector.h"
-#include "tracker/tag_layout.h"
+#include "tracker/board_pose.h"
 
 namespace reconar {
 
@@ -142,13 +142,5 @@ struct CalibrationReport {
 // NumericFailure when the refinement meets a non-finite cost.
 Result<CalibrationReport> CalibrateIntrinsics(const CalibrationObservations& observations,
                                               const CalibrationOptions& options);
-
-// Intrinsics text file, read by `reconar track/view --intrinsics FILE`: '#' comment lines, then
-// one line "fx fy cx cy k1 k2 width height" (pixels in the CameraIntrinsics convention; width and
-// height integers, 0 when unknown). Written atomically with shortest round-trip doubles.
-Status WriteIntrinsics(const std::string& path, const CameraIntrinsics& intrinsics);
-// NotFound / IoError for the file, CorruptData (naming the file and line) when the data line is
-// missing, malformed, has extra fields, or gives fx, fy <= 0 or a negative size.
-Result<CameraIntrinsics> ReadIntrinsics(const std::string& path);
 
 }  // namespace reconar

@@ -149,9 +149,7 @@ double KeyframeGate::TriangulationAngleDeg(const GateMapPose& map_pose) {
   const int count = std::min(map_pose.num_points, kMaxAnglePoints);
   for (int i = 0; i < count; ++i)
     angles_[static_cast<size_t>(i)] = TriangulationAngle(keyframe_centre_, centre, map_pose.points[i]);
-  double* middle = angles_.data() + count / 2;
-  std::nth_element(angles_.data(), middle, angles_.data() + count);
-  return *middle * 180.0 / M_PI;
+  return MedianInPlace(angles_.data(), static_cast<size_t>(count)) * 180.0 / M_PI;
 }
 
 void KeyframeGate::MoveKeyframeToMap(int map_version, const Sim3& new_from_old) {

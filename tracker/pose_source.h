@@ -1,7 +1,7 @@
 #pragma once
 // PoseSource: the camera's pose in the world of an AR scene, once per video frame, from the frame's
-// gray image. The AR runtime (render/ar) joins a FrameSource, a PoseSource and the renderer; a
-// source of another kind (map-based tracking) implements this interface next to TagPoseSource.
+// gray image. TagPoseSource (the tags) and FusedPoseSource (the tags and a project's map, the one
+// the AR runtime in render/ar uses) implement it; docs/architecture.md says how to add another.
 //
 // Frames: cam_from_world maps world points (metres) into the camera frame (x right, y down,
 // z forward). The world is the source's: a tag layout's frame (tags.layout), the chosen tag's

@@ -20,7 +20,7 @@
 #include "core/base/image.h"
 #include "core/base/status.h"
 #include "tracker/pose_source.h"
-#include "tracker/tag_layout.h"
+#include "tracker/board_pose.h"
 #include "tracker/tag_tracker.h"
 
 namespace reconar {

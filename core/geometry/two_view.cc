@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "core/base/median.h"
 #include "core/geometry/correspondence.h"
 #include "core/geometry/fundamental_eight_point.h"
 #include "core/geometry/homography_four_point.h"
@@ -40,8 +41,7 @@ void RefineFundamental(const std::vector<Correspondence>& matches, double t2, in
   std::vector<double> inlier_errors;
   inlier_errors.reserve(inliers->size());
   for (int i : *inliers) inlier_errors.push_back(std::sqrt(residuals[i]));
-  std::nth_element(inlier_errors.begin(), inlier_errors.begin() + inlier_errors.size() / 2, inlier_errors.end());
-  const double sigma = 1.4826 * inlier_errors[inlier_errors.size() / 2];
+  const double sigma = 1.4826 * MedianInPlace(inlier_errors.data(), inlier_errors.size());
   if (!(sigma > 0.0)) return;
   const double c2 = (2.3849 * sigma) * (2.3849 * sigma);
   const auto robust_cost = [&](const Eigen::Matrix3d& model) {

@@ -14,6 +14,10 @@ Status DecodeJpeg(std::string_view bytes, const std::string& name, const ImageRe
 Status DecodePng(std::string_view bytes, const std::string& name, const ImageReadOptions& options,
                  DecodedImage* out);
 
+// The stored size (before orientation) and the EXIF of an image from its header.
+Status ReadJpegHeader(std::string_view bytes, const std::string& name, ImageHeader* out);
+Status ReadPngHeader(std::string_view bytes, const std::string& name, ImageHeader* out);
+
 // Refuses zero or over-budget dimensions before any pixel memory is allocated.
 Status CheckDimensions(uint64_t width, uint64_t height, const std::string& name, const ImageReadOptions& options);
 

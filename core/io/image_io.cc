@@ -70,6 +70,24 @@ Result<DecodedImage> ReadImage(const std::string& path, const ImageReadOptions& 
   return ReadImageFromMemory(bytes, path, options);
 }
 
+Result<ImageHeader> ReadImageHeader(const std::string& path) {
+  RECONAR_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
+  if (bytes.empty()) return FileError(StatusCode::kCorruptData, path, "empty file (0 bytes)");
+  ImageHeader header;
+  switch (DetectImageFormat(bytes)) {
+    case ImageFormat::kJpeg:
+      RECONAR_RETURN_IF_ERROR(io_internal::ReadJpegHeader(bytes, path, &header));
+      break;
+    case ImageFormat::kPng:
+      RECONAR_RETURN_IF_ERROR(io_internal::ReadPngHeader(bytes, path, &header));
+      break;
+    case ImageFormat::kUnknown:
+      return FileError(StatusCode::kCorruptData, path, "not a JPEG or PNG image");
+  }
+  if (OrientationSwapsAxes(header.exif.orientation)) std::swap(header.width, header.height);
+  return header;
+}
+
 Result<DecodedImage> ReadImageFromMemory(std::string_view bytes, const std::string& name,
                                          const ImageReadOptions& options) {
   if (options.max_pixels <= 0) {

@@ -29,6 +29,13 @@ struct DecodedImage {
   std::vector<std::string> warnings;
 };
 
+// What a photo's header says, without its pixels decoded.
+struct ImageHeader {
+  int width = 0;   // upright, after the EXIF orientation
+  int height = 0;
+  ExifInfo exif;   // a JPEG's APP1; present=false for a PNG
+};
+
 enum class ImageFormat { kUnknown, kJpeg, kPng };
 
 // Identifies the format from the first bytes of a file.
@@ -38,6 +45,10 @@ ImageFormat DetectImageFormat(std::string_view bytes);
 // kResourceExhausted for images above options.max_pixels, kUnsupported for valid formats we do
 // not decode (CMYK JPEG, HEIC, ...).
 Result<DecodedImage> ReadImage(const std::string& path, const ImageReadOptions& options = {});
+
+// The size and EXIF of a photo from its header alone (the pixels are not decoded). Errors as
+// ReadImage's for a missing file or a header that is damaged or of an unsupported format.
+Result<ImageHeader> ReadImageHeader(const std::string& path);
 
 // Same as ReadImage on bytes already in memory (e.g. a recorded MJPEG frame); `name_for_errors`
 // prefixes every error message.

@@ -250,7 +250,39 @@ Status FailureToStatus(const ErrorManager& err, const MemorySource& src, const s
   }
 }
 
+// The EXIF of the APP1 markers ReadHeader saved.
+ExifInfo SavedExif(const jpeg_decompress_struct& cinfo, std::vector<std::string>* warnings) {
+  for (jpeg_saved_marker_ptr marker = cinfo.marker_list; marker != nullptr; marker = marker->next) {
+    const std::string_view payload(reinterpret_cast<const char*>(marker->data), marker->data_length);
+    if (marker->marker == JPEG_APP0 + 1 && payload.size() >= 5 && payload.substr(0, 5) == std::string_view("Exif\0", 5)) {
+      ExifInfo exif = ParseExifApp1(payload);
+      if (!exif.warning.empty() && warnings != nullptr) warnings->push_back("EXIF: " + exif.warning);
+      return exif;
+    }
+  }
+  return ExifInfo{};
+}
+
 }  // namespace
+
+Status ReadJpegHeader(std::string_view bytes, const std::string& name, ImageHeader* out) {
+  ErrorManager err{};
+  jpeg_decompress_struct cinfo{};
+  cinfo.err = jpeg_std_error(&err.pub);
+  err.pub.error_exit = OnError;
+  err.pub.emit_message = OnMessage;
+  err.pub.output_message = OnOutputMessage;
+  DecompressGuard guard(&cinfo);
+  MemorySource src{};
+  HeaderInfo header{};
+  if (!ReadHeader(&cinfo, &err, &src, reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), &header)) {
+    return FailureToStatus(err, src, name, 0, false);
+  }
+  out->width = static_cast<int>(header.width);
+  out->height = static_cast<int>(header.height);
+  out->exif = SavedExif(cinfo, nullptr);
+  return Status::Ok();
+}
 
 Status DecodeJpeg(std::string_view bytes, const std::string& name, const ImageReadOptions& options,
                   DecodedImage* out) {
@@ -277,14 +309,7 @@ Status DecodeJpeg(std::string_view bytes, const std::string& name, const ImageRe
   }
   RECONAR_RETURN_IF_ERROR(CheckDimensions(header.width, header.height, name, options));
 
-  for (jpeg_saved_marker_ptr marker = cinfo.marker_list; marker != nullptr; marker = marker->next) {
-    const std::string_view payload(reinterpret_cast<const char*>(marker->data), marker->data_length);
-    if (marker->marker == JPEG_APP0 + 1 && payload.size() >= 5 && payload.substr(0, 5) == std::string_view("Exif\0", 5)) {
-      out->exif = ParseExifApp1(payload);
-      if (!out->exif.warning.empty()) out->warnings.push_back("EXIF: " + out->exif.warning);
-      break;
-    }
-  }
+  out->exif = SavedExif(cinfo, &out->warnings);
 
   out->rgb = Image<uint8_t>(static_cast<int>(header.width), static_cast<int>(header.height), 3);
   if (!DecodeScanlines(&cinfo, &err, out->rgb.data(), header.width, header.height)) {

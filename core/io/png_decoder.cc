@@ -122,6 +122,26 @@ Status FailureToStatus(const PngContext& ctx, const std::string& name) {
 
 }  // namespace
 
+Status ReadPngHeader(std::string_view bytes, const std::string& name, ImageHeader* out) {
+  // IHDR is always the first chunk: 8 bytes of signature, its length and type, then the size.
+  const auto* raw = reinterpret_cast<const uint8_t*>(bytes.data());
+  if (bytes.size() < 24 || bytes.substr(12, 4) != "IHDR") {
+    return FileError(StatusCode::kCorruptData, name, "PNG without an IHDR chunk first (truncated or damaged)");
+  }
+  const auto be32 = [&](size_t at) {
+    return static_cast<uint32_t>(raw[at]) << 24 | static_cast<uint32_t>(raw[at + 1]) << 16 |
+           static_cast<uint32_t>(raw[at + 2]) << 8 | raw[at + 3];
+  };
+  const uint32_t width = be32(16), height = be32(20);
+  if (width == 0 || height == 0 || width > 0x7FFFFFFF || height > 0x7FFFFFFF) {
+    return FileError(StatusCode::kCorruptData, name,
+                     "PNG size " + std::to_string(width) + " x " + std::to_string(height) + " is invalid");
+  }
+  out->width = static_cast<int>(width);
+  out->height = static_cast<int>(height);
+  return Status::Ok();
+}
+
 Status DecodePng(std::string_view bytes, const std::string& name, const ImageReadOptions& options,
                  DecodedImage* out) {
   // Refuse absurd sizes from IHDR (always the first chunk) before libpng reads any further.

@@ -7,8 +7,8 @@
 // The problem owns its state, its linearisation and its damped linear solve (fixed-size Cholesky,
 // a Schur complement, CHOLMOD), so the loop knows nothing of the block structure.
 //
-// Users: NormalLmSolve (normal_lm.h: fixed-size normal equations; TinyLmSolve, the absolute pose
-// refinement, the planar tag pose), the bundle adjuster (core/optim/bundle_adjuster.cc: points
+// Users: NormalLmSolve (normal_lm.h: fixed-size normal equations; the absolute pose refinement,
+// the planar tag pose), the bundle adjuster (core/optim/bundle_adjuster.cc: points
 // eliminated by the Schur complement) and calibration (tracker/calibration.cc: target poses
 // eliminated by the Schur complement).
 //

@@ -7,10 +7,9 @@
 // a manifold (the problem supplies x [+] dx, e.g. a rotation update R <- exp(dw) R), and a robust
 // loss enters by iteratively reweighted least squares (robust_loss.h).
 //
-// Users: TinyLmSolve (core/optim/tiny_lm.h; vector state, the normal equations formed from a
-// fixed-size residual functor), the absolute pose refinement (core/geometry/pose_refinement.cc;
-// rotation, translation and focal, hundreds of robustly weighted reprojection residuals) and the
-// planar tag pose (tracker/tag_pose.cc).
+// Users: the absolute pose refinement (core/geometry/pose_refinement.cc; rotation, translation and
+// focal, hundreds of robustly weighted reprojection residuals) and the planar tag pose
+// (tracker/tag_pose.cc).
 //
 // The problem type provides
 //   using State = ...;                          // copyable, fixed size

@@ -5,6 +5,7 @@
 // estimation of transformation parameters between two point patterns", PAMI 1991).
 #include <Eigen/Core>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <optional>
 #include <vector>
 
@@ -22,7 +23,7 @@ struct Sim3 {
 
 // The Sim3 with to_i ~ Apply(from_i) in the least-squares sense; with `fixed_scale` only the
 // rotation and translation are estimated. Needs at least 3 pairs and a `from` set that is not a
-// single point (InvalidArgument otherwise).
+// single point, to rounding (InvalidArgument otherwise).
 inline Result<Sim3> AlignSimilarity(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
                                     std::optional<double> fixed_scale = std::nullopt) {
   if (from.size() != to.size()) return InvalidArgument("AlignSimilarity: point sets differ in size");
@@ -41,7 +42,12 @@ inline Result<Sim3> AlignSimilarity(const std::vector<Eigen::Vector3d>& from, co
     covariance += (to[i] - mean_to) * (from[i] - mean_from).transpose() / n;
     variance_from += (from[i] - mean_from).squaredNorm() / n;
   }
-  if (!(variance_from > 0.0)) return InvalidArgument("AlignSimilarity: all source points coincide");
+  // Points that differ only by rounding (cameras turning on one spot) give no rotation either.
+  double largest_from = 0.0;
+  for (const Eigen::Vector3d& point : from) largest_from = std::max(largest_from, point.norm());
+  if (!(variance_from > 1e-18 * largest_from * largest_from) || !(variance_from > 0.0)) {
+    return InvalidArgument("AlignSimilarity: all source points coincide");
+  }
 
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Vector3d s = Eigen::Vector3d::Ones();

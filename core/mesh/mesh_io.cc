@@ -98,7 +98,7 @@ Result<PlyHeader> ParseHeader(std::string_view bytes, const std::string& path) {
     const std::string_view line = bytes.substr(position, end - position);
     position = end + 1;
     ++line_number;
-    const std::vector<std::string_view> fields = mesh_internal::SplitFields(line);
+    const std::vector<std::string_view> fields = SplitFields(line);
     if (line_number == 1) {
       if (fields.size() != 1 || fields[0] != "ply") {
         return FileError(StatusCode::kCorruptData, path, "not a PLY file (no \"ply\" magic line)");

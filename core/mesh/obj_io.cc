@@ -124,7 +124,7 @@ class ObjParser {
   Status ParseLine(std::string_view line) {
     const size_t comment = line.find('#');
     if (comment != std::string_view::npos) line = line.substr(0, comment);
-    const std::vector<std::string_view> fields = mesh_internal::SplitFields(line);
+    const std::vector<std::string_view> fields = SplitFields(line);
     if (fields.empty()) return Status::Ok();
     if (fields[0] == "v") return ParseVertex(fields);
     if (fields[0] == "vn") return ParseNormal(fields);

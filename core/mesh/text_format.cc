@@ -29,19 +29,4 @@ Status CheckFiniteVertices(const std::string& path, const Mesh& mesh) {
   return Status::Ok();
 }
 
-
-std::vector<std::string_view> SplitFields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  size_t i = 0;
-  while (i < line.size()) {
-    const size_t begin = line.find_first_not_of(" \t\r", i);
-    if (begin == std::string_view::npos) break;
-    size_t end = line.find_first_of(" \t\r", begin);
-    if (end == std::string_view::npos) end = line.size();
-    fields.push_back(line.substr(begin, end - begin));
-    i = end;
-  }
-  return fields;
-}
-
 }  // namespace reconar::mesh_internal

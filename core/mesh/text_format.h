@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/base/text_fields.h"
 #include "core/mesh/mesh.h"
 
 namespace reconar::mesh_internal {
@@ -18,7 +19,5 @@ float ColourChannel(uint8_t byte);
 // kInvalidArgument naming `path` and the first vertex with a non-finite position or normal,
 // which text formats cannot carry.
 Status CheckFiniteVertices(const std::string& path, const Mesh& mesh);
-// The fields of a line separated by spaces, tabs or carriage returns.
-std::vector<std::string_view> SplitFields(std::string_view line);
 
 }  // namespace reconar::mesh_internal

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/base/median.h"
+
 namespace reconar {
 namespace {
 
@@ -112,8 +114,7 @@ OrientedPoints MergeOrientedPoints(const std::vector<MergeInput>& parts, MergeRe
   std::stable_sort(order.begin(), order.end(), [](const Ref& a, const Ref& b) { return a.score > b.score; });
   float cell = 1.0f;
   if (!footprints.empty()) {
-    std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2, footprints.end());
-    cell = footprints[footprints.size() / 2];
+    cell = MedianInPlace(footprints.data(), footprints.size());
   }
   std::vector<float>().swap(footprints);
   const auto cell_of = [cell](float v) {

@@ -6,6 +6,8 @@
 #include <numeric>
 #include <string>
 
+#include "core/base/median.h"
+
 namespace reconar {
 namespace {
 
@@ -120,8 +122,7 @@ ViewClustering ClusterByCameras(const Reconstruction& rec, const std::vector<int
   }
   double spacing = 1.0;
   if (!nearest.empty()) {
-    std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
-    spacing = nearest[nearest.size() / 2];
+    spacing = MedianInPlace(nearest.data(), nearest.size());
   }
   const double sigma = 2.0 * spacing;
   const double min_cos = std::cos(options.max_view_angle);

@@ -18,6 +18,7 @@
 #include "core/mvs/dense_memory.h"
 #include "core/mvs/merge_points.h"
 #include "core/mvs/undistort.h"
+#include "core/pipeline/stage_record.h"
 #include "core/sfm/model_io.h"
 
 namespace reconar {
@@ -156,6 +157,21 @@ Status DenseStageOptions::Check() const {
   RECONAR_RETURN_IF_ERROR(outliers.Check());
   RECONAR_RETURN_IF_ERROR(patchmatch.Check());
   return mvs.Check();
+}
+
+std::string DenseStageSettings(const DenseStageOptions& options) {
+  std::string settings =
+      StageRecord::Settings({{"level", options.level},
+                             {"max_image_size", options.max_image_size},
+                             {"max_cluster_size", options.clustering.max_cluster_size},
+                             {"budget_mib", static_cast<double>(options.memory_budget_bytes) / (1 << 20)},
+                             {"remove_outliers", options.remove_outliers ? 1.0 : 0.0}});
+  // PMVS records no method, so that the projects made before the choice existed stay finished.
+  if (options.method != DenseMethod::kPmvs) {
+    settings += " " + StageRecord::Settings({{"method", static_cast<double>(options.method)},
+                                             {"fill_min_support", options.patchmatch.fill_min_support}});
+  }
+  return settings;
 }
 
 Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageOptions& options) {

@@ -82,6 +82,9 @@ struct DenseStageReport {
   std::string points_path, report_path;
 };
 
+// The settings the dense stage's record holds (core/pipeline/stage_record.h).
+std::string DenseStageSettings(const DenseStageOptions& options);
+
 // Errors name the file: a missing or corrupt sparse model or image list, an image missing from the
 // list or unreadable, a photo whose size differs from its camera. FailedPrecondition when no
 // cluster yields a point; ResourceExhausted when even the smallest useful cluster at the coarsest

@@ -10,10 +10,12 @@
 #include "core/base/atomic_file.h"
 #include "core/base/json_writer.h"
 #include "core/base/keep_masked.h"
+#include "core/base/median.h"
 #include "core/base/memory_usage.h"
 #include "core/mesh/mesh_file.h"
 #include "core/mesh/poisson/point_kdtree.h"
 #include "core/mesh/poisson/point_normals.h"
+#include "core/pipeline/stage_record.h"
 
 namespace reconar {
 namespace {
@@ -35,8 +37,7 @@ double MedianSpacing(const std::vector<Eigen::Vector3f>& positions) {
     if (nearest.size() > 1) spacing.push_back(sum / static_cast<double>(nearest.size() - 1));
   }
   if (spacing.empty()) return 0.0;
-  std::nth_element(spacing.begin(), spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2), spacing.end());
-  return spacing[spacing.size() / 2];
+  return MedianInPlace(spacing.data(), spacing.size());
 }
 
 }  // namespace
@@ -141,6 +142,18 @@ Result<MeshStageReport> MeshPointsFile(const std::string& points_path, const std
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report.peak_rss_bytes = PeakResidentBytes();
   return report;
+}
+
+std::string MeshStageSettings(const MeshStageOptions& options) {
+  std::string formats;
+  for (const std::string& f : options.formats) formats += (formats.empty() ? "" : ",") + f;
+  return StageRecord::Settings({{"version", 2},
+                                {"depth", options.poisson.depth},
+                                {"trim", options.poisson.trim},
+                                {"point_weight", options.poisson.point_weight},
+                                {"budget_mib", static_cast<double>(options.memory_budget_bytes) / (1 << 20)},
+                                {"max_faces", static_cast<double>(options.max_faces)}}) +
+         " formats=" + formats;
 }
 
 Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOptions& options) {

@@ -60,6 +60,9 @@ struct MeshStageReport {
   std::string report_path;
 };
 
+// The settings the mesh stage's record holds (core/pipeline/stage_record.h).
+std::string MeshStageSettings(const MeshStageOptions& options);
+
 // FailedPrecondition without dense points; ResourceExhausted when even depth 5 does not fit.
 Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOptions& options);
 

@@ -36,11 +36,12 @@ bool Exists(const std::string& path) {
 // sizing, RequiredArenaBytes, for the pyramid itself).
 constexpr size_t kFeatureBytesPerPixel = 8;
 
-// Pixels of the first readable photo: a project's photos usually come from one camera.
+// Pixels of the first readable photo, from its header: a project's photos usually come from one
+// camera.
 size_t TypicalPixelCount(const std::vector<std::string>& paths) {
   for (const std::string& path : paths) {
-    auto image = ReadImage(path);
-    if (image.ok()) return static_cast<size_t>(image->rgb.width()) * static_cast<size_t>(image->rgb.height());
+    auto header = ReadImageHeader(path);
+    if (header.ok()) return static_cast<size_t>(header->width) * static_cast<size_t>(header->height);
   }
   return 0;
 }
@@ -247,7 +248,6 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
   ReconstructReport report;
   StageRunner runner(project, options, &report);
   const int threads = ThreadPool::ResolveThreadCount(options.num_threads);
-  const auto Settings = StageRecord::Settings;
   const size_t budget = options.memory_budget_bytes;
 
   if (options.run_sparse) {
@@ -323,7 +323,6 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     sfm.show_progress = options.show_progress;
     sfm.tags.enabled = with_tags;
     sfm.tags.registration.tag_size_m = with_tags ? options.tag_size_m : 1.0;
-    const MapperOptions& mapper = sfm.mapper;
     const auto run_mapping = [&](StageSummary* summary) -> Status {
       RECONAR_ASSIGN_OR_RETURN(const SfmStageReport r, RunSfmStage(project, sfm));
       if (r.live_model == SfmStageReport::LiveModel::kContinued) {
@@ -354,25 +353,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       json.EndObject();
       return WriteFileAtomically(project.SparseDir() + "/report.json", json.str() + "\n");
     };
-    std::string mapping_settings =
-        Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
-                  {"min_verified_inliers", static_cast<double>(mapper.registration_min_verified_inliers)},
-                  {"min_baseline_points", static_cast<double>(mapper.registration_min_baseline_points)},
-                  {"min_inlier_spread", mapper.registration_min_inlier_spread},
-                  {"max_models", static_cast<double>(mapper.max_models)},
-                  {"min_model_images", static_cast<double>(mapper.min_model_images)},
-                  {"max_starts", static_cast<double>(mapper.init_max_starts)},
-                  {"merge_models", mapper.merge_models ? 1.0 : 0.0},
-                  {"max_error", mapper.max_reprojection_error_px},
-                  {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
-                  {"tag_size", options.tag_size_m},
-                  {"world_tag", sfm.tags.registration.world_tag},
-                  {"tags_in_ba", sfm.tags.in_adjustment ? 1.0 : 0.0}});
-    // Tag projects map differently since images register by their known tags and the world tag is
-    // fitted as a square (version 2): their recorded mapping is not reused. Others are unchanged.
-    if (with_tags) mapping_settings += " " + Settings({{"tag_mapping", 2.0}});
     const auto map_matches = [&]() {
-      return runner.Run("mapping", mapping_settings + ExtractAgainDigest(matching.extract_again),
+      return runner.Run("mapping", SfmStageSettings(sfm) + ExtractAgainDigest(matching.extract_again),
                         Exists(project.SparseDir() + "/report.json"), runner.redone() || tags_redone, run_mapping);
     };
     RECONAR_RETURN_IF_ERROR(map_matches());
@@ -424,18 +406,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       }
       return Status::Ok();
     };
-    std::string dense_settings = Settings({{"level", dense.level},
-                                           {"max_image_size", dense.max_image_size},
-                                           {"max_cluster_size", dense.clustering.max_cluster_size},
-                                           {"budget_mib", Mib(budget)},
-                                           {"remove_outliers", dense.remove_outliers ? 1.0 : 0.0}});
-    // PMVS records no method, so that the projects made before the choice existed stay finished.
-    if (dense.method != DenseMethod::kPmvs) {
-      dense_settings += " " + Settings({{"method", static_cast<double>(dense.method)},
-                                        {"fill_min_support", dense.patchmatch.fill_min_support}});
-    }
     RECONAR_RETURN_IF_ERROR(
-        runner.Run("dense", dense_settings, Exists(project.root() + "/dense/report.json"), runner.redone(), run_dense));
+        runner.Run("dense", DenseStageSettings(dense), Exists(project.root() + "/dense/report.json"), runner.redone(), run_dense));
   }
 
   if (options.run_mesh) {
@@ -443,8 +415,6 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     mesh.memory_budget_bytes = budget;
     mesh.poisson.num_threads = threads;
     mesh.poisson.show_progress = options.show_progress;
-    std::string formats;
-    for (const std::string& f : mesh.formats) formats += (formats.empty() ? "" : ",") + f;
     const auto run_mesh = [&](StageSummary* summary) -> Status {
       RECONAR_ASSIGN_OR_RETURN(const MeshStageReport r, RunMeshStage(project, mesh));
       summary->peak_rss_bytes = std::max(r.peak_rss_bytes, r.pilot_peak_bytes);
@@ -457,15 +427,7 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       }
       return Status::Ok();
     };
-    RECONAR_RETURN_IF_ERROR(runner.Run("mesh",
-                                       Settings({{"version", 2},
-                                                 {"depth", mesh.poisson.depth},
-                                                 {"trim", mesh.poisson.trim},
-                                                 {"point_weight", mesh.poisson.point_weight},
-                                                 {"budget_mib", Mib(budget)},
-                                                 {"max_faces", static_cast<double>(mesh.max_faces)}}) +
-                                           " formats=" + formats,
-                                       Exists(project.MeshDir() + "/report.json"), runner.redone(), run_mesh));
+    RECONAR_RETURN_IF_ERROR(runner.Run("mesh", MeshStageSettings(mesh), Exists(project.MeshDir() + "/report.json"), runner.redone(), run_mesh));
   }
 
   // Scale: what tags.json says.

@@ -14,6 +14,7 @@
 #include "core/features/sift/sift_io.h"
 #include "core/io/image_io.h"
 #include "core/pipeline/match_stage.h"
+#include "core/pipeline/stage_record.h"
 #include "core/sfm/model_io.h"
 
 namespace reconar {
@@ -145,6 +146,29 @@ MapperPair ToMapperPair(int image_a, int image_b, const std::vector<FeatureMatch
   pair.matches.matches = matches;
   pair.planar = planar;
   return pair;
+}
+
+std::string SfmStageSettings(const SfmStageOptions& options) {
+  const MapperOptions& mapper = options.mapper;
+  const bool with_tags = options.tags.enabled;
+  std::string settings =
+      StageRecord::Settings({{"principal_point", static_cast<double>(mapper.principal_point)},
+                             {"min_verified_inliers", static_cast<double>(mapper.registration_min_verified_inliers)},
+                             {"min_baseline_points", static_cast<double>(mapper.registration_min_baseline_points)},
+                             {"min_inlier_spread", mapper.registration_min_inlier_spread},
+                             {"max_models", static_cast<double>(mapper.max_models)},
+                             {"min_model_images", static_cast<double>(mapper.min_model_images)},
+                             {"max_starts", static_cast<double>(mapper.init_max_starts)},
+                             {"merge_models", mapper.merge_models ? 1.0 : 0.0},
+                             {"max_error", mapper.max_reprojection_error_px},
+                             {"refine_distortion", mapper.refine_distortion ? 1.0 : 0.0},
+                             {"tag_size", with_tags ? options.tags.registration.tag_size_m : 0.0},
+                             {"world_tag", options.tags.registration.world_tag},
+                             {"tags_in_ba", options.tags.in_adjustment ? 1.0 : 0.0}});
+  // Tag projects map differently since images register by their known tags and the world tag is
+  // fitted as a square (version 2): their recorded mapping is not reused. Others are unchanged.
+  if (with_tags) settings += " " + StageRecord::Settings({{"tag_mapping", 2.0}});
+  return settings;
 }
 
 Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions& options,

@@ -71,6 +71,10 @@ void WriteSfmReportFields(const SfmStageReport& report, JsonWriter* json);
 MapperImage ToMapperImage(const ProjectImage& image, const std::vector<SiftKeypoint>& keypoints);
 MapperPair ToMapperPair(int image_a, int image_b, const std::vector<FeatureMatch>& matches, bool planar);
 
+// The settings the mapping stage's record holds (core/pipeline/stage_record.h): a change to any of
+// them maps again.
+std::string SfmStageSettings(const SfmStageOptions& options);
+
 // FailedPrecondition when the mapper finds no initial pair (its message says why); errors of
 // the project files name the file.
 Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions& options,

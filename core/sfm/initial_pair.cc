@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/base/median.h"
 #include "core/sfm/mapper_adjustment.h"
 #include "core/sfm/pair_pose.h"
 #include "core/sfm/point_filter.h"
@@ -228,8 +229,7 @@ std::string CheckInitialModel(const MapperModel& model, const std::string& pair_
     return pair_name + ": only " + std::to_string(angles.size()) + " points triangulated (need " +
            std::to_string(bounds.min_points) + ")";
   }
-  std::nth_element(angles.begin(), angles.begin() + static_cast<std::ptrdiff_t>(angles.size() / 2), angles.end());
-  const double median = angles[angles.size() / 2];
+  const double median = MedianInPlace(angles.data(), angles.size());
   if (median < bounds.min_median_angle_deg * kDegree) {
     return pair_name + ": median triangulation angle " + std::to_string(median / kDegree) + " deg is below " +
            std::to_string(bounds.min_median_angle_deg) + " deg";

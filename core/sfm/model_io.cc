@@ -12,6 +12,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/number_format.h"
+#include "core/base/text_fields.h"
 
 namespace reconar {
 
@@ -122,16 +123,7 @@ class LineReader {
     const std::string_view line(text_.data() + position_, end - position_);
     position_ = end + 1;
     ++line_number_;
-    fields_.clear();
-    size_t i = 0;
-    while (i < line.size()) {
-      const size_t begin = line.find_first_not_of(" \t\r", i);
-      if (begin == std::string_view::npos) break;
-      size_t stop = line.find_first_of(" \t\r", begin);
-      if (stop == std::string_view::npos) stop = line.size();
-      fields_.push_back(line.substr(begin, stop - begin));
-      i = stop;
-    }
+    SplitFields(line, &fields_);
     return true;
   }
 

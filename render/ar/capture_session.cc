@@ -4,9 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <memory>
-#include <optional>
 #include <thread>
 
 #include "core/base/atomic_file.h"
@@ -15,31 +13,11 @@
 #include "core/io/focal_prior.h"
 #include "core/io/image_write.h"
 #include "render/ar/capture_preview.h"
-#include "tracker/tag_detector.h"
 
 namespace reconar {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The similarity taking map `from`'s frame into map `to`'s, from the centres of the keyframes both
-// hold (by name). Unset with fewer than 3 shared (or all on one spot).
-std::optional<Sim3> MapFromMap(const LocalizationMap& to, const LocalizationMap& from) {
-  std::map<std::string, Eigen::Vector3d> from_centres;
-  for (const MapKeyframe& keyframe : from.keyframes)
-    from_centres[keyframe.name] = CameraCenterInWorld(keyframe.cam_from_world);
-  std::vector<Eigen::Vector3d> from_points, to_points;
-  for (const MapKeyframe& keyframe : to.keyframes) {
-    const auto found = from_centres.find(keyframe.name);
-    if (found == from_centres.end()) continue;
-    from_points.push_back(found->second);
-    to_points.push_back(CameraCenterInWorld(keyframe.cam_from_world));
-  }
-  if (from_points.size() < 3) return std::nullopt;
-  Result<Sim3> to_from_from = AlignSimilarity(from_points, to_points);
-  if (!to_from_from.ok()) return std::nullopt;
-  return *to_from_from;
-}
 
 std::string KeyframeName(int ordinal) {
   char name[32];
@@ -80,320 +58,346 @@ Status CaptureOptions::Check() const {
   return gate.Check();
 }
 
-Result<CaptureReport> RunCapture(const CaptureOptions& options,
-                                 const std::function<void(const CaptureEvent&)>& on_event,
-                                 const std::atomic<bool>* stop) {
+CaptureSession::CaptureSession(const CaptureOptions& options)
+    : options_(options),
+      keyframe_gate_(options.gate),
+      map_follower_(options.map_tracker),
+      tags_in_view_(16) {}
+
+CaptureSession::~CaptureSession() = default;
+
+Result<std::unique_ptr<CaptureSession>> CaptureSession::Open(const CaptureOptions& options,
+                                                             std::function<void(const CaptureEvent&)> on_event) {
   RECONAR_RETURN_IF_ERROR(options.Check());
-  const std::string images_dir = (fs::path(options.project_dir) / "images").string();
+  std::unique_ptr<CaptureSession> session(new CaptureSession(options));
+  session->on_event_ = std::move(on_event);
+  session->images_dir_ = (fs::path(options.project_dir) / "images").string();
   std::error_code error;
-  fs::create_directories(images_dir, error);
-  if (error) return IoError(images_dir + ": cannot create the directory: " + error.message());
+  fs::create_directories(session->images_dir_, error);
+  if (error) return IoError(session->images_dir_ + ": cannot create the directory: " + error.message());
   // What a capture killed mid-write left (a keyframe or feature file in flight).
   RECONAR_RETURN_IF_ERROR(RemoveStaleTemporaryFiles(options.project_dir).status());
   FrameSourceOptions source_options = options.source_options;
   source_options.want_rgb = true;
-  RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<FrameSource> source, OpenFrameSource(options.source, source_options));
+  RECONAR_ASSIGN_OR_RETURN(session->source_, OpenFrameSource(options.source, source_options));
 
-  CaptureReport report;
-  report.source = source->Describe();
-  const int on_disk = KeyframesOnDisk(images_dir);
-  const bool replay = IsReplay(options.source);
+  CaptureReport& report = session->report_;
+  report.source = session->source_->Describe();
+  session->on_disk_ = KeyframesOnDisk(session->images_dir_);
+  session->replay_ = IsReplay(options.source);
   // A replay meets its keyframes again from the first; a live camera goes on after them.
-  int ordinal = replay ? 0 : on_disk;
-  report.keyframes = on_disk;
-  for (int k = 1; k <= on_disk; ++k) report.keyframe_files.push_back((fs::path(images_dir) / KeyframeName(k)).string());
-  const auto emit = [&](CaptureEvent event) {
-    event.frames = report.frames;
-    event.keyframes = report.keyframes;
-    if (on_event) on_event(event);
-  };
-  if (options.max_keyframes > 0 && report.keyframes >= options.max_keyframes && !replay) {
+  session->ordinal_ = session->replay_ ? 0 : session->on_disk_;
+  report.keyframes = session->on_disk_;
+  for (int k = 1; k <= session->on_disk_; ++k)
+    report.keyframe_files.push_back((fs::path(session->images_dir_) / KeyframeName(k)).string());
+  if (options.max_keyframes > 0 && report.keyframes >= options.max_keyframes && !session->replay_) {
     report.stop_reason = "--max-keyframes reached";
-    return report;
+    session->ended_ = true;
+    return session;
   }
-
-  std::unique_ptr<LiveReconstruction> live;
-  std::vector<std::string> live_paths;  // in the order given to `live`
-  std::vector<bool> keyframe_registered;  // in the same order
   if (options.reconstruct_live) {
     LiveReconstructionOptions live_options = options.live;
     live_options.publish_map = live_options.publish_map || options.track_map;
     live_options.localizer = options.map_tracker.localizer;
-    live = std::make_unique<LiveReconstruction>(Project(options.project_dir), live_options);
+    session->live_ = std::make_unique<LiveReconstruction>(Project(options.project_dir), live_options);
   }
   // A camera goes on after the keyframes an earlier run took, and the live model grows from them.
-  if (!replay) {
-    report.keyframes_kept = on_disk;
-    if (live) {
+  if (!session->replay_) {
+    report.keyframes_kept = session->on_disk_;
+    if (session->live_) {
       for (const std::string& path : report.keyframe_files) {
-        live->AddKeyframe(path);
-        live_paths.push_back(path);
-        keyframe_registered.push_back(false);
+        session->live_->AddKeyframe(path);
+        session->live_paths_.push_back(path);
+        session->keyframe_registered_.push_back(false);
       }
     }
   }
-  KeyframeGate keyframe_gate(options.gate);
-  // The camera followed against the live model's newest map.
-  LiveMap map;
-  std::unique_ptr<MapTracker> map_tracker;
-  MapTrackerFrameReport map_report;
-  std::vector<double> map_track_ms;
-  const auto track_map = [&](const Frame& frame, CaptureEvent* event) -> Status {
-    if (!live || !options.track_map) return Status::Ok();
-    LiveMap newest;
-    if (replay) {
-      newest = live->MapAsOf(live->NumKeyframes() - options.map_lag_keyframes);
-    } else if (live->MapVersion() != map.version) {
-      newest = live->LatestMap();
-    }
-    if (newest.version != map.version && newest.map) {
-      const auto switch_start = std::chrono::steady_clock::now();
-      map_tracker.reset();  // it borrows the old map
-      // The gate's last keyframe, posed in the old map, carried into the new one.
-      if (map.map && keyframe_gate.keyframe_map_version() == map.version) {
-        if (const std::optional<Sim3> new_from_old = MapFromMap(*newest.map, *map.map))
-          keyframe_gate.MoveKeyframeToMap(newest.version, *new_from_old);
-      }
-      map = std::move(newest);
-      MapTrackerOptions tracker_options = options.map_tracker;
-      tracker_options.intrinsics = ScaledIntrinsics(map.intrinsics, frame.width, frame.height);
-      Result<std::unique_ptr<MapTracker>> created = map.localizer ? MapTracker::Create(map.localizer, tracker_options)
-                                                                  : MapTracker::Create(map.map.get(), tracker_options);
-      if (!created.ok()) return created.status().WithContext("following the live model");
-      map_tracker = std::move(created).value();
-      ++report.maps_used;
-      const double switch_ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - switch_start).count();
-      report.max_map_switch_ms = std::max(report.max_map_switch_ms, switch_ms);
-      report.total_map_switch_ms += switch_ms;
-    }
-    if (!map_tracker) return Status::Ok();
-    RECONAR_RETURN_IF_ERROR(map_tracker->Track(frame.gray, nullptr, &map_report));
-    map_track_ms.push_back(map_report.track_ms);
-    event->map_version = map.version;
-    event->map_state = map_report.state;
-    event->map_pose_found = map_report.found;
-    event->cam_from_world = map_report.cam_from_world;
-    event->map_inliers = map_report.inliers;
-    if (map_report.found) ++report.frames_map_posed;
-    return Status::Ok();
-  };
-  const auto emit_registered = [&](int64_t frame_index, double video_seconds) {
-    if (!live) return;
-    for (const int k : live->TakeNewlyRegistered()) {
-      keyframe_registered[static_cast<size_t>(k)] = true;
-      CaptureEvent event;
-      event.kind = CaptureEvent::Kind::kRegistered;
-      event.frame_index = frame_index;
-      event.video_seconds = video_seconds;
-      event.path = live_paths[static_cast<size_t>(k)];
-      event.registered = live->NumRegistered();
-      emit(event);
-    }
-  };
-  const auto replay_start = std::chrono::steady_clock::now();
+  session->replay_start_ = std::chrono::steady_clock::now();
   if (!options.preview_dir.empty()) {
     fs::create_directories(options.preview_dir, error);
     if (error) return IoError(options.preview_dir + ": cannot create the directory: " + error.message());
   }
-  std::unique_ptr<TagDetector> tag_detector;
-  TagDetectionList tags_in_view(16);
-  std::vector<std::array<Eigen::Vector2d, 4>> last_tags;
-  const bool previewing = !options.preview_dir.empty() || options.show_preview;
-  if (previewing && !options.preview_tag_family.empty()) {
+  session->previewing_ = !options.preview_dir.empty() || options.show_preview;
+  if (session->previewing_ && !options.preview_tag_family.empty()) {
     RECONAR_ASSIGN_OR_RETURN(const TagFamily family, ParseTagFamily(options.preview_tag_family));
     TagDetectorOptions detector_options;
     detector_options.family = family;
-    RECONAR_ASSIGN_OR_RETURN(tag_detector, TagDetector::Create(detector_options));
+    RECONAR_ASSIGN_OR_RETURN(session->tag_detector_, TagDetector::Create(detector_options));
   }
-  Image<uint8_t> last_view, preview;  // the last frame previewed, and with the overlay drawn
-  GateVerdict last_verdict = GateVerdict::kTooClose;
-  const char* last_advice = "";
-  const auto draw_overlay = [&]() {
-    preview = last_view;
-    CapturePreviewState state;
-    state.verdict = last_verdict;
-    state.advice = last_advice;
-    state.keyframe_registered = keyframe_registered;
-    if (live) state.coverage = live->Coverage();
-    state.tags = last_tags;
-    DrawCapturePreview(state, &preview);
-  };
-  // The overlay on the last frame previewed, as `name` and as latest.png.
-  const auto draw_preview = [&](const char* name) -> Status {
-    draw_overlay();
-    if (name != nullptr)
-      RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options.preview_dir) / name).string(), preview.view(), 3));
-    RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options.preview_dir) / "latest.png").string(), preview.view(), 3));
-    ++report.previews;
-    return Status::Ok();
-  };
-  const auto take_view = [&](const Frame& frame, const GateFrameReport& gate, bool find_tags) {
-    if (last_view.width() != frame.width || last_view.height() != frame.height)
-      last_view = Image<uint8_t>(frame.width, frame.height, 3);
-    for (int y = 0; y < frame.height; ++y)
-      std::copy(frame.rgb.row(y), frame.rgb.row(y) + 3 * frame.width, last_view.row(y));
-    last_verdict = gate.verdict;
-    last_advice = gate.advice;
-    if (!find_tags) return;
-    last_tags.clear();
-    if (tag_detector && tag_detector->Detect(frame.gray, &tags_in_view).ok()) {
-      for (const TagDetection& tag : tags_in_view)
-        last_tags.push_back({tag.corners[0], tag.corners[1], tag.corners[2], tag.corners[3]});
-    }
-  };
-  // Each keyframe and one frame per second: the tags found again, the picture written.
-  const auto write_preview = [&](const Frame& frame, const GateFrameReport& gate) -> Status {
-    if (!previewing || frame.rgb.data == nullptr) return Status::Ok();
-    take_view(frame, gate, /*find_tags=*/true);
-    if (options.preview_dir.empty()) return Status::Ok();
-    char name[40];
-    std::snprintf(name, sizeof(name), "preview_%06lld.png", static_cast<long long>(frame.index));
-    return draw_preview(name);
-  };
-  // Every frame in the window, with the tags last found; false: stop (the reason is set).
-  const auto show_preview = [&](const Frame& frame, const GateFrameReport& gate, bool taken) -> bool {
-    if (!options.show_preview || frame.rgb.data == nullptr) return true;
-    if (!taken) take_view(frame, gate, /*find_tags=*/false);
-    draw_overlay();
-    const Result<bool> shown = options.show_preview(preview);
-    if (shown.ok() && *shown) return true;
-    report.stop_reason = shown.ok() ? "window closed" : "the window failed: " + shown.status().message();
-    report.window_failed = !shown.ok();
-    return false;
-  };
+  return session;
+}
 
-  std::vector<double> gate_ms;
-  int corrupt_in_a_row = 0;
-  std::string last_damage;
-  int64_t first_timestamp = -1;
-  int last_status_second = -1;
-  while (true) {
-    if (stop != nullptr && stop->load()) {
-      report.stop_reason = "stopped";
-      break;
-    }
-    Result<FrameHandle> next = source->Next();
-    if (!next.ok()) {
-      if (IsEndOfStream(next.status())) {
-        report.stop_reason = replay ? "end of the recording" : "end of the stream";
-        break;
-      }
-      // A damaged frame is skipped; the same damage met again (a recording cut short, which cannot
-      // be read past) ends the capture like a camera that disconnected.
-      const bool same_damage = next.status().message() == last_damage;
-      last_damage = next.status().message();
-      if (next.status().code() == StatusCode::kCorruptData && !same_damage &&
-          ++corrupt_in_a_row < options.max_corrupt_frames_in_a_row) {
-        ++report.corrupt;
-        CaptureEvent warning;
-        warning.kind = CaptureEvent::Kind::kWarning;
-        warning.message = "skipped a corrupt frame: " + next.status().message();
-        emit(warning);
-        continue;
-      }
-      report.source_failed = true;
-      report.stop_reason = next.status().message();
-      break;
-    }
-    corrupt_in_a_row = 0;
-    const Frame& frame = **next;
-    if (first_timestamp < 0) first_timestamp = frame.timestamp_ns;
-    ++report.frames;
+void CaptureSession::Emit(CaptureEvent event) const {
+  event.frames = report_.frames;
+  event.keyframes = report_.keyframes;
+  if (on_event_) on_event_(event);
+}
+
+void CaptureSession::EmitRegistered(int64_t frame_index, double video_seconds) {
+  if (!live_) return;
+  for (const int k : live_->TakeNewlyRegistered()) {
+    keyframe_registered_[static_cast<size_t>(k)] = true;
     CaptureEvent event;
-    event.frame_index = frame.index;
-    event.video_seconds = static_cast<double>(frame.timestamp_ns - first_timestamp) * 1e-9;
-    if (replay && options.replay_in_real_time)
-      std::this_thread::sleep_until(replay_start + std::chrono::duration<double>(event.video_seconds));
-    emit_registered(event.frame_index, event.video_seconds);
-    if (live) event.registered = live->NumRegistered();
-    if (const Status tracked = track_map(frame, &event); !tracked.ok()) {
-      return Status(tracked.code(), std::string(frame.name) + ": " + tracked.message());
-    }
-    GateMapPose map_pose;
-    if (event.map_pose_found) {
-      map_pose.map_version = event.map_version;
-      map_pose.cam_from_world = event.cam_from_world;
-      map_pose.points = map_report.inlier_world_points.data();
-      map_pose.num_points = static_cast<int>(map_report.inlier_world_points.size());
-    }
-    const auto start = std::chrono::steady_clock::now();
-    const Status judged = keyframe_gate.Process(frame.gray, &event.gate, &map_pose);
-    gate_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-    if (!judged.ok()) return Status(judged.code(), std::string(frame.name) + ": " + judged.message());
-    if (event.gate.triangulation_angle_deg >= 0.0) ++report.frames_map_motion;
-    switch (event.gate.verdict) {
-      case GateVerdict::kBlurred:
-        ++report.blurred;
-        break;
-      case GateVerdict::kBadExposure:
-        ++report.bad_exposure;
-        break;
-      case GateVerdict::kTooClose:
-        ++report.too_close;
-        break;
-      case GateVerdict::kLost:
-        ++report.lost;
-        break;
-      case GateVerdict::kKeyframe:
-        break;
-    }
-    if (event.gate.verdict == GateVerdict::kKeyframe) {
-      ++ordinal;
-      const std::string path = (fs::path(images_dir) / KeyframeName(ordinal)).string();
-      event.kind = CaptureEvent::Kind::kKeyframe;
-      event.path = path;
-      if (ordinal <= on_disk) {
-        event.kept = true;
-        ++report.keyframes_kept;
-      } else {
-        ExifInfo exif =
-            options.focal_px > 0.0 ? ExifForFocal(frame.width, frame.height, options.focal_px, "") : ExifInfo{};
-        exif.make = "reconar";
-        exif.model = report.source;
-        RECONAR_RETURN_IF_ERROR(WriteJpeg(path, frame.rgb, 3, options.jpeg_quality, BuildExifApp1(exif)));
-        ++report.keyframes;
-        report.keyframe_files.push_back(path);
-      }
-      if (live) {
-        live->AddKeyframe(path);
-        live_paths.push_back(path);
-      }
-      keyframe_registered.push_back(false);
-      emit(event);
-      RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate));
-      if (!show_preview(frame, event.gate, /*taken=*/true)) break;
-      if (options.max_keyframes > 0 && ordinal >= options.max_keyframes) {
-        report.stop_reason = "--max-keyframes reached";
-        break;
-      }
-      continue;
-    }
-    const int second = static_cast<int>(event.video_seconds);
-    bool taken = false;
-    if (second != last_status_second) {
-      last_status_second = second;
-      event.kind = CaptureEvent::Kind::kStatus;
-      emit(event);
-      RECONAR_RETURN_IF_ERROR(write_preview(frame, event.gate));
-      taken = previewing;
-    } else if (options.frame_events) {
-      event.kind = CaptureEvent::Kind::kFrame;
-      emit(event);
-    }
-    if (!show_preview(frame, event.gate, taken)) break;
+    event.kind = CaptureEvent::Kind::kRegistered;
+    event.frame_index = frame_index;
+    event.video_seconds = video_seconds;
+    event.path = live_paths_[static_cast<size_t>(k)];
+    event.registered = live_->NumRegistered();
+    Emit(event);
   }
-  report.median_gate_ms = Median(gate_ms);
-  report.median_map_track_ms = Median(map_track_ms);
-  if (live) {
+}
+
+// The camera followed against the live model's newest map.
+Status CaptureSession::FollowMap(const Frame& frame, CaptureEvent* event) {
+  if (!live_ || !options_.track_map) return Status::Ok();
+  LiveMap newest;
+  if (replay_) {
+    newest = live_->MapAsOf(live_->NumKeyframes() - options_.map_lag_keyframes);
+  } else if (live_->MapVersion() != map_follower_.version()) {
+    newest = live_->LatestMap();
+  }
+  if (newest.version != map_follower_.version() && newest.map) {
+    const bool keyframe_in_old_map =
+        map_follower_.following() && keyframe_gate_.keyframe_map_version() == map_follower_.version();
+    Result<MapSwitch> switched = map_follower_.TakeUp(newest.version, newest.map, newest.localizer,
+                                                      newest.intrinsics, frame.width, frame.height);
+    if (!switched.ok()) return switched.status().WithContext("following the live model");
+    const MapSwitch& taken_up = *switched;
+    // The gate's last keyframe, posed in the old map, carried into the new one.
+    if (keyframe_in_old_map && taken_up.new_from_old) keyframe_gate_.MoveKeyframeToMap(newest.version, *taken_up.new_from_old);
+    ++report_.maps_used;
+    report_.max_map_switch_ms = std::max(report_.max_map_switch_ms, taken_up.milliseconds);
+    report_.total_map_switch_ms += taken_up.milliseconds;
+  }
+  if (!map_follower_.following()) return Status::Ok();
+  RECONAR_RETURN_IF_ERROR(map_follower_.Track(frame.gray, &map_report_));
+  map_track_ms_.push_back(map_report_.track_ms);
+  event->map_version = map_follower_.version();
+  event->map_state = map_report_.state;
+  event->map_pose_found = map_report_.found;
+  event->cam_from_world = map_report_.cam_from_world;
+  event->map_inliers = map_report_.inliers;
+  if (map_report_.found) ++report_.frames_map_posed;
+  return Status::Ok();
+}
+
+void CaptureSession::DrawOverlay() {
+  preview_ = last_view_;
+  CapturePreviewState state;
+  state.verdict = last_verdict_;
+  state.advice = last_advice_;
+  state.keyframe_registered = keyframe_registered_;
+  if (live_) state.coverage = live_->Coverage();
+  state.tags = last_tags_;
+  DrawCapturePreview(state, &preview_);
+}
+
+// The overlay on the last frame previewed, as `name` and as latest.png.
+Status CaptureSession::DrawPreview(const char* name) {
+  DrawOverlay();
+  if (name != nullptr)
+    RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options_.preview_dir) / name).string(), preview_.view(), 3));
+  RECONAR_RETURN_IF_ERROR(WritePng((fs::path(options_.preview_dir) / "latest.png").string(), preview_.view(), 3));
+  ++report_.previews;
+  return Status::Ok();
+}
+
+void CaptureSession::TakeView(const Frame& frame, const GateFrameReport& gate, bool find_tags) {
+  if (last_view_.width() != frame.width || last_view_.height() != frame.height)
+    last_view_ = Image<uint8_t>(frame.width, frame.height, 3);
+  for (int y = 0; y < frame.height; ++y)
+    std::copy(frame.rgb.row(y), frame.rgb.row(y) + 3 * frame.width, last_view_.row(y));
+  last_verdict_ = gate.verdict;
+  last_advice_ = gate.advice;
+  if (!find_tags) return;
+  last_tags_.clear();
+  if (tag_detector_ && tag_detector_->Detect(frame.gray, &tags_in_view_).ok()) {
+    for (const TagDetection& tag : tags_in_view_)
+      last_tags_.push_back({tag.corners[0], tag.corners[1], tag.corners[2], tag.corners[3]});
+  }
+}
+
+// Each keyframe and one frame per second: the tags found again, the picture written.
+Status CaptureSession::WritePreview(const Frame& frame, const GateFrameReport& gate) {
+  if (!previewing_ || frame.rgb.data == nullptr) return Status::Ok();
+  TakeView(frame, gate, /*find_tags=*/true);
+  if (options_.preview_dir.empty()) return Status::Ok();
+  char name[40];
+  std::snprintf(name, sizeof(name), "preview_%06lld.png", static_cast<long long>(frame.index));
+  return DrawPreview(name);
+}
+
+// Every frame in the window, with the tags last found; false: stop (the reason is set).
+bool CaptureSession::ShowPreview(const Frame& frame, const GateFrameReport& gate, bool taken) {
+  if (!options_.show_preview || frame.rgb.data == nullptr) return true;
+  if (!taken) TakeView(frame, gate, /*find_tags=*/false);
+  DrawOverlay();
+  const Result<bool> shown = options_.show_preview(preview_);
+  if (shown.ok() && *shown) return true;
+  report_.stop_reason = shown.ok() ? "window closed" : "the window failed: " + shown.status().message();
+  report_.window_failed = !shown.ok();
+  return false;
+}
+
+bool CaptureSession::SourceFailed(const Status& status) {
+  if (IsEndOfStream(status)) {
+    report_.stop_reason = replay_ ? "end of the recording" : "end of the stream";
+    return true;
+  }
+  // A damaged frame is skipped; the same damage met again (a recording cut short, which cannot
+  // be read past) ends the capture like a camera that disconnected.
+  const bool same_damage = status.message() == last_damage_;
+  last_damage_ = status.message();
+  if (status.code() == StatusCode::kCorruptData && !same_damage &&
+      ++corrupt_in_a_row_ < options_.max_corrupt_frames_in_a_row) {
+    ++report_.corrupt;
+    CaptureEvent warning;
+    warning.kind = CaptureEvent::Kind::kWarning;
+    warning.message = "skipped a corrupt frame: " + status.message();
+    Emit(warning);
+    return false;
+  }
+  report_.source_failed = true;
+  report_.stop_reason = status.message();
+  return true;
+}
+
+Status CaptureSession::TakeKeyframe(const Frame& frame, CaptureEvent* event) {
+  ++ordinal_;
+  const std::string path = (fs::path(images_dir_) / KeyframeName(ordinal_)).string();
+  event->kind = CaptureEvent::Kind::kKeyframe;
+  event->path = path;
+  if (ordinal_ <= on_disk_) {
+    event->kept = true;
+    ++report_.keyframes_kept;
+  } else {
+    ExifInfo exif =
+        options_.focal_px > 0.0 ? ExifForFocal(frame.width, frame.height, options_.focal_px, "") : ExifInfo{};
+    exif.make = "reconar";
+    exif.model = report_.source;
+    RECONAR_RETURN_IF_ERROR(WriteJpeg(path, frame.rgb, 3, options_.jpeg_quality, BuildExifApp1(exif)));
+    ++report_.keyframes;
+    report_.keyframe_files.push_back(path);
+  }
+  if (live_) {
+    live_->AddKeyframe(path);
+    live_paths_.push_back(path);
+  }
+  keyframe_registered_.push_back(false);
+  return Status::Ok();
+}
+
+Result<bool> CaptureSession::Step() {
+  if (ended_) return false;
+  Result<FrameHandle> next = source_->Next();
+  while (!next.ok()) {
+    if (SourceFailed(next.status())) {
+      ended_ = true;
+      return false;
+    }
+    next = source_->Next();
+  }
+  corrupt_in_a_row_ = 0;
+  const Frame& frame = **next;
+  if (first_timestamp_ < 0) first_timestamp_ = frame.timestamp_ns;
+  ++report_.frames;
+  CaptureEvent event;
+  event.frame_index = frame.index;
+  event.video_seconds = static_cast<double>(frame.timestamp_ns - first_timestamp_) * 1e-9;
+  if (replay_ && options_.replay_in_real_time)
+    std::this_thread::sleep_until(replay_start_ + std::chrono::duration<double>(event.video_seconds));
+  EmitRegistered(event.frame_index, event.video_seconds);
+  if (live_) event.registered = live_->NumRegistered();
+  if (const Status tracked = FollowMap(frame, &event); !tracked.ok()) {
+    return Status(tracked.code(), std::string(frame.name) + ": " + tracked.message());
+  }
+  GateMapPose map_pose;
+  if (event.map_pose_found) {
+    map_pose.map_version = event.map_version;
+    map_pose.cam_from_world = event.cam_from_world;
+    map_pose.points = map_report_.inlier_world_points.data();
+    map_pose.num_points = static_cast<int>(map_report_.inlier_world_points.size());
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const Status judged = keyframe_gate_.Process(frame.gray, &event.gate, &map_pose);
+  gate_ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  if (!judged.ok()) return Status(judged.code(), std::string(frame.name) + ": " + judged.message());
+  if (event.gate.triangulation_angle_deg >= 0.0) ++report_.frames_map_motion;
+  switch (event.gate.verdict) {
+    case GateVerdict::kBlurred:
+      ++report_.blurred;
+      break;
+    case GateVerdict::kBadExposure:
+      ++report_.bad_exposure;
+      break;
+    case GateVerdict::kTooClose:
+      ++report_.too_close;
+      break;
+    case GateVerdict::kLost:
+      ++report_.lost;
+      break;
+    case GateVerdict::kKeyframe:
+      break;
+  }
+  if (event.gate.verdict == GateVerdict::kKeyframe) {
+    RECONAR_RETURN_IF_ERROR(TakeKeyframe(frame, &event));
+    Emit(event);
+    RECONAR_RETURN_IF_ERROR(WritePreview(frame, event.gate));
+    if (!ShowPreview(frame, event.gate, /*taken=*/true)) {
+      ended_ = true;
+      return false;
+    }
+    if (options_.max_keyframes > 0 && ordinal_ >= options_.max_keyframes) {
+      report_.stop_reason = "--max-keyframes reached";
+      ended_ = true;
+      return false;
+    }
+    return true;
+  }
+  const int second = static_cast<int>(event.video_seconds);
+  bool taken = false;
+  if (second != last_status_second_) {
+    last_status_second_ = second;
+    event.kind = CaptureEvent::Kind::kStatus;
+    Emit(event);
+    RECONAR_RETURN_IF_ERROR(WritePreview(frame, event.gate));
+    taken = previewing_;
+  } else if (options_.frame_events) {
+    event.kind = CaptureEvent::Kind::kFrame;
+    Emit(event);
+  }
+  if (!ShowPreview(frame, event.gate, taken)) {
+    ended_ = true;
+    return false;
+  }
+  return true;
+}
+
+Result<CaptureReport> CaptureSession::Finish() {
+  if (!ended_) report_.stop_reason = "stopped";
+  ended_ = true;
+  report_.median_gate_ms = Median(gate_ms_);
+  report_.median_map_track_ms = Median(map_track_ms_);
+  if (live_) {
     // The worker finishes the keyframes it has not reached; its events still reach the caller.
-    RECONAR_ASSIGN_OR_RETURN(report.live_model, live->Finish());
-    report.live = true;
-    emit_registered(-1, -1.0);
+    RECONAR_ASSIGN_OR_RETURN(report_.live_model, live_->Finish());
+    report_.live = true;
+    EmitRegistered(-1, -1.0);
   }
   // latest.png once more, with every registration the live model made.
-  if (!options.preview_dir.empty() && last_view.width() > 0) RECONAR_RETURN_IF_ERROR(draw_preview(nullptr));
-  return report;
+  if (!options_.preview_dir.empty() && last_view_.width() > 0) RECONAR_RETURN_IF_ERROR(DrawPreview(nullptr));
+  return report_;
+}
+
+Result<CaptureReport> RunCapture(const CaptureOptions& options,
+                                 const std::function<void(const CaptureEvent&)>& on_event,
+                                 const std::atomic<bool>* stop) {
+  RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<CaptureSession> session, CaptureSession::Open(options, on_event));
+  while (stop == nullptr || !stop->load()) {
+    RECONAR_ASSIGN_OR_RETURN(const bool more, session->Step());
+    if (!more) break;
+  }
+  return session->Finish();
 }
 
 }  // namespace reconar

@@ -10,8 +10,11 @@
 // gate is deterministic, so it takes the same keyframes, and those already on disk are kept, not
 // written again; the run then goes on past them. A live camera's keyframes are numbered on after
 // the last one on disk.
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,7 +23,9 @@
 #include "core/pipeline/live_reconstruction.h"
 #include "platform/camera/frame_source.h"
 #include "tracker/keyframe_gate.h"
+#include "tracker/map_follower.h"
 #include "tracker/map_tracker.h"
+#include "tracker/tag_detector.h"
 
 namespace reconar {
 
@@ -112,10 +117,81 @@ struct CaptureReport {
   LiveReconstructionReport live_model;
 };
 
-// Runs the capture until the source ends, max_keyframes are on disk, *stop becomes true (SIGINT),
-// or the source fails (the report says so; what was captured stays). Errors: bad options, a source
-// that cannot be opened, a keyframe that cannot be written (full disk: the file is named, the
-// earlier keyframes are intact).
+// The capture, a frame at a time (the shape of ArSession, render/ar/ar_session.h):
+//
+//   RECONAR_ASSIGN_OR_RETURN(auto session, CaptureSession::Open(options, on_event));
+//   for (;;) {
+//     RECONAR_ASSIGN_OR_RETURN(const bool more, session->Step());
+//     if (!more) break;
+//   }
+//   RECONAR_ASSIGN_OR_RETURN(const CaptureReport report, session->Finish());
+//
+// Events reach on_event from Step() and Finish() on the caller's thread.
+class CaptureSession {
+ public:
+  // Errors: bad options, a source that cannot be opened, a project directory that cannot be made.
+  static Result<std::unique_ptr<CaptureSession>> Open(const CaptureOptions& options,
+                                                      std::function<void(const CaptureEvent&)> on_event);
+  ~CaptureSession();
+
+  // The next frame through the gate (and against the live model's map). False when the capture
+  // has ended: the source ended or failed, max_keyframes were reached, or the window closed
+  // (report().stop_reason says which). Errors: a keyframe that cannot be written (full disk: the
+  // file is named, the earlier keyframes are intact), a tracking error naming the frame.
+  Result<bool> Step();
+
+  // Ends the capture (stop_reason "stopped" when Step() had not ended it): the live model finishes
+  // the keyframes it has not reached, its registrations are reported, the last preview is drawn.
+  Result<CaptureReport> Finish();
+
+  const CaptureReport& report() const { return report_; }
+
+ private:
+  explicit CaptureSession(const CaptureOptions& options);
+  void Emit(CaptureEvent event) const;
+  void EmitRegistered(int64_t frame_index, double video_seconds);
+  Status FollowMap(const Frame& frame, CaptureEvent* event);
+  // False when the frame ends the capture (report_.stop_reason set); the event warns of a skipped one.
+  bool SourceFailed(const Status& status);
+  Status TakeKeyframe(const Frame& frame, CaptureEvent* event);
+  void DrawOverlay();
+  Status DrawPreview(const char* name);
+  void TakeView(const Frame& frame, const GateFrameReport& gate, bool find_tags);
+  Status WritePreview(const Frame& frame, const GateFrameReport& gate);
+  bool ShowPreview(const Frame& frame, const GateFrameReport& gate, bool taken);
+
+  CaptureOptions options_;
+  std::function<void(const CaptureEvent&)> on_event_;
+  std::string images_dir_;
+  std::unique_ptr<FrameSource> source_;
+  CaptureReport report_;
+  bool ended_ = false;
+  bool replay_ = false;
+  int on_disk_ = 0;   // keyframes found in images_dir_ at Open
+  int ordinal_ = 0;   // of the last keyframe taken or met again
+  std::unique_ptr<LiveReconstruction> live_;
+  std::vector<std::string> live_paths_;    // in the order given to live_
+  std::vector<bool> keyframe_registered_;  // in the same order
+  KeyframeGate keyframe_gate_;
+  MapFollower map_follower_;
+  MapTrackerFrameReport map_report_;
+  std::vector<double> map_track_ms_, gate_ms_;
+  std::chrono::steady_clock::time_point replay_start_;
+  std::unique_ptr<TagDetector> tag_detector_;
+  TagDetectionList tags_in_view_;
+  std::vector<std::array<Eigen::Vector2d, 4>> last_tags_;
+  bool previewing_ = false;
+  Image<uint8_t> last_view_, preview_;  // the last frame previewed, and with the overlay drawn
+  GateVerdict last_verdict_ = GateVerdict::kTooClose;
+  const char* last_advice_ = "";
+  int corrupt_in_a_row_ = 0;
+  std::string last_damage_;
+  int64_t first_timestamp_ = -1;
+  int last_status_second_ = -1;
+};
+
+// Opens a CaptureSession and steps it until it ends or *stop becomes true (SIGINT), then Finish().
+// A source that fails ends the capture with the report saying so (what was captured stays).
 Result<CaptureReport> RunCapture(const CaptureOptions& options,
                                  const std::function<void(const CaptureEvent&)>& on_event,
                                  const std::atomic<bool>* stop = nullptr);

@@ -21,7 +21,7 @@
 #include "core/io/image_io.h"
 #include "tests/support/ar_video.h"
 #include "tests/support/run_command.h"
-#include "tracker/calibration.h"
+#include "core/io/intrinsics_file.h"
 
 namespace reconar {
 namespace {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tests/tracker/rotation_video.h"
+#include "tracker/map_follower.h"
 
 namespace reconar {
 namespace {
@@ -212,6 +213,86 @@ TEST_F(MapTrackerTest, RejectsBadOptionsAndInputs) {
       EXPECT_FALSE(report.found) << side;
     }
   }
+}
+
+// The map moved by the similarity: points and keyframe poses (what each keyframe sees is unchanged).
+LocalizationMap Moved(const LocalizationMap& map, const Sim3& moved_from_map) {
+  LocalizationMap moved = map;
+  for (Eigen::Vector3d& point : moved.points) point = moved_from_map.Apply(point);
+  for (MapKeyframe& keyframe : moved.keyframes) {
+    const Eigen::Vector3d centre = moved_from_map.Apply(CameraCenterInWorld(keyframe.cam_from_world));
+    keyframe.cam_from_world.rotation = keyframe.cam_from_world.rotation * moved_from_map.rotation.transpose();
+    keyframe.cam_from_world.translation = -(keyframe.cam_from_world.rotation * centre);
+  }
+  return moved;
+}
+
+Sim3 ASimilarity() {
+  Sim3 similarity;
+  similarity.scale = 1.7;
+  similarity.rotation = Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.2, 0.9, -0.3).normalized()).matrix();
+  similarity.translation = Eigen::Vector3d(0.5, -2.0, 3.0);
+  return similarity;
+}
+
+TEST_F(MapTrackerTest, AFollowerTakesUpANewMapAndPosesInItsFrame) {
+  MapFollower follower(Options());
+  MapTrackerFrameReport report;
+  EXPECT_EQ(follower.Track(ImageView<const uint8_t>(), &report).code(), StatusCode::kFailedPrecondition);
+  EXPECT_EQ(follower.TakeUp(1, nullptr, nullptr, scene_->frame_camera, 640, 480).status().code(),
+            StatusCode::kInvalidArgument);
+  const Image<uint8_t> frame = testing::RenderRotatedView(*scene_, Sweep(0));
+  // The map's camera at twice the frame's size: the follower scales it to the frame.
+  CameraIntrinsics map_camera = scene_->frame_camera;
+  map_camera.fx *= 2.0;
+  map_camera.fy *= 2.0;
+  map_camera.cx *= 2.0;
+  map_camera.cy *= 2.0;
+  map_camera.width *= 2;
+  map_camera.height *= 2;
+  auto first = follower.TakeUp(1, std::make_shared<const LocalizationMap>(*map_), nullptr, map_camera, 640, 480);
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  EXPECT_FALSE(first->new_from_old.has_value());  // no map before
+  ASSERT_TRUE(follower.Track(frame.view(), &report).ok());
+  ASSERT_TRUE(report.found);
+  const Rigid3 in_first = report.cam_from_world;
+  EXPECT_LT(Compare(in_first, testing::RotatedViewPose(*scene_, Sweep(0))).rotation_deg, 0.2);
+
+  const Sim3 moved = ASimilarity();
+  auto second = follower.TakeUp(2, std::make_shared<const LocalizationMap>(Moved(*map_, moved)), nullptr, map_camera,
+                                640, 480);
+  ASSERT_TRUE(second.ok()) << second.status().ToString();
+  EXPECT_EQ(follower.version(), 2);
+  // The keyframes of a camera turning on the spot share one centre: no similarity from them.
+  EXPECT_FALSE(second->new_from_old.has_value());
+  ASSERT_TRUE(follower.Track(frame.view(), &report).ok());
+  ASSERT_TRUE(report.found);
+  const Eigen::Vector3d expected_centre = moved.Apply(CameraCenterInWorld(in_first));
+  EXPECT_LT((CameraCenterInWorld(report.cam_from_world) - expected_centre).norm(), 0.01 * moved.scale);
+  const Eigen::Matrix3d expected_rotation = in_first.rotation * moved.rotation.transpose();
+  EXPECT_LT(Eigen::AngleAxisd(Eigen::Matrix3d(report.cam_from_world.rotation * expected_rotation.transpose())).angle(),
+            0.2 * M_PI / 180.0);
+}
+
+TEST(MapFromMapTest, TheSharedKeyframesCentresGiveTheSimilarity) {
+  LocalizationMap old_map;
+  for (int k = 0; k < 5; ++k) {
+    MapKeyframe keyframe;
+    keyframe.name = "keyframe_" + std::to_string(k) + ".jpg";
+    keyframe.cam_from_world.rotation = Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d::UnitY()).matrix();
+    keyframe.cam_from_world.translation = Eigen::Vector3d(std::cos(k), 0.2 * k, std::sin(k) + 4.0);
+    old_map.keyframes.push_back(keyframe);
+  }
+  const Sim3 truth = ASimilarity();
+  LocalizationMap new_map = Moved(old_map, truth);
+  new_map.keyframes.erase(new_map.keyframes.begin());  // the new map need not hold every keyframe
+  const std::optional<Sim3> new_from_old = MapFromMap(new_map, old_map);
+  ASSERT_TRUE(new_from_old.has_value());
+  EXPECT_NEAR(new_from_old->scale, truth.scale, 1e-9);
+  EXPECT_LT((new_from_old->rotation - truth.rotation).norm(), 1e-9);
+  EXPECT_LT((new_from_old->translation - truth.translation).norm(), 1e-9);
+  new_map.keyframes.resize(2);  // two shared keyframes are not enough
+  EXPECT_FALSE(MapFromMap(new_map, old_map).has_value());
 }
 
 }  // namespace

@@ -64,8 +64,7 @@ std::vector<uint8_t> ClassifyDistinctPoints(const std::vector<Eigen::Vector3f>& 
     std::vector<double> around(k);
     for (size_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
       for (size_t j = 0; j < k; ++j) around[j] = log_spacing[knn[i * k + j]];
-      std::nth_element(around.begin(), around.begin() + static_cast<std::ptrdiff_t>(k / 2), around.end());
-      log_ratio[i] = log_spacing[i] - around[k / 2];
+      log_ratio[i] = log_spacing[i] - MedianInPlace(around.data(), k);
     }
   });
   const double median = Median(log_ratio);

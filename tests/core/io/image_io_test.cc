@@ -162,6 +162,33 @@ TEST_F(ImageIoTest, DecodesRgbJpegCloseToSource) {
   EXPECT_TRUE(decoded->warnings.empty());
 }
 
+TEST_F(ImageIoTest, TheHeaderGivesTheUprightSizeWithoutDecoding) {
+  JpegSpec spec = PatternJpeg(480, 320);
+  testing::TiffBuilder tiff(true);
+  tiff.Ifd0Short(0x0112, 6);  // rotate 90 degrees clockwise for display
+  spec.app1 = tiff.BuildApp1();
+  const std::string jpeg = EncodeJpeg(spec);
+  auto rotated = ReadImageHeader(Write("header.jpg", jpeg));
+  ASSERT_TRUE(rotated.ok()) << rotated.status().ToString();
+  EXPECT_EQ(rotated->width, 320);
+  EXPECT_EQ(rotated->height, 480);
+  EXPECT_EQ(rotated->exif.orientation, 6);
+  // A photo cut short after its headers still has its size; one cut inside them does not.
+  auto cut = ReadImageHeader(Write("cut.jpg", jpeg.substr(0, jpeg.size() / 2)));
+  ASSERT_TRUE(cut.ok()) << cut.status().ToString();
+  EXPECT_EQ(cut->width, 320);
+  EXPECT_EQ(ReadImageHeader(Write("head.jpg", jpeg.substr(0, 40))).status().code(), StatusCode::kCorruptData);
+  PngSpec png{7, 5, PNG_COLOR_TYPE_RGB, 8};
+  png.samples.assign(7 * 5 * 3, 90);
+  auto png_header = ReadImageHeader(Write("header.png", EncodePng(png)));
+  ASSERT_TRUE(png_header.ok()) << png_header.status().ToString();
+  EXPECT_EQ(png_header->width, 7);
+  EXPECT_EQ(png_header->height, 5);
+  EXPECT_EQ(ReadImageHeader(Write("short.png", EncodePng(png).substr(0, 20))).status().code(),
+            StatusCode::kCorruptData);
+  EXPECT_EQ(ReadImageHeader(Write("present.jpg", jpeg) + ".missing").status().code(), StatusCode::kNotFound);
+}
+
 TEST_F(ImageIoTest, DecodesProgressiveAndRestartIntervalJpegs) {
   JpegSpec progressive = PatternJpeg(64, 48);
   progressive.progressive = true;

@@ -1,4 +1,4 @@
-#include "tracker/tag_layout.h"
+#include "tracker/board_pose.h"
 
 #include <algorithm>
 #include <cmath>
