@@ -150,21 +150,14 @@ int RunMatch(int argc, char** argv, int first) {
   valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
   valued.insert({"project", "pairs", "memory-budget"});
   Args args(valued, {"json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 0, SIZE_MAX)) return *exit_code;
   MatchStageOptions options;  // the library's defaults: ratio 0.6, 100 inliers (sfm and reconstruct: 0.8, 30)
   if (Status s = ReadMatchArgs(args, &options); !s.ok()) return Fail(s);
   if (args.Has("project")) {
     if (!args.positionals().empty()) return Fail(InvalidArgument("give either --project DIR or two images, not both"));
     return MatchProject(args, options);
   }
-  if (args.positionals().size() != 2) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (args.positionals().size() != 2) return UsageError(kHelp);
   return MatchTwo(args, options);
 }
 

@@ -52,17 +52,9 @@ int RunTrack(int argc, char** argv, int first) {
   std::set<std::string> valued = kTrackerValuedOptions;
   valued.insert({"layout", "project", "max-frames"});
   Args args(valued, {"json", "no-map"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    std::fputs(kTrackerOptionsHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().size() != 1 || (args.Has("layout") && args.Has("project"))) {
-    std::fputs(kHelp, stderr);
-    std::fputs(kTrackerOptionsHelp, stderr);
-    return 2;
-  }
+  const CommandUsage usage = {1, 1, {}, [](const Args& a) { return !(a.Has("layout") && a.Has("project")); }};
+  const std::string help = std::string(kHelp) + kTrackerOptionsHelp;
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, help, usage)) return *exit_code;
   ArSessionOptions options;
   options.source = args.positionals()[0];
   options.frames.want_rgb = false;

@@ -112,18 +112,12 @@ int RunView(int argc, char** argv, int first) {
   valued.insert({"model", "project", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
                  "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces"});
   Args args(valued, {"no-axes", "smooth", "no-map", "json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    std::fputs(kTrackerOptionsHelp, stdout);
-    return 0;
-  }
-  if (!args.positionals().empty() || args.Has("model") == args.Has("project") ||
-      args.Has("camera") == args.Has("frames")) {
-    std::fputs(kHelp, stderr);
-    std::fputs(kTrackerOptionsHelp, stderr);
-    return 2;
-  }
+  // A model or a project, and a camera or frames: one of each.
+  const CommandUsage usage = {0, 0, {}, [](const Args& a) {
+                                return a.Has("model") != a.Has("project") && a.Has("camera") != a.Has("frames");
+                              }};
+  const std::string help = std::string(kHelp) + kTrackerOptionsHelp;
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, help, usage)) return *exit_code;
   TrackerDefaults defaults;
   auto loaded = ProjectFromArgs(args, &defaults);
   if (!loaded.ok()) return Fail(loaded.status());
