@@ -43,6 +43,22 @@ Result<ModelPlacement> ModelPlacement::StandingOnTag(const Mesh& mesh, double he
   return placement;
 }
 
+ModelPlacement ModelPlacement::Scaled(double scale, const Eigen::Vector3d& model_up) {
+  ModelPlacement placement;
+  placement.scale = scale;
+  placement.rotation = Eigen::Quaterniond::FromTwoVectors(model_up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return placement;
+}
+
+ModelPlacement ModelPlacement::Turned(double degrees, const Eigen::Vector3d& shift) const {
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(degrees * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  ModelPlacement turned = *this;
+  turned.rotation = turn * rotation;
+  turned.offset = turn * offset;
+  turned.offset += shift;
+  return turned;
+}
+
 Eigen::Matrix4d CamFromModel(const Rigid3& cam_from_tag, const ModelPlacement& placement) {
   return cam_from_tag.Matrix() * placement.TagFromModel();
 }

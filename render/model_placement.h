@@ -27,6 +27,13 @@ struct ModelPlacement {
   // a zero model_up or a height that is not positive.
   static Result<ModelPlacement> StandingOnTag(const Mesh& mesh, double height_m,
                                               const Eigen::Vector3d& model_up = Eigen::Vector3d::UnitY());
+  // A fixed scale (model units to metres, 1 for a metric model) with the model's `model_up` axis
+  // along the tag's z, the model's origin on the tag centre.
+  static ModelPlacement Scaled(double scale, const Eigen::Vector3d& model_up = Eigen::Vector3d::UnitY());
+
+  // This placement turned by `degrees` about the tag's z axis (its offset with it), then moved by
+  // `shift` (metres, in the tag frame).
+  ModelPlacement Turned(double degrees, const Eigen::Vector3d& shift = Eigen::Vector3d::Zero()) const;
 };
 
 // cam_from_tag * tag_from_model as a 4x4 similarity.

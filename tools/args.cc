@@ -131,19 +131,31 @@ int Fail(const Status& status) {
   return ExitCodeFor(status);
 }
 
-std::optional<int> ParseCommand(Args* args, int argc, char** argv, int first, const char* help,
-                                size_t min_positionals, size_t max_positionals) {
+int UsageError(const std::string& help) {
+  std::fputs(help.c_str(), stderr);
+  return 2;
+}
+
+std::optional<int> ParseCommand(Args* args, int argc, char** argv, int first, const std::string& help,
+                                const CommandUsage& usage) {
   if (Status s = args->Parse(argc, argv, first); !s.ok()) return Fail(s);
   if (args->Has("help")) {
-    std::fputs(help, stdout);
+    std::fputs(help.c_str(), stdout);
     return 0;
   }
   const size_t count = args->positionals().size();
-  if (count < min_positionals || count > max_positionals) {
-    std::fputs(help, stderr);
-    return 2;
-  }
+  bool right = count >= usage.min_positionals && count <= usage.max_positionals;
+  for (const std::string& option : usage.required) right = right && args->Has(option);
+  if (!right || (usage.rule != nullptr && !usage.rule(*args))) return UsageError(help);
   return std::nullopt;
+}
+
+std::optional<int> ParseCommand(Args* args, int argc, char** argv, int first, const char* help,
+                                size_t min_positionals, size_t max_positionals) {
+  CommandUsage usage;
+  usage.min_positionals = min_positionals;
+  usage.max_positionals = max_positionals;
+  return ParseCommand(args, argc, argv, first, help, usage);
 }
 
 }  // namespace reconar::tools

@@ -8,6 +8,7 @@
 //   --threads N            GetThreads: worker threads, 0 or absent: one per core
 //   --json                 the command's result as JSON on stdout instead of its summary
 //   --help, -h             the command's usage on stdout
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <set>
@@ -51,10 +52,25 @@ std::string LowercaseExtension(const std::string& path);
 int ExitCodeFor(const Status& status);
 int Fail(const Status& status);  // prints "reconar: error: ..." and returns the exit code
 
+// When a command's usage is right, beyond what Args::Parse checks: the positional count, the
+// options it cannot do without, and any further rule (e.g. "--model or --project, not both").
+struct CommandUsage {
+  size_t min_positionals = 0;
+  size_t max_positionals = SIZE_MAX;
+  std::vector<std::string> required;          // options that must be given
+  bool (*rule)(const Args& args) = nullptr;  // nullptr: none
+};
+
 // The start of every command: parses; with --help prints `help` on stdout (exit code 0); with a
-// parse error or a positional count outside [min_positionals, max_positionals] prints the error
-// or `help` on stderr (exit code 2). Returns the exit code to stop with, or nullopt to go on.
+// parse error prints it, and with a usage that breaks `usage` prints `help` on stderr (exit code
+// 2). Returns the exit code to stop with, or nullopt to go on.
+std::optional<int> ParseCommand(Args* args, int argc, char** argv, int first, const std::string& help,
+                                const CommandUsage& usage);
+// The same with only a positional count in [min_positionals, max_positionals].
 std::optional<int> ParseCommand(Args* args, int argc, char** argv, int first, const char* help,
                                 size_t min_positionals, size_t max_positionals);
+// `help` on stderr, and the exit code of a usage error (2): for a usage a command can judge only
+// later (match's images, once its options are read).
+int UsageError(const std::string& help);
 
 }  // namespace reconar::tools

@@ -82,15 +82,7 @@ void PrintSummary(const std::string& path, const BalProblem& problem, const Bund
 
 int RunBundleAdjust(int argc, char** argv, int first) {
   Args args({"bal", "solver", "loss", "loss-scale", "max-iterations", "threads"}, {"json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (!args.Has("bal") || !args.positionals().empty()) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, {0, 0, {"bal"}})) return *exit_code;
   BundleAdjustmentOptions options;
   auto loss = LossFromArgs(args);
   if (!loss.ok()) return Fail(loss.status());

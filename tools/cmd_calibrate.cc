@@ -33,15 +33,8 @@ constexpr char kHelp[] =
 
 int RunCalibrate(int argc, char** argv, int first) {
   Args args({"tag-size", "out", "family", "layout", "decimate"}, {"fix-principal-point", "no-distortion", "json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().empty() || !args.Has("tag-size") || !args.Has("out")) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  const CommandUsage usage = {1, SIZE_MAX, {"tag-size", "out"}};
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, usage)) return *exit_code;
   auto tag_size = args.GetDouble("tag-size", 0.0, 1e-4, 100.0);
   if (!tag_size.ok()) return Fail(tag_size.status());
   CalibrationPhotoOptions photo_options;

@@ -50,15 +50,7 @@ void PrintMeshSummary(const char* verb, const std::string& path, const Mesh& mes
 
 int RunExport(int argc, char** argv, int first) {
   Args args({"max-faces"}, {"ascii", "json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().size() != 2) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
   const std::string& input = args.positionals()[0];
   const std::string& output = args.positionals()[1];
   // Both extensions are checked before anything is read.

@@ -66,15 +66,7 @@ int RunFeatures(int argc, char** argv, int first) {
   std::set<std::string> valued = kSiftValuedOptions;
   valued.insert({"project", "key", "threads"});
   Args args(valued, {"json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().empty()) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 1, SIZE_MAX)) return *exit_code;
   if (!args.Has("project") && !args.Has("key")) {
     return Fail(InvalidArgument("nothing to write: give --project DIR and/or --key OUT"));
   }

@@ -6,7 +6,6 @@
 #include "core/base/thread_pool.h"
 #include "core/pipeline/map_stage.h"
 #include "core/pipeline/reconstruct.h"
-#include "core/pipeline/stage_record.h"
 #include "tools/args.h"
 #include "tools/commands.h"
 
@@ -37,11 +36,8 @@ int RunMap(int argc, char** argv, int first) {
   const Project project(args.positionals()[0]);
   MapStageOptions options = ReconstructOptions().map;
   options.build.num_threads = ThreadPool::ResolveThreadCount(*threads);
-  auto report = RunMapStage(project, options);
+  auto report = RunMapStage(project, options);  // records the stage: a later `reconstruct` reuses the map
   if (!report.ok()) return Fail(report.status());
-  // The map now matches the model: a later `reconstruct` reuses it.
-  StageRecord record(project);
-  if (Status s = record.Record("map", MapStageSettings(options)); !s.ok()) return Fail(s);
   if (args.Has("json")) {
     JsonWriter json;
     json.BeginObject().Key("path").String(report->path).Key("frame").String(report->frame);

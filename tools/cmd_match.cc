@@ -2,7 +2,6 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/json_writer.h"
-#include "core/pipeline/feature_stage.h"
 #include "core/pipeline/match_stage.h"
 #include "tools/commands.h"
 
@@ -83,61 +82,36 @@ int MatchProject(const Args& args, MatchStageOptions options) {
 }
 
 int MatchTwo(const Args& args, const MatchStageOptions& options) {
-  FeatureStageOptions feature_options;
   auto sift = SiftOptionsFromArgs(args);
   if (!sift.ok()) return Fail(sift.status());
-  feature_options.sift = *sift;
-  feature_options.num_threads = options.num_threads;
-  feature_options.show_progress = false;
-  const std::vector<std::string> paths = args.positionals();
-  std::vector<SiftFeatures> features;
-  auto extracted = RunFeatureStage(paths, nullptr, feature_options, &features);
-  if (!extracted.ok()) return Fail(extracted.status());
-  if (!extracted->skipped.empty()) return Fail(InvalidArgument(extracted->skipped.front()));
-  const ProjectImage& a = extracted->extracted[0].image;
-  const ProjectImage& b = extracted->extracted[1].image;
-  MatchOptions match = options.match;
-  auto putative = MatchDescriptors(features[0].descriptors.data(), static_cast<int>(features[0].keypoints.size()),
-                                   features[1].descriptors.data(), static_cast<int>(features[1].keypoints.size()),
-                                   match);
-  if (!putative.ok()) return Fail(putative.status());
-  auto verified = VerifyMatches(features[0], a.width, a.height, features[1], b.width, b.height, *putative,
-                                options.two_view);
-  if (!verified.ok()) return Fail(verified.status());
-  const TwoViewGeometry& g = verified->geometry;
+  auto match = MatchTwoPhotos(args.positionals()[0], args.positionals()[1], *sift, options);
+  if (!match.ok()) return Fail(match.status());
+  const ProjectImage& a = match->images[0];
+  const ProjectImage& b = match->images[1];
+  const size_t features_a = match->features[0].keypoints.size();
+  const size_t features_b = match->features[1].keypoints.size();
+  const VerifiedPair& verified = match->pair;
+  const TwoViewGeometry& g = verified.geometry;
   if (args.Has("json")) {
     JsonWriter json(2);
-    json.BeginObject()
-        .Key("image_a")
-        .String(a.name)
-        .Key("features_a")
-        .Int(static_cast<long long>(features[0].keypoints.size()));
-    json.Key("image_b").String(b.name).Key("features_b").Int(static_cast<long long>(features[1].keypoints.size()));
-    json.Key("ratio").Double(match.max_ratio).Key("putative").Int(verified->num_putative);
+    json.BeginObject().Key("image_a").String(a.name).Key("features_a").Int(static_cast<long long>(features_a));
+    json.Key("image_b").String(b.name).Key("features_b").Int(static_cast<long long>(features_b));
+    json.Key("ratio").Double(options.match.max_ratio).Key("putative").Int(verified.num_putative);
     json.Key("f_threshold_px").Double(g.f_threshold_px).Key("f_inliers").Int(g.num_f_inliers);
     json.Key("h_threshold_px").Double(g.h_threshold_px).Key("h_inliers").Int(g.num_h_inliers);
     json.Key("result").String(TwoViewConfigName(g.config)).Key("reason").String(g.reason).EndObject();
     std::printf("%s\n", json.str().c_str());
   } else {
-    std::printf("%s: %zu features, %s: %zu features\n", a.name.c_str(), features[0].keypoints.size(), b.name.c_str(),
-                features[1].keypoints.size());
-    std::printf("putative matches (ratio %.2f): %d\n", match.max_ratio, verified->num_putative);
+    std::printf("%s: %zu features, %s: %zu features\n", a.name.c_str(), features_a, b.name.c_str(), features_b);
+    std::printf("putative matches (ratio %.2f): %d\n", options.match.max_ratio, verified.num_putative);
     std::printf("F-inliers (threshold %.2f px): %d, H-inliers among them (%.2f px): %d, ratio %.2f\n", g.f_threshold_px,
                 g.num_f_inliers, g.h_threshold_px, g.num_h_inliers, g.h_to_f_inlier_ratio);
     std::printf("result: %s%s%s\n", TwoViewConfigName(g.config), g.reason.empty() ? "" : " - ", g.reason.c_str());
   }
   if (args.Has("pairs")) {
-    std::string text;
-    char line[128];
-    for (const FeatureMatch& m : verified->inlier_matches) {
-      const SiftKeypoint& ka = features[0].keypoints[m.index_a];
-      const SiftKeypoint& kb = features[1].keypoints[m.index_b];
-      std::snprintf(line, sizeof(line), "%.3f %.3f %.3f %.3f\n", ka.x, ka.y, kb.x, kb.y);
-      text += line;
-    }
-    if (Status s = WriteFileAtomically(args.Get("pairs"), text); !s.ok()) return Fail(s);
+    if (Status s = WriteFileAtomically(args.Get("pairs"), MatchedPositionsText(*match)); !s.ok()) return Fail(s);
     if (!args.Has("json")) {
-      std::printf("wrote %zu matches to %s\n", verified->inlier_matches.size(), args.Get("pairs").c_str());
+      std::printf("wrote %zu matches to %s\n", verified.inlier_matches.size(), args.Get("pairs").c_str());
     }
   }
   return g.config == TwoViewGeometry::Config::kTooFewInliers ? 1 : 0;
@@ -150,21 +124,14 @@ int RunMatch(int argc, char** argv, int first) {
   valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
   valued.insert({"project", "pairs", "memory-budget"});
   Args args(valued, {"json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 0, SIZE_MAX)) return *exit_code;
   MatchStageOptions options;  // the library's defaults: ratio 0.6, 100 inliers (sfm and reconstruct: 0.8, 30)
   if (Status s = ReadMatchArgs(args, &options); !s.ok()) return Fail(s);
   if (args.Has("project")) {
     if (!args.positionals().empty()) return Fail(InvalidArgument("give either --project DIR or two images, not both"));
     return MatchProject(args, options);
   }
-  if (args.positionals().size() != 2) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (args.positionals().size() != 2) return UsageError(kHelp);
   return MatchTwo(args, options);
 }
 

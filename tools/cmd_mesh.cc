@@ -34,15 +34,7 @@ constexpr char kHelp[] =
 
 int RunMesh(int argc, char** argv, int first) {
   Args args({"depth", "trim", "point-weight", "threads"}, {"estimate-normals", "remove-outliers", "ascii", "json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().size() != 2) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
   const std::string input = args.positionals()[0];
   const std::string output = args.positionals()[1];
   // The mesh stage on any points file, with Poisson's own defaults and the depth as given.

@@ -80,6 +80,13 @@ std::string PhotoJson(const PhotoDetections& photo, const char* family) {
   return json.str();
 }
 
+// A sheet (--ids, --size and --out, no photo) or photos (none of those).
+bool IsSheet(const Args& args) { return args.Has("ids") || args.Has("size") || args.Has("out"); }
+bool IsRightUsage(const Args& args) {
+  const bool sheet = IsSheet(args);
+  return args.positionals().empty() == sheet && (!sheet || (args.Has("ids") && args.Has("size") && args.Has("out")));
+}
+
 // reconar tags IMAGES...: the tags in each photo.
 int RunDetect(const Args& args, TagFamily family) {
   auto paths = CollectImagePaths(args.positionals());
@@ -108,16 +115,10 @@ int RunDetect(const Args& args, TagFamily family) {
 
 int RunTags(int argc, char** argv, int first) {
   Args args({"family", "ids", "size", "paper", "margin", "out", "threads"}, {"json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, {0, SIZE_MAX, {}, IsRightUsage})) {
+    return *exit_code;
   }
-  const bool sheet = args.Has("ids") || args.Has("size") || args.Has("out");
-  if (args.positionals().empty() == !sheet || (sheet && (!args.Has("ids") || !args.Has("size") || !args.Has("out")))) {
-    std::fputs(kHelp, stderr);
-    return 2;
-  }
+  const bool sheet = IsSheet(args);
   const std::string family_name = args.Get("family", "tag36h11");
   auto family = ParseTagFamily(family_name);
   if (!family.ok()) return Fail(family.status());

@@ -1,9 +1,7 @@
 // reconar track: AprilTag 6-DoF tracking over a camera or recorded frames, one line per frame; the
 // runtime is render/ar/ar_session.h, this command parses, calls and prints.
-#include <algorithm>
 #include <cstdio>
 #include <string>
-#include <vector>
 
 #include "render/ar/ar_project.h"
 #include "render/ar/ar_session.h"
@@ -52,29 +50,16 @@ int RunTrack(int argc, char** argv, int first) {
   std::set<std::string> valued = kTrackerValuedOptions;
   valued.insert({"layout", "project", "max-frames"});
   Args args(valued, {"json", "no-map"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    std::fputs(kTrackerOptionsHelp, stdout);
-    return 0;
-  }
-  if (args.positionals().size() != 1 || (args.Has("layout") && args.Has("project"))) {
-    std::fputs(kHelp, stderr);
-    std::fputs(kTrackerOptionsHelp, stderr);
-    return 2;
-  }
+  const CommandUsage usage = {1, 1, {}, [](const Args& a) { return !(a.Has("layout") && a.Has("project")); }};
+  const std::string help = std::string(kHelp) + kTrackerOptionsHelp;
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, help, usage)) return *exit_code;
   ArSessionOptions options;
   options.source = args.positionals()[0];
   options.frames.want_rgb = false;
   TrackerDefaults defaults;
   auto project = ProjectFromArgs(args, &defaults);
   if (!project.ok()) return Fail(project.status());
-  if (*project) {
-    options.pose.layout = std::move((*project)->layout);
-    options.map = std::move((*project)->map);
-    options.track_tags = (*project)->has_tags;
-    if (!args.Has("intrinsics")) options.photo_cameras = (*project)->photo_cameras;
-  }
+  if (*project) UseArProject(**project, args.Has("intrinsics"), &options);
   auto tracker_options = TrackerOptionsFromArgs(args, defaults);
   if (!tracker_options.ok()) return Fail(tracker_options.status());
   options.pose.tracker = *tracker_options;
@@ -95,45 +80,24 @@ int RunTrack(int argc, char** argv, int first) {
     std::fprintf(stderr, "reconar track: %s\n", (*project)->no_tags_note.c_str());
   }
 
-  std::vector<double> frame_ms;
-  long frames_with_tags = 0;
-  long tag_instances = 0;
-  long predicted_found = 0;
-  long predicted_searched = 0;
-  long frames_by_source[4] = {0, 0, 0, 0};
-  for (;;) {
-    auto more = (*session)->Step();
-    if (!more.ok()) return Fail(more.status());
-    if (!*more) break;
-    if (const TagPoseSource* tags = (*session)->tags()) {
-      int measured = 0;
-      for (const TrackedTag& tag : tags->report().tags) measured += tag.measured ? 1 : 0;
-      frames_with_tags += measured > 0 ? 1 : 0;
-      tag_instances += measured;
-      predicted_found += tags->report().predicted_found;
-      predicted_searched += tags->report().predicted_searched;
-    }
-    ++frames_by_source[static_cast<int>((*session)->sources().source())];
-    frame_ms.push_back((*session)->pose().track_ms);
-    std::printf("%s\n", (json ? ArFrameJson(**session) : ArFrameText(**session)).c_str());
+  auto report = (*session)->Run([json](const ArSession& frame) -> Result<bool> {
+    std::printf("%s\n", (json ? ArFrameJson(frame) : ArFrameText(frame)).c_str());
     std::fflush(stdout);
-  }
-  const long frames = (*session)->frames();
-  std::vector<double> sorted = frame_ms;
-  std::sort(sorted.begin(), sorted.end());
-  double total = 0.0;
-  for (double ms : frame_ms) total += ms;
-  std::string tags_seen = options.track_tags ? ", tags in " + std::to_string(frames_with_tags) + " (" +
-                                                   std::to_string(tag_instances) + " tag instances)"
+    return true;
+  });
+  if (!report.ok()) return Fail(report.status());
+  const ArSessionReport& r = *report;
+  std::string tags_seen = options.track_tags ? ", tags in " + std::to_string(r.frames_with_tags) + " (" +
+                                                   std::to_string(r.tag_instances) + " tag instances)"
                                              : "";
-  std::fprintf(stderr, "reconar track: %ld frames%s; tracking %.2f ms/frame mean, %.2f median, %.2f max\n", frames,
-               tags_seen.c_str(), total / frames, sorted[sorted.size() / 2], sorted.back());
+  std::fprintf(stderr, "reconar track: %ld frames%s; tracking %.2f ms/frame mean, %.2f median, %.2f max\n", r.frames,
+               tags_seen.c_str(), r.mean_track_ms, r.median_track_ms, r.max_track_ms);
   if (options.track_tags && !options.pose.layout.empty()) {
     std::fprintf(stderr, "reconar track: %ld of the tag instances found by prediction (%ld predicted regions)\n",
-                 predicted_found, predicted_searched);
+                 r.predicted_found, r.predicted_searched);
   }
   if (options.map) {
-    std::fprintf(stderr, "reconar track: %s%s\n", PoseSourceCounts(frames_by_source).c_str(),
+    std::fprintf(stderr, "reconar track: %s%s\n", PoseSourceCounts(r.frames_by_source).c_str(),
                  (*session)->metric() ? "" : "; poses in model units");
   }
   return 0;

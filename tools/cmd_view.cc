@@ -77,32 +77,21 @@ Result<Eigen::Vector3d> ParseVector(const std::string& name, const std::string& 
 }
 
 Result<ModelPlacement> PlacementFromArgs(const Args& args, const Mesh& mesh, double tag_size) {
-  auto up = ParseAxis(args.Get("model-up", "y"));
-  if (!up.ok()) return up.status();
+  RECONAR_ASSIGN_OR_RETURN(const Eigen::Vector3d up, ParseAxis(args.Get("model-up", "y")));
   ModelPlacement placement;
   if (args.Has("model-scale")) {
-    auto scale = args.GetDouble("model-scale", 1.0, 1e-9, 1e9);
-    if (!scale.ok()) return scale.status();
-    placement.scale = *scale;
-    placement.rotation = Eigen::Quaterniond::FromTwoVectors(*up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    RECONAR_ASSIGN_OR_RETURN(const double scale, args.GetDouble("model-scale", 1.0, 1e-9, 1e9));
+    placement = ModelPlacement::Scaled(scale, up);
   } else {
-    auto height = args.GetDouble("model-height", tag_size, 1e-6, 1e6);
-    if (!height.ok()) return height.status();
-    auto standing = ModelPlacement::StandingOnTag(mesh, *height, *up);
-    if (!standing.ok()) return standing.status();
-    placement = *standing;
+    RECONAR_ASSIGN_OR_RETURN(const double height, args.GetDouble("model-height", tag_size, 1e-6, 1e6));
+    RECONAR_ASSIGN_OR_RETURN(placement, ModelPlacement::StandingOnTag(mesh, height, up));
   }
-  auto degrees = args.GetDouble("model-rotate", 0.0, -360.0, 360.0);
-  if (!degrees.ok()) return degrees.status();
-  const Eigen::Matrix3d turn = Eigen::AngleAxisd(*degrees * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  placement.rotation = turn * placement.rotation;
-  placement.offset = turn * placement.offset;
+  RECONAR_ASSIGN_OR_RETURN(const double degrees, args.GetDouble("model-rotate", 0.0, -360.0, 360.0));
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
   if (args.Has("model-offset")) {
-    auto offset = ParseVector("model-offset", args.Get("model-offset"));
-    if (!offset.ok()) return offset.status();
-    placement.offset += *offset;
+    RECONAR_ASSIGN_OR_RETURN(offset, ParseVector("model-offset", args.Get("model-offset")));
   }
-  return placement;
+  return placement.Turned(degrees, offset);
 }
 
 }  // namespace
@@ -112,18 +101,12 @@ int RunView(int argc, char** argv, int first) {
   valued.insert({"model", "project", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
                  "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces"});
   Args args(valued, {"no-axes", "smooth", "no-map", "json"});
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(kHelp, stdout);
-    std::fputs(kTrackerOptionsHelp, stdout);
-    return 0;
-  }
-  if (!args.positionals().empty() || args.Has("model") == args.Has("project") ||
-      args.Has("camera") == args.Has("frames")) {
-    std::fputs(kHelp, stderr);
-    std::fputs(kTrackerOptionsHelp, stderr);
-    return 2;
-  }
+  // A model or a project, and a camera or frames: one of each.
+  const CommandUsage usage = {0, 0, {}, [](const Args& a) {
+                                return a.Has("model") != a.Has("project") && a.Has("camera") != a.Has("frames");
+                              }};
+  const std::string help = std::string(kHelp) + kTrackerOptionsHelp;
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, help, usage)) return *exit_code;
   TrackerDefaults defaults;
   auto loaded = ProjectFromArgs(args, &defaults);
   if (!loaded.ok()) return Fail(loaded.status());
@@ -133,12 +116,7 @@ int RunView(int argc, char** argv, int first) {
   auto tracker_options = TrackerOptionsFromArgs(args, defaults);
   if (!tracker_options.ok()) return Fail(tracker_options.status());
   session.pose.tracker = *tracker_options;
-  if (project) {
-    session.pose.layout = project->layout;
-    session.map = project->map;
-    session.track_tags = project->has_tags;
-    if (!args.Has("intrinsics")) session.photo_cameras = project->photo_cameras;
-  }
+  if (project) UseArProject(*project, args.Has("intrinsics"), &session);
   session.pose.smoothed = args.Has("smooth");
   session.source = args.Has("camera") ? args.Get("camera") : args.Get("frames");
   auto tag_id = args.GetInt("tag-id", -1, -1, 1 << 20);
@@ -199,13 +177,16 @@ int RunView(int argc, char** argv, int first) {
   std::fprintf(stderr,
                "%sreconar view: %ld frames, model drawn on %ld; median ms per frame: track %.2f, render %.2f, "
                "track + render %.2f%s\n",
-               stderr_is_terminal ? "\r" : "", report->frames, report->frames_with_model, report->median_track_ms,
-               report->median_render_ms, report->median_frame_ms, to_files ? " (render includes the readback)" : "");
+               stderr_is_terminal ? "\r" : "", report->session.frames, report->frames_with_model,
+               report->session.median_track_ms, report->median_render_ms, report->median_frame_ms,
+               to_files ? " (render includes the readback)" : "");
   if (session.map) {
-    std::fprintf(stderr, "reconar view: %s%s\n", PoseSourceCounts(report->frames_by_source).c_str(),
+    std::fprintf(stderr, "reconar view: %s%s\n", PoseSourceCounts(report->session.frames_by_source).c_str(),
                  session.map->metric ? "" : "; poses in model units");
   }
-  if (to_files) std::fprintf(stderr, "reconar view: wrote %ld PNGs to %s\n", report->frames, options.out_dir.c_str());
+  if (to_files) {
+    std::fprintf(stderr, "reconar view: wrote %ld PNGs to %s\n", report->session.frames, options.out_dir.c_str());
+  }
   return 0;
 }
 

@@ -156,15 +156,7 @@ int RunReconstructCommand(int argc, char** argv, int first, const char* help, bo
   std::set<std::string> valued = ValuedOptions();
   if (sparse_only) valued.erase("stages");
   Args args(valued, kFlags);
-  if (Status s = args.Parse(argc, argv, first); !s.ok()) return Fail(s);
-  if (args.Has("help")) {
-    std::fputs(help, stdout);
-    return 0;
-  }
-  if (args.positionals().size() < 2) {
-    std::fputs(help, stderr);
-    return 2;
-  }
+  if (const auto exit_code = ParseCommand(&args, argc, argv, first, help, 2, SIZE_MAX)) return *exit_code;
   std::vector<std::string> inputs = args.positionals();
   const Project project(inputs.back());
   inputs.pop_back();

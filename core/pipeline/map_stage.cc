@@ -70,6 +70,8 @@ Result<MapStageReport> RunMapStage(const Project& project, const MapStageOptions
   json.Key("seconds").Double(report.seconds);
   json.EndObject();
   RECONAR_RETURN_IF_ERROR(WriteFileAtomically(project.MapDir() + "/report.json", json.str() + "\n"));
+  // The map now matches the model: a later `reconstruct` reuses it.
+  RECONAR_RETURN_IF_ERROR(StageRecord(project).Record("map", MapStageSettings(options)));
   return report;
 }
 

@@ -155,6 +155,62 @@ Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int heigh
   return pair;
 }
 
+namespace {
+
+// One pair's step: the matches of image i (features a) in image j (features b), both added to
+// `matcher`, verified.
+Result<VerifiedPair> MatchAndVerify(Matcher* matcher, int i, int j, const FeatureFile& a, const FeatureFile& b,
+                                    const TwoViewOptions& options) {
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<FeatureMatch> putative, matcher->Match(i, j));
+  RECONAR_ASSIGN_OR_RETURN(VerifiedPair pair, VerifyMatches(a.features, a.image_width, a.image_height, b.features,
+                                                            b.image_width, b.image_height, putative, options));
+  pair.image_a = i;
+  pair.image_b = j;
+  return pair;
+}
+
+}  // namespace
+
+Result<TwoPhotoMatch> MatchTwoPhotos(const std::string& path_a, const std::string& path_b, const SiftOptions& sift,
+                                     const MatchStageOptions& options) {
+  FeatureStageOptions feature_options;
+  feature_options.sift = sift;
+  feature_options.num_threads = options.num_threads;
+  feature_options.show_progress = false;
+  std::vector<SiftFeatures> features;
+  RECONAR_ASSIGN_OR_RETURN(const FeatureStageReport extracted,
+                           RunFeatureStage({path_a, path_b}, nullptr, feature_options, &features));
+  if (!extracted.skipped.empty()) return InvalidArgument(extracted.skipped.front());
+  RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<Matcher> matcher, Matcher::Create(options.match));
+  FeatureFile files[2];
+  for (int k = 0; k < 2; ++k) {
+    files[k].image_width = extracted.extracted[k].image.width;
+    files[k].image_height = extracted.extracted[k].image.height;
+    files[k].features = std::move(features[k]);
+    const SiftFeatures& f = files[k].features;
+    RECONAR_RETURN_IF_ERROR(matcher->AddImage(k, f.descriptors.data(), static_cast<int>(f.keypoints.size())));
+  }
+  TwoPhotoMatch match;
+  RECONAR_ASSIGN_OR_RETURN(match.pair, MatchAndVerify(matcher.get(), 0, 1, files[0], files[1], options.two_view));
+  for (int k = 0; k < 2; ++k) {
+    match.images[k] = extracted.extracted[k].image;
+    match.features[k] = std::move(files[k].features);
+  }
+  return match;
+}
+
+std::string MatchedPositionsText(const TwoPhotoMatch& match) {
+  std::string text;
+  char line[128];
+  for (const FeatureMatch& m : match.pair.inlier_matches) {
+    const SiftKeypoint& ka = match.features[0].keypoints[m.index_a];
+    const SiftKeypoint& kb = match.features[1].keypoints[m.index_b];
+    std::snprintf(line, sizeof(line), "%.3f %.3f %.3f %.3f\n", ka.x, ka.y, kb.x, kb.y);
+    text += line;
+  }
+  return text;
+}
+
 std::string MatchStageSettings(const MatchStageOptions& options) {
   return StageRecord::Settings({{"ratio", options.match.max_ratio},
                                 {"checks", options.match.max_leaf_checks},
@@ -319,20 +375,11 @@ Result<MatchStageReport> RunMatchStage(const Project& project, const MatchStageO
         pool.ParallelFor(0, block_pairs.size(), [&](size_t k, int worker) {
           const size_t p = block_pairs[k];
           const auto [i, j] = pairs[p];
-          auto putative = matchers[worker]->Match(i, j);
-          if (!putative.ok()) {
-            errors[p] = putative.status();
+          auto verified = MatchAndVerify(matchers[worker].get(), i, j, files[i], files[j], options.two_view);
+          if (verified.ok()) {
+            results[p] = std::move(verified).value();
           } else {
-            auto verified = VerifyMatches(files[i].features, files[i].image_width, files[i].image_height,
-                                          files[j].features, files[j].image_width, files[j].image_height, *putative,
-                                          options.two_view);
-            if (verified.ok()) {
-              verified->image_a = i;
-              verified->image_b = j;
-              results[p] = std::move(verified).value();
-            } else {
-              errors[p] = verified.status().WithContext(images[i].name + " / " + images[j].name);
-            }
+            errors[p] = verified.status().WithContext(images[i].name + " / " + images[j].name);
           }
           if (progress) progress->Advance();
         });

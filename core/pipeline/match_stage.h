@@ -94,6 +94,20 @@ Result<VerifiedPair> VerifyMatches(const SiftFeatures& a, int width_a, int heigh
                                    int width_b, int height_b, const std::vector<FeatureMatch>& putative,
                                    const TwoViewOptions& options);
 
+// `reconar match A B`: the two photos' features, extracted as the feature stage extracts them (with
+// `sift`, on options.num_threads threads, in memory: nothing is written), matched with
+// options.match and verified with options.two_view as the stage matches and verifies a pair.
+struct TwoPhotoMatch {
+  ProjectImage images[2];
+  SiftFeatures features[2];
+  VerifiedPair pair;  // image_a 0, image_b 1
+};
+// InvalidArgument "PATH: reason" for a photo that cannot be read; errors of the options.
+Result<TwoPhotoMatch> MatchTwoPhotos(const std::string& path_a, const std::string& path_b, const SiftOptions& sift,
+                                     const MatchStageOptions& options);
+// The verified matches, one "xa ya xb yb" line each (pixels, three decimals): `reconar match --pairs`.
+std::string MatchedPositionsText(const TwoPhotoMatch& match);
+
 // Why a photo is extracted again.
 enum class ReextractionReason {
   kNone,

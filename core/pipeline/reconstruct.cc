@@ -72,9 +72,10 @@ class StageRunner {
     }
   }
 
-  // Runs `body` unless the stage finished with these settings (and `outputs_present`); records it.
+  // Runs `body` unless the stage finished with these settings (and `outputs_present`); records it
+  // unless the stage records itself (the map stage).
   Status Run(const std::string& name, const std::string& settings, bool outputs_present, bool force_redo,
-             const std::function<Status(StageSummary*)>& body) {
+             const std::function<Status(StageSummary*)>& body, bool records_itself = false) {
     StageSummary summary;
     summary.name = name;
     const bool reuse = !options_.force && !force_redo && outputs_present && record_.Finished(name, settings);
@@ -98,7 +99,7 @@ class StageRunner {
     summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     // A stage that resets the peak itself (per phase) reports its own maximum in the summary.
     summary.peak_rss_bytes = std::max(summary.peak_rss_bytes, PeakResidentBytes());
-    RECONAR_RETURN_IF_ERROR(record_.Record(name, settings));
+    if (!records_itself) RECONAR_RETURN_IF_ERROR(record_.Record(name, settings));
     Add(summary);
     return Status::Ok();
   }
@@ -382,7 +383,8 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       return Status::Ok();
     };
     RECONAR_RETURN_IF_ERROR(
-        runner.Run("map", MapStageSettings(map), Exists(project.MapDir() + "/report.json"), runner.redone(), run_map));
+        runner.Run("map", MapStageSettings(map), Exists(project.MapDir() + "/report.json"), runner.redone(), run_map,
+                   /*records_itself=*/true));
   }
 
   if (options.run_dense) {

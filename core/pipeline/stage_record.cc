@@ -8,7 +8,10 @@
 
 namespace reconar {
 
-StageRecord::StageRecord(const Project& project) : path_(project.root() + "/stages.txt") {
+StageRecord::StageRecord(const Project& project) : path_(project.root() + "/stages.txt") { Read(); }
+
+void StageRecord::Read() {
+  stages_.clear();
   auto text = ReadFileToString(path_);
   if (!text.ok()) return;
   std::istringstream in(*text);
@@ -25,6 +28,7 @@ bool StageRecord::Finished(const std::string& stage, const std::string& settings
 }
 
 Status StageRecord::Record(const std::string& stage, const std::string& settings) {
+  Read();
   stages_[stage] = settings;
   std::set<std::string> replaced = {stage};
   for (bool grew = true; grew;) {  // the stages reading a replaced one, until none is added

@@ -3,7 +3,9 @@
 // sfm`, or of `reconar reconstruct` after an interruption) reuses a stage only when it finished
 // with the same settings. A stage is recorded after its outputs are written (atomically), so a
 // killed run never records a stage it did not finish; recording a stage drops the record of every
-// stage that reads it (kStageInputs).
+// stage that reads it (kStageInputs). Several records of one project may be open at once (the
+// stage runner's, and the map stage's, which records itself): each reads the file again before it
+// writes, so none undoes another's lines.
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -45,12 +47,15 @@ class StageRecord {
   explicit StageRecord(const Project& project);
 
   bool Finished(const std::string& stage, const std::string& settings) const;
+  // Reads stages.txt again, sets the stage's line and writes the file (atomically).
   Status Record(const std::string& stage, const std::string& settings);
 
   // "name=value name=value" with values printed to 12 significant digits.
   static std::string Settings(std::initializer_list<std::pair<const char*, double>> values);
 
  private:
+  void Read();
+
   std::string path_;
   std::map<std::string, std::string> stages_;
 };

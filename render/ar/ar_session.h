@@ -13,18 +13,22 @@
 //     use(session->frame(), session->pose(), session->sources());
 //   }
 //
-// `reconar track` prints what Step() found; `reconar view` (render/ar/ar_view.h) draws it. The
-// frame is held (its FrameHandle) until the next Step() or the session's end. Steady-state Step()
-// makes no heap allocation of its own (the source's and the pose source's guarantees).
+// Run() is that loop, with each frame handed to a callback and the run's statistics
+// (ArSessionReport) gathered: `reconar track` prints what each frame found; `reconar view`
+// (render/ar/ar_view.h) draws it. The frame is held (its FrameHandle) until the next Step() or the
+// session's end. Steady-state Step() makes no heap allocation of its own (the source's and the
+// pose source's guarantees).
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "core/base/status.h"
 #include "core/math/camera_intrinsics.h"
-#include "platform/camera/frame_source.h"
 #include "core/sfm/localization_map.h"
+#include "platform/camera/frame_source.h"
+#include "render/ar/ar_project.h"
 #include "tracker/fused_pose_source.h"
 #include "tracker/pose_source.h"
 #include "tracker/tag_pose_source.h"
@@ -48,6 +52,27 @@ struct ArSessionOptions {
   int max_frames = 0;  // Step() ends after this many frames (0: at the end of the stream)
 };
 
+// What Run() saw over the frames.
+struct ArSessionReport {
+  long frames = 0;
+  // Tags measured (tracked tags only): frames with at least one, and over all frames; of those,
+  // the ones found where a layout's pose predicted them, and the regions searched so.
+  long frames_with_tags = 0;
+  long tag_instances = 0;
+  long predicted_found = 0;
+  long predicted_searched = 0;
+  // Frames by the source of their pose (FusedPoseSource): indexed by PoseSourceKind.
+  long frames_by_source[4] = {0, 0, 0, 0};
+  // Tracking time per frame (WorldPose::track_ms), milliseconds.
+  double mean_track_ms = 0.0;
+  double median_track_ms = 0.0;  // the upper median
+  double max_track_ms = 0.0;
+};
+
+// A project's tags (its layout; track_tags as it has them), its map, and unless `camera_given`
+// (--intrinsics) its photos' cameras.
+void UseArProject(const ArProject& project, bool camera_given, ArSessionOptions* options);
+
 class ArSession {
  public:
   // Errors of the source, "SOURCE: no frames" (FailedPrecondition) for an empty stream, errors of
@@ -58,6 +83,9 @@ class ArSession {
   // True with the next frame and its pose; false at the end of the stream or after max_frames.
   // A tracking error names the frame.
   Result<bool> Step();
+  // Step() until the stream ends, max_frames, or `each_frame` (called after every frame with the
+  // session: the frame, its pose and its sources) says false or fails (its error is returned).
+  Result<ArSessionReport> Run(const std::function<Result<bool>(const ArSession& session)>& each_frame);
 
   const Frame& frame() const { return *frame_; }
   const WorldPose& pose() const { return pose_; }

@@ -1,11 +1,11 @@
 #include "render/ar/ar_view.h"
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <vector>
 
 #include "core/base/atomic_file.h"
+#include "core/base/median.h"
 #include "core/io/image_write.h"
 
 namespace reconar {
@@ -25,12 +25,6 @@ std::string OutputName(const Frame& frame) {
 
 double MsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace
@@ -97,17 +91,13 @@ Status ArView::Draw(bool* drawn_model) {
 
 Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& session)>& each_frame) {
   const bool to_files = !options_.out_dir.empty();
-  std::vector<double> track_ms, render_ms, frame_ms;
+  std::vector<double> render_ms, frame_ms;
   ArViewReport report;
-  for (;;) {
-    RECONAR_ASSIGN_OR_RETURN(const bool more, session_->Step());
-    if (!more) break;
-    track_ms.push_back(session_->pose().track_ms);
+  const auto draw_frame = [&](const ArSession& session) -> Result<bool> {
     const auto render_start = std::chrono::steady_clock::now();
     bool drawn_model = false;
     Status drawn = Draw(&drawn_model);
     if (drawn_model) ++report.frames_with_model;
-    ++report.frames_by_source[static_cast<int>(session_->sources().source())];
     if (drawn.ok()) {
       if (to_files) {
         drawn = renderer_->ReadRgb(&rgb_);
@@ -117,17 +107,16 @@ Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& sessi
       }
     }
     render_ms.push_back(MsSince(render_start));
-    frame_ms.push_back(MsSince(session_->frame_start()));
-    const std::string name = OutputName(session_->frame());
+    frame_ms.push_back(MsSince(session.frame_start()));
+    const std::string name = OutputName(session.frame());
     if (!drawn.ok()) return drawn.WithContext(name);
     if (to_files) RECONAR_RETURN_IF_ERROR(WritePng(options_.out_dir + "/" + name, rgb_.view(), 3));
-    ++report.frames;
-    if (each_frame) each_frame(*session_);
-    if (!to_files && context_->PollEvents().should_quit()) break;
-  }
-  report.median_track_ms = Median(track_ms);
-  report.median_render_ms = Median(render_ms);
-  report.median_frame_ms = Median(frame_ms);
+    if (each_frame) each_frame(session);
+    return to_files || !context_->PollEvents().should_quit();
+  };
+  RECONAR_ASSIGN_OR_RETURN(report.session, session_->Run(draw_frame));
+  report.median_render_ms = Median(std::move(render_ms));
+  report.median_frame_ms = Median(std::move(frame_ms));
   return report;
 }
 

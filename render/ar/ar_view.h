@@ -33,13 +33,10 @@ struct ArViewOptions {
 };
 
 struct ArViewReport {
-  long frames = 0;
+  ArSessionReport session;  // the frames, the sources of their poses, the tracking times
   long frames_with_model = 0;
-  // Frames by the source of their pose (FusedPoseSource): indexed by PoseSourceKind.
-  long frames_by_source[4] = {0, 0, 0, 0};
-  // Medians over the frames, milliseconds: pose (tracking), drawing (with the readback when
-  // writing PNGs), and both.
-  double median_track_ms = 0.0;
+  // Medians over the frames, milliseconds: drawing (with the readback when writing PNGs), and
+  // tracking and drawing together.
   double median_render_ms = 0.0;
   double median_frame_ms = 0.0;
 };

@@ -94,6 +94,39 @@ TEST(ArSessionTest, MaxFramesStopsEarly) {
   EXPECT_EQ(steps, 2);
 }
 
+// Run(): the Step() loop with each frame handed over, and what it saw.
+TEST(ArSessionTest, RunHandsEveryFrameOverAndCountsWhatItSaw) {
+  auto session = ArSession::Open(Options(WriteFrames()));
+  ASSERT_TRUE(session.ok()) << session.status().ToString();
+  int seen = 0;
+  auto report = (*session)->Run([&](const ArSession& frame) -> Result<bool> {
+    EXPECT_EQ(frame.frame().index, seen);
+    EXPECT_TRUE(frame.pose().found);
+    ++seen;
+    return true;
+  });
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  EXPECT_EQ(seen, kFrames);
+  EXPECT_EQ(report->frames, kFrames);
+  EXPECT_EQ(report->frames_with_tags, kFrames);
+  EXPECT_EQ(report->tag_instances, kFrames);
+  EXPECT_EQ(report->frames_by_source[static_cast<int>(PoseSourceKind::kTags)], kFrames);
+  EXPECT_GT(report->max_track_ms, 0.0);
+  EXPECT_LE(report->median_track_ms, report->max_track_ms);
+  EXPECT_LE(report->mean_track_ms, report->max_track_ms);
+
+  // The callback stops the run (a closed window), and its error ends it.
+  auto stopped = ArSession::Open(Options(WriteFrames()));
+  ASSERT_TRUE(stopped.ok());
+  auto two = (*stopped)->Run([](const ArSession& frame) -> Result<bool> { return frame.frames() < 2; });
+  ASSERT_TRUE(two.ok());
+  EXPECT_EQ(two->frames, 2);
+  auto failing = ArSession::Open(Options(WriteFrames()));
+  ASSERT_TRUE(failing.ok());
+  auto failed = (*failing)->Run([](const ArSession&) -> Result<bool> { return Internal("drawing failed"); });
+  EXPECT_EQ(failed.status().code(), StatusCode::kInternal);
+}
+
 // The project's camera (photos twice the video's size) is scaled to the first frame.
 TEST(ArSessionTest, PhotoCameraIsScaledToTheVideo) {
   ArSessionOptions options = Options(WriteFrames());

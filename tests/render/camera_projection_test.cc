@@ -118,6 +118,25 @@ TEST(ModelPlacementTest, CamFromModelComposesTagPoseAndPlacement) {
   EXPECT_NEAR((actual.head<3>() - expected).norm(), 0.0, 1e-12);
 }
 
+TEST(ModelPlacementTest, ScaledAndTurnedAboutTheTagNormal) {
+  // Model z up: a fixed scale keeps it along the tag's z.
+  const ModelPlacement scaled = ModelPlacement::Scaled(0.5, Eigen::Vector3d::UnitZ());
+  EXPECT_DOUBLE_EQ(scaled.scale, 0.5);
+  EXPECT_NEAR((scaled.rotation - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(scaled.offset.norm(), 0.0, 0.0);
+  // Model y up (the default) becomes the tag's z.
+  EXPECT_NEAR((ModelPlacement::Scaled(1.0).rotation * Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitZ()).norm(), 0.0,
+              1e-12);
+
+  ModelPlacement placement = scaled;
+  placement.offset = Eigen::Vector3d(0.1, 0.0, 0.02);
+  const ModelPlacement turned = placement.Turned(90.0, Eigen::Vector3d(0.0, 0.0, 0.01));
+  EXPECT_DOUBLE_EQ(turned.scale, 0.5);
+  // A quarter turn about z: x goes to y, the offset turns with the model, then the shift is added.
+  EXPECT_NEAR((turned.rotation * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((turned.offset - Eigen::Vector3d(0.0, 0.1, 0.03)).norm(), 0.0, 1e-12);
+}
+
 TEST(ModelPlacementTest, RejectsUnusableInput) {
   EXPECT_EQ(ModelPlacement::StandingOnTag(Mesh(), 1.0).status().code(), StatusCode::kInvalidArgument);
   const Mesh flat = Box(Eigen::Vector3f(0, 1, 0), Eigen::Vector3f(1, 1, 1));  // no extent along y

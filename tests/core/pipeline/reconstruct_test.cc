@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "core/base/atomic_file.h"
+#include "core/pipeline/map_stage.h"
+#include "core/pipeline/stage_record.h"
 #include "core/sfm/localization_map.h"
 #include "tests/support/run_command.h"
 
@@ -100,6 +102,13 @@ TEST(RunReconstruct, ASecondRunReusesEveryStageAndAChangedSettingRedoesTheStages
   EXPECT_EQ(second->table1.registered, first->table1.registered) << "Table 1 of the reused model";
   EXPECT_EQ(Contents(project.SparseDir() + "/points3D.txt"), model);
   EXPECT_TRUE(ReadLocalizationMap(project.MapPath()).ok()) << "the sparse stages end with the localisation map";
+
+  // The map stage alone (`reconar map`) records itself: the next run reuses its map.
+  ASSERT_TRUE(StageRecord(project).Record("map", "stale=1").ok());
+  ASSERT_TRUE(RunMapStage(project, options.map).ok());
+  auto after_map = RunReconstruct(TemplePhotos(), project, options);
+  ASSERT_TRUE(after_map.ok()) << after_map.status().ToString();
+  EXPECT_EQ(Reused(*after_map), all_reused);
 
   options.matching.two_view.min_inliers = 31;
   auto third = RunReconstruct(TemplePhotos(), project, options);

@@ -96,5 +96,18 @@ TEST(StageRecord, TheMapIsDroppedWithTheModelButNotWithTheDenseStages) {
   EXPECT_FALSE(IsSideStage("mapping"));
 }
 
+TEST(StageRecord, TwoRecordsOpenAtOnceKeepEachOthersLines) {
+  // The stage runner's record, and the map stage's own while the runner's is open.
+  const Project project(testing::MakeTestDirectory("reconar_stage_record_two"));
+  StageRecord runner(project);
+  ASSERT_TRUE(runner.Record("mapping", "x=1").ok());
+  ASSERT_TRUE(StageRecord(project).Record("map", "x=1").ok());
+  ASSERT_TRUE(runner.Record("dense", "x=1").ok());
+  auto text = ReadFileToString(project.root() + "/stages.txt");
+  ASSERT_TRUE(text.ok());
+  EXPECT_EQ(*text, "dense x=1\nmap x=1\nmapping x=1\n");
+  EXPECT_TRUE(runner.Finished("map", "x=1"));
+}
+
 }  // namespace
 }  // namespace reconar
