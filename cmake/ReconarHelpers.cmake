@@ -19,6 +19,32 @@ elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^(aarch64|arm64|ARM64)$")
   set(RECONAR_ARCH_ARM64 ON)
 endif()
 
+# reconar_add_kernel_sources(TARGET [SSE2 sources...] [AVX2 sources...] [AVX512 sources...] [NEON sources...])
+# Adds a module's SIMD kernels: each instruction set's sources only where the target architecture
+# has it, compiled with its flags (RECONAR_<ISA>_FLAGS; those sources skip the libraries'
+# precompiled header, built without them), and defines RECONAR_HAVE_<ISA>_KERNELS for the target,
+# the one macro the dispatchers test (core/base/kernel_choice.h).
+function(reconar_add_kernel_sources target)
+  cmake_parse_arguments(ARG "" "" "SSE2;AVX2;AVX512;NEON" ${ARGN})
+  set(isas)
+  if(RECONAR_ARCH_X86)
+    set(isas SSE2 AVX2 AVX512)
+  elseif(RECONAR_ARCH_ARM64)
+    set(isas NEON)
+  endif()
+  foreach(isa IN LISTS isas)
+    if(NOT ARG_${isa})
+      continue()
+    endif()
+    target_sources(${target} PRIVATE ${ARG_${isa}})
+    if(RECONAR_${isa}_FLAGS)
+      set_source_files_properties(${ARG_${isa}} PROPERTIES COMPILE_OPTIONS "${RECONAR_${isa}_FLAGS}"
+                                  SKIP_PRECOMPILE_HEADERS ON)
+    endif()
+    target_compile_definitions(${target} PRIVATE RECONAR_HAVE_${isa}_KERNELS)
+  endforeach()
+endfunction()
+
 # reconar_add_library(NAME SOURCES ... [PUBLIC_LINKS ...] [PRIVATE_LINKS ...])
 # Creates target reconar_<NAME> with the repository root as include root ("core/base/status.h").
 function(reconar_add_library name)

@@ -13,6 +13,7 @@ namespace {
 constexpr char kUsage[] =
     "usage: reconar COMMAND [ARGS] [--help]\n"
     "       reconar --version                              version, build type and the SIMD kernels this CPU runs\n"
+    "                                                      (RECONAR_<DISPATCHER>_KERNEL=<kernel> forces one)\n"
     "\n"
     "commands:\n"
     "  reconstruct IMAGES_DIR PROJECT_DIR [--tag-size M]   the whole job: photos to a metric mesh (+ preview)\n"
@@ -35,12 +36,18 @@ constexpr char kUsage[] =
     "\n"
     "exit codes: 0 ok, 1 failed run, 2 bad usage or input\n";
 
-// "reconar 0.1.0 (Release)", the CPU's SIMD features and the kernel each dispatcher selected.
+// "reconar 0.1.0 (Release)", the CPU's SIMD features and the kernel each dispatcher selected,
+// among which, and whether its RECONAR_<DISPATCHER>_KERNEL variable set it.
 int PrintVersion() {
   std::printf("reconar %s (%s)\ncpu: %s\n", reconar::ReconarVersion(), reconar::ReconarBuildType(),
               reconar::CpuFeatureNames(reconar::HostCpuFeatures()).c_str());
-  for (const reconar::SimdKernelChoice& choice : reconar::SimdKernelReport()) {
-    std::printf("kernel %s: %s\n", choice.dispatcher.c_str(), choice.kernel.c_str());
+  for (const reconar::KernelChoice& choice : reconar::SimdKernelReport()) {
+    std::string available;
+    for (const std::string& name : choice.available) available += " " + name;
+    const std::string set_by =
+        choice.overridden ? "; set by " + reconar::KernelOverrideVariable(choice.dispatcher) : "";
+    std::printf("kernel %s: %s (of%s%s)\n", choice.dispatcher.c_str(), choice.kernel().c_str(), available.c_str(),
+                set_by.c_str());
   }
   return 0;
 }

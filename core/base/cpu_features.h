@@ -1,8 +1,6 @@
 #pragma once
-// CPU-feature detection in one place. Every SIMD dispatcher (descriptor distance in core/features,
-// the SIFT kernel tables in core/features/sift, the NCC kernel in core/mvs/pmvs) keeps its own
-// kernel table but asks HostCpuFeatures() whether the CPU runs a kernel. Which kernel each one chose
-// is listed by SimdKernelReport() (core/pipeline/simd_kernels.h) for `reconar --version`.
+// CPU-feature detection in one place. The SIMD dispatchers ask it through CpuRunsKernel
+// (core/base/kernel_choice.h), which says which features each instruction set's kernels need.
 #include <string>
 
 namespace reconar {

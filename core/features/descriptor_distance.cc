@@ -1,9 +1,5 @@
 #include "core/features/descriptor_distance.h"
 
-#include <cstdlib>
-#include <cstring>
-
-#include "core/base/cpu_features.h"
 #include "core/features/descriptor_distance_kernels.h"
 
 namespace reconar {
@@ -34,33 +30,26 @@ const DescriptorDistanceKernel& ScalarDescriptorDistanceKernel() {
 }
 
 std::vector<DescriptorDistanceKernel> AvailableDescriptorDistanceKernels() {
-  std::vector<DescriptorDistanceKernel> kernels = {ScalarDescriptorDistanceKernel()};
-#if defined(RECONAR_FEATURES_HAVE_SSE2)
-  kernels.push_back({"sse2", internal::DescriptorDistanceSse2, internal::DescriptorDistanceBatchSse2});
+  return KernelsThisCpuRuns<DescriptorDistanceKernel>({
+      ScalarDescriptorDistanceKernel(),
+#if defined(RECONAR_HAVE_SSE2_KERNELS)
+      {"sse2", internal::DescriptorDistanceSse2, internal::DescriptorDistanceBatchSse2},
 #endif
-#if defined(RECONAR_FEATURES_HAVE_AVX2)
-  if (HostCpuFeatures().avx2) {
-    kernels.push_back({"avx2", internal::DescriptorDistanceAvx2, internal::DescriptorDistanceBatchAvx2});
-  }
+#if defined(RECONAR_HAVE_AVX2_KERNELS)
+      {"avx2", internal::DescriptorDistanceAvx2, internal::DescriptorDistanceBatchAvx2},
 #endif
-#if defined(RECONAR_FEATURES_HAVE_NEON)
-  kernels.push_back({"neon", internal::DescriptorDistanceNeon, internal::DescriptorDistanceBatchNeon});
+#if defined(RECONAR_HAVE_NEON_KERNELS)
+      {"neon", internal::DescriptorDistanceNeon, internal::DescriptorDistanceBatchNeon},
 #endif
-  return kernels;
+  });
 }
 
-// The one dispatch point: the last available kernel is the widest one this CPU runs.
-const DescriptorDistanceKernel& ActiveDescriptorDistanceKernel() {
-  static const DescriptorDistanceKernel active = [] {
-    const std::vector<DescriptorDistanceKernel> kernels = AvailableDescriptorDistanceKernels();
-    if (const char* forced = std::getenv("RECONAR_DESCRIPTOR_KERNEL")) {
-      for (const DescriptorDistanceKernel& k : kernels) {
-        if (std::strcmp(k.name, forced) == 0) return k;
-      }
-    }
-    return kernels.back();
-  }();
-  return active;
+const KernelDispatch<DescriptorDistanceKernel>& DescriptorDistanceKernelDispatch() {
+  static const KernelDispatch<DescriptorDistanceKernel> dispatch =
+      ChooseKernel("descriptor", AvailableDescriptorDistanceKernels());
+  return dispatch;
 }
+
+const DescriptorDistanceKernel& ActiveDescriptorDistanceKernel() { return DescriptorDistanceKernelDispatch().kernel; }
 
 }  // namespace reconar

@@ -3,11 +3,13 @@
 // The largest possible value, 128 * 255^2 = 8'323'200, fits an int32 with room to spare.
 //
 // Every instruction set has its own kernel (scalar reference, SSE2 and AVX2 on x86-64, NEON on
-// aarch64), each in its own translation unit; ActiveDescriptorDistanceKernel() is the single
-// place where one is chosen for the running CPU. Tests compare every available kernel with the
-// scalar reference.
+// aarch64), each in its own translation unit; DescriptorDistanceKernelDispatch() is the single
+// place where one is chosen for the running CPU, by the rule of core/base/kernel_choice.h. Tests
+// compare every available kernel with the scalar reference.
 #include <cstdint>
 #include <vector>
+
+#include "core/base/kernel_choice.h"
 
 namespace reconar {
 
@@ -31,8 +33,9 @@ const DescriptorDistanceKernel& ScalarDescriptorDistanceKernel();
 // Every kernel compiled in and supported by this CPU, the scalar reference first.
 std::vector<DescriptorDistanceKernel> AvailableDescriptorDistanceKernels();
 
-// The fastest kernel for this CPU (chosen once, then cached). The environment variable
-// RECONAR_DESCRIPTOR_KERNEL=<name> forces a specific available kernel (for debugging).
+// Dispatcher "descriptor": the widest available kernel, chosen once; RECONAR_DESCRIPTOR_KERNEL=<name>
+// forces another (for debugging).
+const KernelDispatch<DescriptorDistanceKernel>& DescriptorDistanceKernelDispatch();
 const DescriptorDistanceKernel& ActiveDescriptorDistanceKernel();
 
 // Convenience wrapper around the active kernel.

@@ -1,5 +1,5 @@
 // AVX2 descriptor distance kernels; this translation unit alone is compiled with
-// RECONAR_AVX2_FLAGS and is only called once the CPU reports AVX2 (descriptor_distance.cc).
+// RECONAR_AVX2_FLAGS and is only called once the CPU reports AVX2 and FMA (descriptor_distance.cc).
 // |a-b| per byte via two saturating subtractions, widened to 16 bit by interleaving with zero,
 // then squared and pairwise summed into 32 bit with _mm256_madd_epi16.
 #include <immintrin.h>

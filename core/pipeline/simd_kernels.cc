@@ -1,16 +1,18 @@
 #include "core/pipeline/simd_kernels.h"
 
 #include "core/features/descriptor_distance.h"
-#include "core/features/sift/kernels.h"
+#include "core/features/sift/kernels_dispatch.h"
+#include "core/mvs/patchmatch/warp_sums.h"
 #include "core/mvs/pmvs/ncc.h"
 
 namespace reconar {
 
-std::vector<SimdKernelChoice> SimdKernelReport() {
+std::vector<KernelChoice> SimdKernelReport() {
   return {
-      {"descriptor_distance", ActiveDescriptorDistanceKernel().name},
-      {"ncc", ActiveNccKernel().name},
-      {"sift", BestSiftKernels().name},
+      DescriptorDistanceKernelDispatch().choice,
+      NccKernelDispatch().choice,
+      SiftKernelDispatch().choice,
+      WarpSumsKernelDispatch().choice,
   };
 }
 

@@ -14,6 +14,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using reconar::testing::CommandRun;
+using reconar::testing::RunCommand;
 using reconar::testing::RunReconar;
 
 fs::path TempDir(const std::string& name) {
@@ -110,9 +111,13 @@ TEST(Cli, VersionNamesTheBuildAndTheKernelsThisCpuRuns) {
   const CommandRun run = RunReconar("--version");
   EXPECT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(run.output.rfind("reconar 0.", 0), 0u) << run.output;
-  for (const char* line : {"\ncpu: ", "\nkernel descriptor_distance: ", "\nkernel ncc: ", "\nkernel sift: "}) {
+  for (const char* line : {"\ncpu: ", "\nkernel descriptor: ", "\nkernel ncc: ", "\nkernel sift: ", "\nkernel warp: "}) {
     EXPECT_NE(run.output.find(line), std::string::npos) << line << " in\n" << run.output;
   }
+  const CommandRun forced = RunCommand(std::string("RECONAR_SIFT_KERNEL=scalar ") + RECONAR_BINARY + " --version");
+  EXPECT_EQ(forced.exit_code, 0) << forced.output;
+  EXPECT_NE(forced.output.find("\nkernel sift: scalar (of scalar"), std::string::npos) << forced.output;
+  EXPECT_NE(forced.output.find("; set by RECONAR_SIFT_KERNEL)\n"), std::string::npos) << forced.output;
 }
 
 }  // namespace

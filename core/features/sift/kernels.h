@@ -1,10 +1,10 @@
 #pragma once
 // SIFT hot loops (blur, DoG, extrema, gradients) behind one table of function pointers.
 // Each instruction set lives in its own translation unit (kernels_ref.cc, kernels_avx2.cc,
-// kernels_avx512.cc, kernels_neon.cc); BestSiftKernels() is the only place that chooses among them, and
-// tests/core/features/sift/kernels_test.cc compares every available table to the reference.
+// kernels_avx512.cc, kernels_neon.cc), which include this header: it includes nothing from the
+// standard library, so that no inline function is emitted with wider instructions. Which table runs
+// is chosen in kernels_dispatch.h.
 #include <cstdint>
-#include <vector>
 
 namespace reconar {
 
@@ -36,11 +36,8 @@ struct SiftKernels {
                        float* magnitude, float* angle);
 };
 
-const SiftKernels& ReferenceSiftKernels();
-// The reference plus every SIMD table this CPU can run; for tests and benchmarks.
-std::vector<const SiftKernels*> AvailableSiftKernels();
-// The fastest table this CPU can run.
-const SiftKernels& BestSiftKernels();
+// The scalar reference every SIMD table is tested against.
+const SiftKernels& ScalarSiftKernels();
 
 namespace sift_internal {
 // Polynomial atan2 shared by every kernel so that they agree to float rounding.
@@ -60,9 +57,16 @@ void ConvolveColumnsTail(const float* const* rows, const float* half_kernel, int
                          float* out);
 void ConvolveColumns2Tail(const float* const* rows, const float* half_kernel, int radius, int x, int width,
                           float* out0, float* out1);
-const SiftKernels* Avx2SiftKernels();    // nullptr when not built for x86 or the CPU lacks AVX2+FMA
-const SiftKernels* Avx512SiftKernels();  // nullptr when not built for x86 or the CPU lacks AVX-512F
-const SiftKernels* NeonSiftKernels();  // nullptr when not built for aarch64
+// The SIMD tables, each defined only where the target compiles it (core/base/kernel_choice.h).
+#if defined(RECONAR_HAVE_AVX2_KERNELS)
+const SiftKernels& Avx2SiftKernels();
+#endif
+#if defined(RECONAR_HAVE_AVX512_KERNELS)
+const SiftKernels& Avx512SiftKernels();  // shares the AVX2 table's gradient kernel
+#endif
+#if defined(RECONAR_HAVE_NEON_KERNELS)
+const SiftKernels& NeonSiftKernels();
+#endif
 }  // namespace sift_internal
 
 }  // namespace reconar

@@ -2,7 +2,6 @@
 // reports both. Tails shorter than a vector fall back to the reference.
 #include <immintrin.h>
 
-#include "core/base/cpu_features.h"
 #include "core/features/sift/kernels.h"
 
 namespace reconar {
@@ -71,7 +70,7 @@ void ConvolveRowAvx2(const float* in, const float* k, int r, int width, float* o
     _mm256_storeu_ps(out + x, acc0);
     _mm256_storeu_ps(out + x + 8, acc1);
   }
-  if (x < width) ReferenceSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
+  if (x < width) ScalarSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
 }
 
 void DifferenceOfGaussiansAvx2(const float* const* g, int width, float* const* out) {
@@ -121,7 +120,7 @@ int FindExtremaAvx2(const float* const* dog, int x_begin, int x_end, float thres
       mask &= mask - 1;
     }
   }
-  if (x < x_end) count += ReferenceSiftKernels().find_extrema(dog, x, x_end, threshold, out_x + count);
+  if (x < x_end) count += ScalarSiftKernels().find_extrema(dog, x, x_end, threshold, out_x + count);
   return count;
 }
 
@@ -157,18 +156,17 @@ void GradientRowAvx2(const float* above, const float* row, const float* below, i
     _mm256_storeu_ps(angle + (x - x_begin), a);
   }
   if (x < x_end) {
-    ReferenceSiftKernels().gradient_row(above, row, below, x, x_end, magnitude + (x - x_begin),
+    ScalarSiftKernels().gradient_row(above, row, below, x, x_end, magnitude + (x - x_begin),
                                         angle + (x - x_begin));
   }
 }
 
 }  // namespace
 
-const SiftKernels* sift_internal::Avx2SiftKernels() {
+const SiftKernels& sift_internal::Avx2SiftKernels() {
   static const SiftKernels kernels{"avx2", ConvolveColumnsAvx2, ConvolveColumns2Avx2, ConvolveRowAvx2, DifferenceOfGaussiansAvx2, FindExtremaAvx2,
                                    GradientRowAvx2};
-  static const bool supported = HostCpuFeatures().avx2 && HostCpuFeatures().fma;
-  return supported ? &kernels : nullptr;
+  return kernels;
 }
 
 }  // namespace reconar

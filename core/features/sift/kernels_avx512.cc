@@ -3,7 +3,6 @@
 // a vector fall back to the reference.
 #include <immintrin.h>
 
-#include "core/base/cpu_features.h"
 #include "core/features/sift/kernels.h"
 
 namespace reconar {
@@ -78,7 +77,7 @@ void ConvolveRowAvx512(const float* in, const float* k, int r, int width, float*
     _mm512_storeu_ps(out + x, acc0);
     _mm512_storeu_ps(out + x + 16, acc1);
   }
-  if (x < width) ReferenceSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
+  if (x < width) ScalarSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
 }
 
 void DifferenceOfGaussiansAvx512(const float* const* g, int width, float* const* out) {
@@ -128,19 +127,17 @@ int FindExtremaAvx512(const float* const* dog, int x_begin, int x_end, float thr
       mask &= mask - 1;
     }
   }
-  if (x < x_end) count += ReferenceSiftKernels().find_extrema(dog, x, x_end, threshold, out_x + count);
+  if (x < x_end) count += ScalarSiftKernels().find_extrema(dog, x, x_end, threshold, out_x + count);
   return count;
 }
 
 }  // namespace
 
-const SiftKernels* sift_internal::Avx512SiftKernels() {
-  static const bool supported = HostCpuFeatures().avx512f && Avx2SiftKernels() != nullptr;
-  if (!supported) return nullptr;
+const SiftKernels& sift_internal::Avx512SiftKernels() {
   static const SiftKernels kernels{"avx512",       ConvolveColumnsAvx512, ConvolveColumns2Avx512,
                                    ConvolveRowAvx512, DifferenceOfGaussiansAvx512,     FindExtremaAvx512,
-                                   Avx2SiftKernels()->gradient_row};
-  return &kernels;
+                                   Avx2SiftKernels().gradient_row};
+  return kernels;
 }
 
 }  // namespace reconar

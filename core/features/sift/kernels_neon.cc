@@ -64,7 +64,7 @@ void ConvolveRowNeon(const float* in, const float* k, int r, int width, float* o
     vst1q_f32(out + x, acc0);
     vst1q_f32(out + x + 4, acc1);
   }
-  if (x < width) ReferenceSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
+  if (x < width) ScalarSiftKernels().convolve_row(in + x, k, r, width - x, out + x);
 }
 
 void DifferenceOfGaussiansNeon(const float* const* g, int width, float* const* out) {
@@ -112,7 +112,7 @@ int FindExtremaNeon(const float* const* dog, int x_begin, int x_end, float thres
       if (lanes[i] != 0) out_x[count++] = x + i;
     }
   }
-  if (x < x_end) count += ReferenceSiftKernels().find_extrema(dog, x, x_end, threshold, out_x + count);
+  if (x < x_end) count += ScalarSiftKernels().find_extrema(dog, x, x_end, threshold, out_x + count);
   return count;
 }
 
@@ -148,17 +148,17 @@ void GradientRowNeon(const float* above, const float* row, const float* below, i
     vst1q_f32(angle + (x - x_begin), a);
   }
   if (x < x_end) {
-    ReferenceSiftKernels().gradient_row(above, row, below, x, x_end, magnitude + (x - x_begin),
+    ScalarSiftKernels().gradient_row(above, row, below, x, x_end, magnitude + (x - x_begin),
                                         angle + (x - x_begin));
   }
 }
 
 }  // namespace
 
-const SiftKernels* sift_internal::NeonSiftKernels() {
+const SiftKernels& sift_internal::NeonSiftKernels() {
   static const SiftKernels kernels{"neon", ConvolveColumnsNeon, ConvolveColumns2Neon, ConvolveRowNeon, DifferenceOfGaussiansNeon, FindExtremaNeon,
                                    GradientRowNeon};
-  return &kernels;
+  return kernels;
 }
 
 }  // namespace reconar

@@ -104,8 +104,8 @@ void ConvolveColumns2Tail(const float* const* rows, const float* k, int r, int x
 
 }  // namespace sift_internal
 
-const SiftKernels& ReferenceSiftKernels() {
-  static const SiftKernels kernels{"reference", ConvolveColumnsRef, ConvolveColumns2Ref, ConvolveRowRef, DifferenceOfGaussiansRef, FindExtremaRef,
+const SiftKernels& ScalarSiftKernels() {
+  static const SiftKernels kernels{"scalar", ConvolveColumnsRef, ConvolveColumns2Ref, ConvolveRowRef, DifferenceOfGaussiansRef, FindExtremaRef,
                                    GradientRowRef};
   return kernels;
 }

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/base/elapsed.h"
-#include "core/features/sift/kernels.h"
+#include "core/features/sift/kernels_dispatch.h"
 
 namespace reconar {
 namespace {
@@ -446,7 +446,7 @@ Result<SiftFeatures> SiftExtractor::Extract(ImageView<const float> gray, SiftRep
   SiftReport local_report;
   SiftReport& rep = report != nullptr ? *report : local_report;
   rep = SiftReport();
-  const SiftKernels& kernels = BestSiftKernels();
+  const SiftKernels& kernels = ActiveSiftKernels();
   rep.kernels = kernels.name;
 
   Arena::Scope scope(arena_);

@@ -1,10 +1,6 @@
 #include "core/mvs/patchmatch/warp_sums.h"
 
 #include <cstddef>
-#include <cstdlib>
-#include <cstring>
-
-#include "core/base/cpu_features.h"
 
 namespace reconar {
 namespace internal {
@@ -39,27 +35,22 @@ const WarpSumsKernel& ScalarWarpSumsKernel() {
 }
 
 std::vector<WarpSumsKernel> AvailableWarpSumsKernels() {
-  std::vector<WarpSumsKernel> kernels = {ScalarWarpSumsKernel()};
-#if defined(RECONAR_PATCHMATCH_HAVE_AVX2)
-  if (HostCpuFeatures().avx2 && HostCpuFeatures().fma) kernels.push_back({"avx2", internal::WarpSumsAvx2});
+  return KernelsThisCpuRuns<WarpSumsKernel>({
+      ScalarWarpSumsKernel(),
+#if defined(RECONAR_HAVE_AVX2_KERNELS)
+      {"avx2", internal::WarpSumsAvx2},
 #endif
-#if defined(RECONAR_PATCHMATCH_HAVE_NEON)
-  kernels.push_back({"neon", internal::WarpSumsNeon});
+#if defined(RECONAR_HAVE_NEON_KERNELS)
+      {"neon", internal::WarpSumsNeon},
 #endif
-  return kernels;
+  });
 }
 
-const WarpSumsKernel& ActiveWarpSumsKernel() {
-  static const WarpSumsKernel active = [] {
-    const std::vector<WarpSumsKernel> kernels = AvailableWarpSumsKernels();
-    if (const char* forced = std::getenv("RECONAR_WARP_KERNEL")) {
-      for (const WarpSumsKernel& k : kernels) {
-        if (std::strcmp(k.name, forced) == 0) return k;
-      }
-    }
-    return kernels.back();
-  }();
-  return active;
+const KernelDispatch<WarpSumsKernel>& WarpSumsKernelDispatch() {
+  static const KernelDispatch<WarpSumsKernel> dispatch = ChooseKernel("warp", AvailableWarpSumsKernels());
+  return dispatch;
 }
+
+const WarpSumsKernel& ActiveWarpSumsKernel() { return WarpSumsKernelDispatch().kernel; }
 
 }  // namespace reconar

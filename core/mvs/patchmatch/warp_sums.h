@@ -10,10 +10,11 @@
 // multiple of kWarpLanes with weight 0 and an offset inside the box.
 //
 // Every instruction set has its own kernel (scalar reference; AVX2 on x86-64; NEON on aarch64) in
-// its own translation unit; ActiveWarpSumsKernel() is the one place where one is chosen. Tests
-// compare every available kernel with the scalar reference.
+// its own translation unit; WarpSumsKernelDispatch() is the one place where one is chosen, by the
+// rule of core/base/kernel_choice.h. Tests compare every available kernel with the scalar reference.
 #include <vector>
 
+#include "core/base/kernel_choice.h"
 #include "core/mvs/patchmatch/warp_sums_types.h"
 
 namespace reconar {
@@ -29,7 +30,8 @@ struct WarpSumsKernel {
 const WarpSumsKernel& ScalarWarpSumsKernel();
 // Every kernel compiled in and supported by this CPU, the scalar reference first.
 std::vector<WarpSumsKernel> AvailableWarpSumsKernels();
-// The widest kernel this CPU runs (chosen once). RECONAR_WARP_KERNEL=<name> forces one.
+// Dispatcher "warp": the widest kernel this CPU runs, chosen once; RECONAR_WARP_KERNEL=<name> forces one.
+const KernelDispatch<WarpSumsKernel>& WarpSumsKernelDispatch();
 const WarpSumsKernel& ActiveWarpSumsKernel();
 
 }  // namespace reconar

@@ -28,10 +28,10 @@ using WarpSumsFn = WarpSums (*)(const WarpHomography& h, const WarpWindow& windo
 
 namespace internal {
 WarpSums WarpSumsScalar(const WarpHomography& h, const WarpWindow& window, const float* image, int stride);
-#if defined(RECONAR_PATCHMATCH_HAVE_AVX2)
+#if defined(RECONAR_HAVE_AVX2_KERNELS)
 WarpSums WarpSumsAvx2(const WarpHomography& h, const WarpWindow& window, const float* image, int stride);
 #endif
-#if defined(RECONAR_PATCHMATCH_HAVE_NEON)
+#if defined(RECONAR_HAVE_NEON_KERNELS)
 WarpSums WarpSumsNeon(const WarpHomography& h, const WarpWindow& window, const float* image, int stride);
 #endif
 }  // namespace internal

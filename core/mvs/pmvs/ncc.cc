@@ -2,10 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 
-#include "core/base/cpu_features.h"
 #include "core/mvs/pmvs/ncc_kernels.h"
 
 namespace reconar {
@@ -30,31 +27,26 @@ const NccKernel& ScalarNccKernel() {
 }
 
 std::vector<NccKernel> AvailableNccKernels() {
-  std::vector<NccKernel> kernels = {ScalarNccKernel()};
-#if defined(RECONAR_PMVS_HAVE_SSE2)
-  kernels.push_back({"sse2", internal::NccSumsSse2});
+  return KernelsThisCpuRuns<NccKernel>({
+      ScalarNccKernel(),
+#if defined(RECONAR_HAVE_SSE2_KERNELS)
+      {"sse2", internal::NccSumsSse2},
 #endif
-#if defined(RECONAR_PMVS_HAVE_AVX2)
-  if (HostCpuFeatures().avx2 && HostCpuFeatures().fma) kernels.push_back({"avx2", internal::NccSumsAvx2});
+#if defined(RECONAR_HAVE_AVX2_KERNELS)
+      {"avx2", internal::NccSumsAvx2},
 #endif
-#if defined(RECONAR_PMVS_HAVE_NEON)
-  kernels.push_back({"neon", internal::NccSumsNeon});
+#if defined(RECONAR_HAVE_NEON_KERNELS)
+      {"neon", internal::NccSumsNeon},
 #endif
-  return kernels;
+  });
 }
 
-const NccKernel& ActiveNccKernel() {
-  static const NccKernel active = [] {
-    const std::vector<NccKernel> kernels = AvailableNccKernels();
-    if (const char* forced = std::getenv("RECONAR_NCC_KERNEL")) {
-      for (const NccKernel& k : kernels) {
-        if (std::strcmp(k.name, forced) == 0) return k;
-      }
-    }
-    return kernels.back();
-  }();
-  return active;
+const KernelDispatch<NccKernel>& NccKernelDispatch() {
+  static const KernelDispatch<NccKernel> dispatch = ChooseKernel("ncc", AvailableNccKernels());
+  return dispatch;
 }
+
+const NccKernel& ActiveNccKernel() { return NccKernelDispatch().kernel; }
 
 bool NormalizeNccReference(float* values, int count, int padded_count, float min_std) {
   if (count <= 1) return false;

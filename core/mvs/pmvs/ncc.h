@@ -7,10 +7,12 @@
 // changes none of the three sums, so every kernel runs whole SIMD blocks.
 //
 // Every instruction set has its own kernel (scalar reference, SSE2 and AVX2 on x86-64, NEON on
-// aarch64) in its own translation unit; ActiveNccKernel() is the one place where one is chosen.
-// Tests compare every available kernel with the scalar reference.
+// aarch64) in its own translation unit; NccKernelDispatch() is the one place where one is chosen,
+// by the rule of core/base/kernel_choice.h. Tests compare every available kernel with the scalar
+// reference.
 #include <vector>
 
+#include "core/base/kernel_choice.h"
 #include "core/mvs/pmvs/ncc_sums.h"
 
 namespace reconar {
@@ -29,7 +31,8 @@ struct NccKernel {
 const NccKernel& ScalarNccKernel();
 // Every kernel compiled in and supported by this CPU, the scalar reference first.
 std::vector<NccKernel> AvailableNccKernels();
-// The widest kernel this CPU runs (chosen once). RECONAR_NCC_KERNEL=<name> forces one.
+// Dispatcher "ncc": the widest kernel this CPU runs, chosen once; RECONAR_NCC_KERNEL=<name> forces one.
+const KernelDispatch<NccKernel>& NccKernelDispatch();
 const NccKernel& ActiveNccKernel();
 
 // Normalises values[0, count) in place to zero mean and unit norm and zeroes [count, padded).

@@ -7,13 +7,13 @@
 namespace reconar::internal {
 
 NccSums NccSumsScalar(const float* normalized_reference, const float* samples, int padded_count);
-#if defined(RECONAR_PMVS_HAVE_SSE2)
+#if defined(RECONAR_HAVE_SSE2_KERNELS)
 NccSums NccSumsSse2(const float* normalized_reference, const float* samples, int padded_count);
 #endif
-#if defined(RECONAR_PMVS_HAVE_AVX2)
+#if defined(RECONAR_HAVE_AVX2_KERNELS)
 NccSums NccSumsAvx2(const float* normalized_reference, const float* samples, int padded_count);
 #endif
-#if defined(RECONAR_PMVS_HAVE_NEON)
+#if defined(RECONAR_HAVE_NEON_KERNELS)
 NccSums NccSumsNeon(const float* normalized_reference, const float* samples, int padded_count);
 #endif
 

@@ -1,8 +1,9 @@
-#include "core/features/sift/kernels.h"
+#include "core/features/sift/kernels_dispatch.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <vector>
 
@@ -16,11 +17,11 @@ std::vector<float> RandomRow(int n, std::mt19937& rng) {
   return row;
 }
 
-class SiftKernelsTest : public ::testing::TestWithParam<const SiftKernels*> {};
+class SiftKernelsTest : public ::testing::TestWithParam<SiftKernels> {};
 
 TEST_P(SiftKernelsTest, ConvolutionsMatchReference) {
-  const SiftKernels& ref = ReferenceSiftKernels();
-  const SiftKernels& k = *GetParam();
+  const SiftKernels& ref = ScalarSiftKernels();
+  const SiftKernels& k = GetParam();
   std::mt19937 rng(7);
   for (int radius : {1, 3, 8, 13, 30}) {
     for (int width : {1, 7, 16, 37, 260}) {
@@ -54,8 +55,8 @@ TEST_P(SiftKernelsTest, ConvolutionsMatchReference) {
 }
 
 TEST_P(SiftKernelsTest, SubtractAndExtremaMatchReferenceExactly) {
-  const SiftKernels& ref = ReferenceSiftKernels();
-  const SiftKernels& k = *GetParam();
+  const SiftKernels& ref = ScalarSiftKernels();
+  const SiftKernels& k = GetParam();
   std::mt19937 rng(11);
   for (int width : {3, 10, 33, 301}) {
     std::vector<std::vector<float>> rows;
@@ -84,8 +85,8 @@ TEST_P(SiftKernelsTest, SubtractAndExtremaMatchReferenceExactly) {
 }
 
 TEST_P(SiftKernelsTest, GradientMatchesReferenceAndAtan2) {
-  const SiftKernels& ref = ReferenceSiftKernels();
-  const SiftKernels& k = *GetParam();
+  const SiftKernels& ref = ScalarSiftKernels();
+  const SiftKernels& k = GetParam();
   std::mt19937 rng(5);
   const int width = 203;
   std::vector<float> above = RandomRow(width, rng), row = RandomRow(width, rng), below = RandomRow(width, rng);
@@ -114,17 +115,22 @@ TEST_P(SiftKernelsTest, GradientMatchesReferenceAndAtan2) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllAvailable, SiftKernelsTest, ::testing::ValuesIn(AvailableSiftKernels()),
-                         [](const ::testing::TestParamInfo<const SiftKernels*>& param_info) {
-                           return std::string(param_info.param->name);
+                         [](const ::testing::TestParamInfo<SiftKernels>& param_info) {
+                           return std::string(param_info.param.name);
                          });
 
-TEST(SiftKernelsDispatch, BestIsAmongAvailable) {
-  const SiftKernels* best = &BestSiftKernels();
+TEST(SiftKernelsDispatch, ActiveIsTheWidestAvailable) {
+  const std::vector<SiftKernels> available = AvailableSiftKernels();
+  const SiftKernels& active = ActiveSiftKernels();
+  EXPECT_STREQ(available.front().name, "scalar");
   bool found = false;
-  for (const SiftKernels* k : AvailableSiftKernels()) found = found || k == best;
+  for (const SiftKernels& k : available) found = found || k.convolve_row == active.convolve_row;
   EXPECT_TRUE(found);
+  if (std::getenv("RECONAR_SIFT_KERNEL") == nullptr) {
+    EXPECT_STREQ(active.name, available.back().name);
+  }
 #if defined(__aarch64__)
-  EXPECT_STREQ(best->name, "neon");
+  EXPECT_STREQ(available.back().name, "neon");
 #endif
 }
 
