@@ -6,9 +6,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
-#include <vector>
 
-#include "core/base/json_writer.h"
 #include "render/ar/capture_session.h"
 #ifdef RECONAR_HAVE_VIEW
 #include "render/ar/capture_window.h"
@@ -16,6 +14,7 @@
 #include "tools/ar_args.h"
 #include "tools/args.h"
 #include "tools/commands.h"
+#include "tools/reconstruct_command.h"
 
 namespace reconar::tools {
 namespace {
@@ -59,39 +58,7 @@ void OnInterrupt(int) { g_stop.store(true); }
 void PrintEvent(const CaptureEvent& event, bool json) {
   const GateFrameReport& g = event.gate;
   if (json) {
-    JsonWriter out;
-    out.BeginObject();
-    out.Key("event").String(event.kind == CaptureEvent::Kind::kKeyframe     ? "keyframe"
-                            : event.kind == CaptureEvent::Kind::kWarning    ? "warning"
-                            : event.kind == CaptureEvent::Kind::kRegistered ? "registered"
-                                                                            : "status");
-    out.Key("frame").Int(event.frame_index).Key("video_seconds").Double(event.video_seconds);
-    out.Key("frames").Int(event.frames).Key("keyframes").Int(event.keyframes).Key("registered").Int(event.registered);
-    if (event.kind == CaptureEvent::Kind::kWarning) {
-      out.Key("message").String(event.message);
-    } else if (event.kind == CaptureEvent::Kind::kRegistered) {
-      out.Key("path").String(event.path);
-    } else {
-      out.Key("verdict").String(GateVerdictName(g.verdict)).Key("advice").String(g.advice);
-      out.Key("sharpness").Double(g.sharpness).Key("sharpness_threshold").Double(g.sharpness_threshold);
-      out.Key("mean_level").Double(g.mean_level).Key("dark_level").Double(g.dark_level);
-      out.Key("bright_level").Double(g.bright_level).Key("highlights").Double(g.highlight_fraction);
-      out.Key("parallax")
-          .Double(g.parallax)
-          .Key("overlap")
-          .Double(g.overlap)
-          .Key("frame_motion")
-          .Double(g.frame_motion);
-    }
-    if (event.kind == CaptureEvent::Kind::kKeyframe) out.Key("path").String(event.path).Key("kept").Bool(event.kept);
-    if ((event.kind == CaptureEvent::Kind::kStatus || event.kind == CaptureEvent::Kind::kKeyframe) &&
-        event.map_version > 0) {
-      out.Key("map").BeginObject().Key("version").Int(event.map_version);
-      out.Key("state").String(MapTrackingStateName(event.map_state)).Key("inliers").Int(event.map_inliers);
-      out.EndObject();
-    }
-    out.EndObject();
-    std::printf("%s\n", out.str().c_str());
+    std::printf("%s\n", CaptureEventJson(event).c_str());
     std::fflush(stdout);
     return;
   }
@@ -166,24 +133,7 @@ int RunCapture(int argc, char** argv, int first) {
   std::signal(SIGINT, SIG_DFL);
   if (!report.ok()) return Fail(report.status());
   if (json) {
-    JsonWriter out;
-    out.BeginObject().Key("event").String("end").Key("source").String(report->source);
-    out.Key("frames").Int(report->frames).Key("keyframes").Int(report->keyframes);
-    out.Key("keyframes_kept").Int(report->keyframes_kept).Key("blurred").Int(report->blurred);
-    out.Key("bad_exposure").Int(report->bad_exposure).Key("too_close").Int(report->too_close);
-    out.Key("lost").Int(report->lost).Key("corrupt").Int(report->corrupt);
-    out.Key("median_gate_ms").Double(report->median_gate_ms).Key("stop_reason").String(report->stop_reason);
-    if (report->live) {
-      const LiveReconstructionReport& live = report->live_model;
-      out.Key("live").BeginObject().Key("registered").Int(live.registered).Key("points").Int(live.points);
-      out.Key("median_latency_s").Double(live.median_latency_seconds);
-      out.Key("p95_latency_s").Double(live.p95_latency_seconds).EndObject();
-      out.Key("map").BeginObject().Key("maps").Int(report->maps_used).Key("frames_posed").Int(report->frames_map_posed);
-      out.Key("median_track_ms").Double(report->median_map_track_ms);
-      out.Key("frames_baseline_from_map").Int(report->frames_map_motion).EndObject();
-    }
-    out.EndObject();
-    std::printf("%s\n", out.str().c_str());
+    std::printf("%s\n", CaptureReportJson(*report).c_str());
   } else {
     std::printf(
         "%s: %d frames, %d keyframes in %s/images (%d already there); passed over: %d blurred, %d badly exposed, "
@@ -213,16 +163,12 @@ int RunCapture(int argc, char** argv, int first) {
     return 1;
   }
   if (!args.Has("reconstruct")) return 0;
-  const std::string images = options.project_dir + "/images";
-  std::vector<std::string> words = {"reconar", "reconstruct", images, options.project_dir};
-  for (const char* passed : {"tag-size", "tag-family"}) {
-    if (!args.Has(passed)) continue;
-    words.push_back(std::string("--") + passed);
-    words.push_back(args.Get(passed));
-  }
-  std::vector<char*> reconstruct_argv;
-  for (std::string& word : words) reconstruct_argv.push_back(word.data());
-  return RunReconstruct(static_cast<int>(reconstruct_argv.size()), reconstruct_argv.data(), 2);
+  // `reconar reconstruct PROJECT_DIR/images PROJECT_DIR` with the capture's --tag-size and --tag-family.
+  auto reconstruct = ReconstructOptionsFromArgs(args);
+  if (!reconstruct.ok()) return Fail(reconstruct.status());
+  auto paths = CollectImagePaths({options.project_dir + "/images"});
+  if (!paths.ok()) return Fail(paths.status());
+  return ReconstructAndPrint(*paths, Project(options.project_dir), *reconstruct, /*json=*/false);
 }
 
 }  // namespace reconar::tools

@@ -1,11 +1,9 @@
-// What `reconar reconstruct` and `reconar sfm` (its sparse stages) share: their options, the call of
-// RunReconstruct (core/pipeline/reconstruct.h) and the printed report.
+#include "tools/reconstruct_command.h"
+
 #include <cstdio>
 #include <string>
 
 #include "core/base/atomic_file.h"
-#include "core/pipeline/reconstruct.h"
-#include "tools/args.h"
 #include "tools/commands.h"
 #include "tracker/photo_tags.h"
 #ifdef RECONAR_HAVE_VIEW
@@ -99,7 +97,9 @@ Status ReadDenseAndMeshArgs(const Args& args, ReconstructOptions* options) {
   return Status::Ok();
 }
 
-Result<ReconstructOptions> OptionsFromArgs(const Args& args) {
+}  // namespace
+
+Result<ReconstructOptions> ReconstructOptionsFromArgs(const Args& args) {
   ReconstructOptions options;
   RECONAR_ASSIGN_OR_RETURN(options.features, FeatureStageOptionsFromArgs(args));
   RECONAR_RETURN_IF_ERROR(ReadMatchArgs(args, &options.matching));
@@ -129,6 +129,8 @@ Result<ReconstructOptions> OptionsFromArgs(const Args& args) {
 #endif
   return options;
 }
+
+namespace {
 
 void PrintReport(const ReconstructReport& report, const Project& project) {
   for (const StageSummary& stage : report.stages) {
@@ -160,7 +162,7 @@ int RunReconstructCommand(int argc, char** argv, int first, const char* help, bo
   std::vector<std::string> inputs = args.positionals();
   const Project project(inputs.back());
   inputs.pop_back();
-  auto options = OptionsFromArgs(args);
+  auto options = ReconstructOptionsFromArgs(args);
   if (!options.ok()) return Fail(options.status());
   if (sparse_only) {
     options->run_dense = options->run_mesh = false;
@@ -168,10 +170,15 @@ int RunReconstructCommand(int argc, char** argv, int first, const char* help, bo
   }
   auto paths = CollectImagePaths(inputs);
   if (!paths.ok()) return Fail(paths.status());
-  auto report = RunReconstruct(*paths, project, *options);
+  return ReconstructAndPrint(*paths, project, *options, args.Has("json"));
+}
+
+int ReconstructAndPrint(const std::vector<std::string>& paths, const Project& project,
+                        const ReconstructOptions& options, bool json) {
+  auto report = RunReconstruct(paths, project, options);
   if (!report.ok()) return Fail(report.status());
   if (!report->preview_error.empty()) std::fprintf(stderr, "warning: no preview: %s\n", report->preview_error.c_str());
-  if (args.Has("json")) {
+  if (json) {
     auto text = ReadFileToString(report->report_path);
     if (!text.ok()) return Fail(text.status());
     std::fputs(text->c_str(), stdout);

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "core/base/atomic_file.h"
+#include "core/base/json_writer.h"
 #include "core/base/median.h"
 #include "core/io/exif.h"
 #include "core/io/focal_prior.h"
@@ -398,6 +399,64 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
     if (!more) break;
   }
   return session->Finish();
+}
+
+std::string CaptureEventJson(const CaptureEvent& event) {
+  const GateFrameReport& g = event.gate;
+  JsonWriter out;
+  out.BeginObject();
+  out.Key("event").String(event.kind == CaptureEvent::Kind::kKeyframe     ? "keyframe"
+                          : event.kind == CaptureEvent::Kind::kWarning    ? "warning"
+                          : event.kind == CaptureEvent::Kind::kRegistered ? "registered"
+                                                                          : "status");
+  out.Key("frame").Int(event.frame_index).Key("video_seconds").Double(event.video_seconds);
+  out.Key("frames").Int(event.frames).Key("keyframes").Int(event.keyframes).Key("registered").Int(event.registered);
+  if (event.kind == CaptureEvent::Kind::kWarning) {
+    out.Key("message").String(event.message);
+  } else if (event.kind == CaptureEvent::Kind::kRegistered) {
+    out.Key("path").String(event.path);
+  } else {
+    out.Key("verdict").String(GateVerdictName(g.verdict)).Key("advice").String(g.advice);
+    out.Key("sharpness").Double(g.sharpness).Key("sharpness_threshold").Double(g.sharpness_threshold);
+    out.Key("mean_level").Double(g.mean_level).Key("dark_level").Double(g.dark_level);
+    out.Key("bright_level").Double(g.bright_level).Key("highlights").Double(g.highlight_fraction);
+    out.Key("parallax")
+        .Double(g.parallax)
+        .Key("overlap")
+        .Double(g.overlap)
+        .Key("frame_motion")
+        .Double(g.frame_motion);
+  }
+  if (event.kind == CaptureEvent::Kind::kKeyframe) out.Key("path").String(event.path).Key("kept").Bool(event.kept);
+  if ((event.kind == CaptureEvent::Kind::kStatus || event.kind == CaptureEvent::Kind::kKeyframe) &&
+      event.map_version > 0) {
+    out.Key("map").BeginObject().Key("version").Int(event.map_version);
+    out.Key("state").String(MapTrackingStateName(event.map_state)).Key("inliers").Int(event.map_inliers);
+    out.EndObject();
+  }
+  out.EndObject();
+  return out.str();
+}
+
+std::string CaptureReportJson(const CaptureReport& report) {
+  JsonWriter out;
+  out.BeginObject().Key("event").String("end").Key("source").String(report.source);
+  out.Key("frames").Int(report.frames).Key("keyframes").Int(report.keyframes);
+  out.Key("keyframes_kept").Int(report.keyframes_kept).Key("blurred").Int(report.blurred);
+  out.Key("bad_exposure").Int(report.bad_exposure).Key("too_close").Int(report.too_close);
+  out.Key("lost").Int(report.lost).Key("corrupt").Int(report.corrupt);
+  out.Key("median_gate_ms").Double(report.median_gate_ms).Key("stop_reason").String(report.stop_reason);
+  if (report.live) {
+    const LiveReconstructionReport& live = report.live_model;
+    out.Key("live").BeginObject().Key("registered").Int(live.registered).Key("points").Int(live.points);
+    out.Key("median_latency_s").Double(live.median_latency_seconds);
+    out.Key("p95_latency_s").Double(live.p95_latency_seconds).EndObject();
+    out.Key("map").BeginObject().Key("maps").Int(report.maps_used).Key("frames_posed").Int(report.frames_map_posed);
+    out.Key("median_track_ms").Double(report.median_map_track_ms);
+    out.Key("frames_baseline_from_map").Int(report.frames_map_motion).EndObject();
+  }
+  out.EndObject();
+  return out.str();
 }
 
 }  // namespace reconar

@@ -196,4 +196,8 @@ Result<CaptureReport> RunCapture(const CaptureOptions& options,
                                  const std::function<void(const CaptureEvent&)>& on_event,
                                  const std::atomic<bool>* stop = nullptr);
 
+// One line of `reconar capture --json`: an event, and the capture's end with its report.
+std::string CaptureEventJson(const CaptureEvent& event);
+std::string CaptureReportJson(const CaptureReport& report);
+
 }  // namespace reconar
