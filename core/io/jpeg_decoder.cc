@@ -203,18 +203,6 @@ bool DecodeScanlines(j_decompress_ptr cinfo, ErrorManager* err, uint8_t* pixels,
   return true;
 }
 
-// Destroys the decompressor however the decode ended (jpeg_destroy is safe on a zeroed struct).
-class DecompressGuard {
- public:
-  explicit DecompressGuard(jpeg_decompress_struct* cinfo) : cinfo_(cinfo) {}
-  ~DecompressGuard() { jpeg_destroy_decompress(cinfo_); }
-  DecompressGuard(const DecompressGuard&) = delete;
-  DecompressGuard& operator=(const DecompressGuard&) = delete;
-
- private:
-  jpeg_decompress_struct* cinfo_;
-};
-
 Status FailureToStatus(const ErrorManager& err, const MemorySource& src, const std::string& name, JDIMENSION height,
                        bool progressive) {
   const std::string rows = std::to_string(err.rows_at_failure) + " of " + std::to_string(height) + " rows";
@@ -250,6 +238,34 @@ Status FailureToStatus(const ErrorManager& err, const MemorySource& src, const s
   }
 }
 
+// One decompression of a JPEG in memory: the error manager that records instead of exiting, the
+// source, the header once read. The decompressor is destroyed however it ended (jpeg_destroy is
+// safe on a zeroed struct).
+class Decompression {
+ public:
+  Decompression() {
+    cinfo.err = jpeg_std_error(&err.pub);
+    err.pub.error_exit = OnError;
+    err.pub.emit_message = OnMessage;
+    err.pub.output_message = OnOutputMessage;
+  }
+  ~Decompression() { jpeg_destroy_decompress(&cinfo); }
+  Decompression(const Decompression&) = delete;
+  Decompression& operator=(const Decompression&) = delete;
+
+  Status ReadHeaderOf(std::string_view bytes, const std::string& name) {
+    if (!ReadHeader(&cinfo, &err, &src, reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), &header)) {
+      return FailureToStatus(err, src, name, 0, false);
+    }
+    return Status::Ok();
+  }
+
+  ErrorManager err{};
+  jpeg_decompress_struct cinfo{};
+  MemorySource src{};
+  HeaderInfo header{};
+};
+
 // The EXIF of the APP1 markers ReadHeader saved.
 ExifInfo SavedExif(const jpeg_decompress_struct& cinfo, std::vector<std::string>* warnings) {
   for (jpeg_saved_marker_ptr marker = cinfo.marker_list; marker != nullptr; marker = marker->next) {
@@ -266,39 +282,22 @@ ExifInfo SavedExif(const jpeg_decompress_struct& cinfo, std::vector<std::string>
 }  // namespace
 
 Status ReadJpegHeader(std::string_view bytes, const std::string& name, ImageHeader* out) {
-  ErrorManager err{};
-  jpeg_decompress_struct cinfo{};
-  cinfo.err = jpeg_std_error(&err.pub);
-  err.pub.error_exit = OnError;
-  err.pub.emit_message = OnMessage;
-  err.pub.output_message = OnOutputMessage;
-  DecompressGuard guard(&cinfo);
-  MemorySource src{};
-  HeaderInfo header{};
-  if (!ReadHeader(&cinfo, &err, &src, reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), &header)) {
-    return FailureToStatus(err, src, name, 0, false);
-  }
-  out->width = static_cast<int>(header.width);
-  out->height = static_cast<int>(header.height);
-  out->exif = SavedExif(cinfo, nullptr);
+  Decompression decompression;
+  RECONAR_RETURN_IF_ERROR(decompression.ReadHeaderOf(bytes, name));
+  out->width = static_cast<int>(decompression.header.width);
+  out->height = static_cast<int>(decompression.header.height);
+  out->exif = SavedExif(decompression.cinfo, nullptr);
   return Status::Ok();
 }
 
 Status DecodeJpeg(std::string_view bytes, const std::string& name, const ImageReadOptions& options,
                   DecodedImage* out) {
-  ErrorManager err{};
-  jpeg_decompress_struct cinfo{};
-  cinfo.err = jpeg_std_error(&err.pub);
-  err.pub.error_exit = OnError;
-  err.pub.emit_message = OnMessage;
-  err.pub.output_message = OnOutputMessage;
-  DecompressGuard guard(&cinfo);
-
-  MemorySource src{};
-  HeaderInfo header{};
-  if (!ReadHeader(&cinfo, &err, &src, reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), &header)) {
-    return FailureToStatus(err, src, name, 0, false);
-  }
+  Decompression decompression;
+  RECONAR_RETURN_IF_ERROR(decompression.ReadHeaderOf(bytes, name));
+  ErrorManager& err = decompression.err;
+  jpeg_decompress_struct& cinfo = decompression.cinfo;
+  const MemorySource& src = decompression.src;
+  const HeaderInfo& header = decompression.header;
   if (header.color_space == JCS_CMYK || header.color_space == JCS_YCCK) {
     return FileError(StatusCode::kUnsupported, name, "CMYK JPEG is not supported; convert to RGB");
   }

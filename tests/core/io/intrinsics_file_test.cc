@@ -14,17 +14,8 @@ namespace {
 
 TEST(IntrinsicsFileTest, RoundTripsExactly) {
   const std::string path = ::testing::TempDir() + "/intrinsics_file_test.txt";
-  CameraIntrinsics k;
-  k.width = 816;
-  k.height = 612;
-  k.fx = 770.0;
-  k.fy = 762.0;
-  k.cx = 401.3;
-  k.cy = 298.6;
-  k.k1 = -0.12;
-  k.k2 = 0.09;
-  k.fx = 765.0000000000001;
-  k.k2 = -1.25e-7;
+  // width, height, fx, fy, cx, cy, k1, k2: digits that need all 17 to read back.
+  const CameraIntrinsics k{816, 612, 765.0000000000001, 764.18, 393.72, 304.66, -0.12, -1.25e-7};
   ASSERT_TRUE(WriteIntrinsics(path, k).ok());
   Result<CameraIntrinsics> read = ReadIntrinsics(path);
   ASSERT_TRUE(read.ok()) << read.status().ToString();
