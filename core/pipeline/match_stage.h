@@ -22,6 +22,7 @@
 #include "core/features/pair_selection.h"
 #include "core/features/sift/sift.h"
 #include "core/geometry/two_view.h"
+#include "core/pipeline/matches_file.h"
 #include "core/pipeline/project.h"
 
 namespace reconar {
@@ -52,14 +53,6 @@ struct MatchStageOptions {
   int num_threads = 0;  // pairs in parallel; <= 0: one per core
   bool show_progress = true;
   size_t memory_budget_bytes = 0;  // for features and forests; 0: no limit
-};
-
-struct VerifiedPair {
-  int image_a = -1;
-  int image_b = -1;
-  int num_putative = 0;
-  TwoViewGeometry geometry;
-  std::vector<FeatureMatch> inlier_matches;
 };
 
 struct MatchStageReport {
@@ -142,16 +135,5 @@ std::string ExtractAgainDigest(const std::map<std::string, std::string>& names);
 // The report's photos extracted again, as the JSON object PROJECT/matches/report.json holds.
 std::string MatchStageReportJson(const MatchStageReport& report);
 
-// Writes PROJECT/matches/matches.txt (atomically) from pairs in the stage's order (image_a <
-// image_b, indices into `images`); pairs with too few inliers are left out.
-Status WriteMatchesFile(const Project& project, const std::vector<ProjectImage>& images,
-                        const std::vector<VerifiedPair>& pairs);
-
-struct MatchesFilePair {
-  std::string name_a, name_b, config;  // config: "verified" or "planar"
-  Eigen::Matrix3d F;
-  std::vector<FeatureMatch> matches;
-};
-Result<std::vector<MatchesFilePair>> ReadMatchesFile(const std::string& path);
 
 }  // namespace reconar

@@ -13,7 +13,7 @@
 #include "core/base/thread_pool.h"
 #include "core/features/sift/sift_io.h"
 #include "core/io/image_io.h"
-#include "core/pipeline/match_stage.h"
+#include "core/pipeline/matches_file.h"
 #include "core/pipeline/stage_record.h"
 #include "core/sfm/model_io.h"
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "core/base/json_reader.h"
-#include "core/pipeline/match_stage.h"
+#include "core/pipeline/matches_file.h"
 #include "core/sfm/model_io.h"
 
 namespace reconar {
