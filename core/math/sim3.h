@@ -45,7 +45,7 @@ inline Result<Sim3> AlignSimilarity(const std::vector<Eigen::Vector3d>& from, co
   // Points that differ only by rounding (cameras turning on one spot) give no rotation either.
   double largest_from = 0.0;
   for (const Eigen::Vector3d& point : from) largest_from = std::max(largest_from, point.norm());
-  if (!(variance_from > 1e-18 * largest_from * largest_from) || !(variance_from > 0.0)) {
+  if (!(variance_from > 1e-18 * largest_from * largest_from)) {
     return InvalidArgument("AlignSimilarity: all source points coincide");
   }
 

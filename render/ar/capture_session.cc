@@ -240,7 +240,7 @@ bool CaptureSession::ShowPreview(const Frame& frame, const GateFrameReport& gate
   return false;
 }
 
-bool CaptureSession::SourceFailed(const Status& status) {
+bool CaptureSession::EndsTheCapture(const Status& status) {
   if (IsEndOfStream(status)) {
     report_.stop_reason = replay_ ? "end of the recording" : "end of the stream";
     return true;
@@ -292,7 +292,7 @@ Result<bool> CaptureSession::Step() {
   if (ended_) return false;
   Result<FrameHandle> next = source_->Next();
   while (!next.ok()) {
-    if (SourceFailed(next.status())) {
+    if (EndsTheCapture(next.status())) {
       ended_ = true;
       return false;
     }

@@ -151,8 +151,9 @@ class CaptureSession {
   void Emit(CaptureEvent event) const;
   void EmitRegistered(int64_t frame_index, double video_seconds);
   Status FollowMap(const Frame& frame, CaptureEvent* event);
-  // False when the frame ends the capture (report_.stop_reason set); the event warns of a skipped one.
-  bool SourceFailed(const Status& status);
+  // True when the source's error ends the capture (report_.stop_reason says why); false for a
+  // corrupt frame that is skipped (a warning event says so).
+  bool EndsTheCapture(const Status& source_error);
   Status TakeKeyframe(const Frame& frame, CaptureEvent* event);
   void DrawOverlay();
   Status DrawPreview(const char* name);
