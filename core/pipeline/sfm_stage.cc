@@ -265,6 +265,8 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   start = Clock::now();
   const std::string sparse = project.SparseDir();
   RECONAR_RETURN_IF_ERROR(CreateDirectories(sparse));
+  // An earlier model's marker goes first: a write that fails midway leaves no finished-looking mix.
+  RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(sparse + "/points3D.txt"));
   std::vector<std::string> paths;
   for (const ProjectImage& image : list) paths.push_back(image.path);
   RECONAR_RETURN_IF_ERROR(WriteBundlerModel(*reconstruction, sparse + "/bundle.out", sparse + "/list.txt", paths));
