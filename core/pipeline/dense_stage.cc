@@ -18,6 +18,7 @@
 #include "core/mvs/dense_memory.h"
 #include "core/mvs/merge_points.h"
 #include "core/mvs/undistort.h"
+#include "core/pipeline/project_lock.h"
 #include "core/pipeline/stage_record.h"
 #include "core/sfm/model_io.h"
 
@@ -176,6 +177,7 @@ std::string DenseStageSettings(const DenseStageOptions& options) {
 
 Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageOptions& options) {
   RECONAR_RETURN_IF_ERROR(options.Check());
+  RECONAR_ASSIGN_OR_RETURN(const ProjectLock lock, LockProject(project));
   DenseStageReport report;
   report.method = options.method;
   report.peak_rss_resettable = ResetPeakResidentBytes();

@@ -8,6 +8,7 @@
 #include "core/base/json_reader.h"
 #include "core/base/json_writer.h"
 #include "core/features/sift/sift_io.h"
+#include "core/pipeline/project_lock.h"
 #include "core/pipeline/stage_record.h"
 #include "core/sfm/model_io.h"
 
@@ -42,6 +43,7 @@ Result<MapStageReport> RunMapStage(const Project& project, const MapStageOptions
     return FailedPrecondition(project.SparseDir() +
                               ": no sparse model (run `reconar reconstruct` or `reconar sfm` first)");
   }
+  RECONAR_ASSIGN_OR_RETURN(const ProjectLock lock, LockProject(project));
   RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(project.SparseDir()));
   const ImageDescriptorLoader load = [&](const SfmImage& image) -> Result<std::vector<uint8_t>> {
     RECONAR_ASSIGN_OR_RETURN(FeatureFile features, ReadFeatureFile(project.MatchedFeaturePath(image.name)));

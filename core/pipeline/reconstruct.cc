@@ -15,6 +15,7 @@
 #include "core/base/thread_pool.h"
 #include "core/io/image_io.h"
 #include "core/pipeline/map_stage.h"
+#include "core/pipeline/project_lock.h"
 #include "core/pipeline/stage_record.h"
 #include "core/pipeline/weak_registrations.h"
 #include "core/sfm/model_io.h"
@@ -244,6 +245,7 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
     return InvalidArgument("reconstruct needs at least 2 photos, got " + std::to_string(image_paths.size()));
   }
   RECONAR_RETURN_IF_ERROR(CreateDirectories(project.root()));
+  RECONAR_ASSIGN_OR_RETURN(const ProjectLock lock, LockProject(project));
   RECONAR_ASSIGN_OR_RETURN(const int stale, RemoveStaleTemporaryFiles(project.root()));
   if (stale > 0) std::fprintf(stderr, "removed %d temporary file(s) of an interrupted run\n", stale);
   ReconstructReport report;

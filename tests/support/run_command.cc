@@ -21,6 +21,20 @@ std::string MakeTestDirectory(const std::string& prefix) {
   return dir.string();
 }
 
+std::string SharedProjectDirectory(const std::string& name, const std::string& binary) {
+  namespace fs = std::filesystem;
+  const auto stamp = fs::last_write_time(binary).time_since_epoch().count();
+  const std::string prefix = "reconar_shared_" + name + "_";
+  const fs::path dir = fs::temp_directory_path() / (prefix + std::to_string(stamp));
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(fs::temp_directory_path(), error)) {
+    const std::string other = entry.path().filename().string();
+    if (other.rfind(prefix, 0) == 0 && entry.path() != dir) fs::remove_all(entry.path(), error);
+  }
+  fs::create_directories(dir);
+  return dir.string();
+}
+
 std::string LinkFiles(const std::string& dir, const std::string& source_dir, const std::vector<std::string>& names) {
   std::filesystem::create_directories(dir);
   for (const std::string& name : names) {

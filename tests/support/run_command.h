@@ -20,6 +20,14 @@ enum class StderrMode {
 // A fresh directory "<gtest temp dir>/<prefix>_<pid>" (created with its parents) for a test's files.
 std::string MakeTestDirectory(const std::string& prefix);
 
+// A directory for one project that tests in several executables share (a heavy model two tests
+// need): "<temp dir>/reconar_shared_<name>_<modification time of `binary`>", created if missing;
+// the directories of other builds of `binary` are removed. Each build starts afresh, so no test
+// reuses stages an older binary made. Runs on it wait for each other (the project's lock,
+// core/pipeline/project_lock.h): the first test to get there makes the project, the others find
+// its stages done. A test that changes the project works on a copy.
+std::string SharedProjectDirectory(const std::string& name, const std::string& binary);
+
 // `dir` (created with its parents) holding a symlink to source_dir/NAME for each of `names`
 // (a subset of a dataset as a project's input); returns `dir`.
 std::string LinkFiles(const std::string& dir, const std::string& source_dir, const std::vector<std::string>& names);
