@@ -5,7 +5,6 @@
 #include <vector>
 
 #include "core/base/json_writer.h"
-#include "core/io/intrinsics_file.h"
 #include "core/pipeline/project.h"
 #include "tools/commands.h"
 #include "tracker/calibration.h"
@@ -47,24 +46,19 @@ int RunCalibrate(int argc, char** argv, int first) {
   auto paths = CollectImagePaths(args.positionals());
   if (!paths.ok()) return Fail(paths.status());
 
-  CalibrationObservations observations;
-  observations.tag_size = *tag_size;
+  CalibrationObservations targets;
+  targets.tag_size = *tag_size;
   if (args.Has("layout")) {
     auto layout = ReadTagLayout(args.Get("layout"));
     if (!layout.ok()) return Fail(layout.status());
-    observations.layout = std::move(*layout);
+    targets.layout = std::move(*layout);
   }
-  int total_tags = 0;
-  auto images = DetectCalibrationImages(*paths, photo_options, &total_tags);
-  if (!images.ok()) return Fail(images.status());
-  observations.images = std::move(*images);
-
   CalibrationOptions options;
   options.fix_principal_point = args.Has("fix-principal-point");
   if (args.Has("no-distortion")) options.estimate_k1 = options.estimate_k2 = false;
-  auto report = CalibrateIntrinsics(observations, options);
-  if (!report.ok()) return Fail(report.status());
-  if (Status s = WriteIntrinsics(args.Get("out"), report->intrinsics); !s.ok()) return Fail(s);
+  auto run = CalibrateFromPhotos(*paths, std::move(targets), photo_options, options, args.Get("out"));
+  if (!run.ok()) return Fail(run.status());
+  const CalibrationReport* report = &run->calibration;
 
   const CameraIntrinsics& k = report->intrinsics;
   if (args.Has("json")) {
@@ -78,7 +72,7 @@ int RunCalibrate(int argc, char** argv, int first) {
     for (int i = 0; i < 6; ++i) json.Key(names[i]).Double(report->stddev[i]);
     json.EndObject();
     json.Key("rms_px").Double(report->rms_px).Key("initial_rms_px").Double(report->initial_rms_px);
-    json.Key("images").Int(static_cast<long long>(observations.images.size()));
+    json.Key("images").Int(static_cast<long long>(run->images));
     json.Key("images_used").Int(report->num_images_used).Key("targets").Int(report->num_targets);
     json.Key("corners").Int(report->num_corners).Key("iterations").Int(report->iterations);
     json.Key("converged").Bool(report->converged).EndObject();
@@ -88,7 +82,7 @@ int RunCalibrate(int argc, char** argv, int first) {
                "reconar calibrate: %d tags found; %d image(s), %d tag view(s), %d corners; rms %.3f px (closed form %.3f)\n"
                "  fx %.2f ± %.2f  fy %.2f ± %.2f  cx %.2f ± %.2f  cy %.2f ± %.2f  k1 %.4f ± %.4f  k2 %.4f ± %.4f\n"
                "  written to %s\n",
-               total_tags, report->num_images_used, report->num_targets, report->num_corners, report->rms_px,
+               run->tags_found, report->num_images_used, report->num_targets, report->num_corners, report->rms_px,
                report->initial_rms_px, k.fx, report->stddev[0], k.fy, report->stddev[1], k.cx, report->stddev[2], k.cy,
                report->stddev[3], k.k1, report->stddev[4], k.k2, report->stddev[5], args.Get("out").c_str());
   return 0;

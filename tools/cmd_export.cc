@@ -1,13 +1,9 @@
 // `reconar export`: converts a mesh or point cloud between the file formats of core/mesh/mesh_file.h.
-#include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <string>
 
-#include "core/base/atomic_file.h"
 #include "core/base/json_writer.h"
-#include "core/mesh/mesh_file.h"
-#include "core/mesh/simplify.h"
+#include "core/mesh/mesh_conversion.h"
 #include "tools/args.h"
 #include "tools/commands.h"
 
@@ -31,75 +27,45 @@ constexpr char kHelp[] =
 
 }  // namespace
 
-// The parent directory of `path` (created when missing) so that writing fails only for real reasons.
-Status CreateParentDirectory(const std::string& path) {
-  const std::string parent = std::filesystem::path(path).parent_path().string();
-  return parent.empty() ? Status::Ok() : CreateDirectories(parent);
-}
-
-uintmax_t FileSize(const std::string& path) {
-  std::error_code error;
-  const uintmax_t size = std::filesystem::file_size(path, error);
-  return error ? 0 : size;
-}
-
-void PrintMeshSummary(const char* verb, const std::string& path, const Mesh& mesh) {
-  std::printf("%s %s: %zu vertices, %zu triangles%s%s\n", verb, path.c_str(), mesh.positions.size(),
-              mesh.triangles.size(), mesh.normals.empty() ? "" : ", normals", mesh.colors.empty() ? "" : ", colours");
-}
-
 int RunExport(int argc, char** argv, int first) {
   Args args({"max-faces"}, {"ascii", "json"});
   if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
   const std::string& input = args.positionals()[0];
   const std::string& output = args.positionals()[1];
-  // Both extensions are checked before anything is read.
-  if (auto format = ReadableMeshFileFormatOf(input); !format.ok()) return Fail(format.status());
-  auto output_format = MeshFileFormatOf(output);
-  if (!output_format.ok()) return Fail(output_format.status());
-  MeshFileOptions options;
-  options.ply_ascii = args.Has("ascii");
-  if (options.ply_ascii && *output_format != MeshFileFormat::kPly) {
+  MeshConversionOptions options;
+  options.file.ply_ascii = args.Has("ascii");
+  if (options.file.ply_ascii && MeshFileFormatOf(output).ok() && *MeshFileFormatOf(output) != MeshFileFormat::kPly) {
     return Fail(InvalidArgument(output + ": --ascii applies only to .ply output"));
   }
   auto max_faces = args.GetInt("max-faces", 0, 0, 1 << 30);
   if (!max_faces.ok()) return Fail(max_faces.status());
+  options.max_faces = static_cast<size_t>(*max_faces);
 
-  const auto start = std::chrono::steady_clock::now();
-  auto mesh = ReadMeshFile(input);
-  if (!mesh.ok()) return Fail(mesh.status());
-  const auto read = std::chrono::steady_clock::now();
-  const size_t triangles_read = mesh->triangles.size();
-  if (!args.Has("json")) PrintMeshSummary("read", input, *mesh);
-  auto simplify_report = SimplifyToFaceBudget(static_cast<size_t>(*max_faces), &*mesh);
-  if (!simplify_report.ok()) return Fail(simplify_report.status().WithContext(input));
-  const SimplifyReport simplified = *simplify_report;
-  if (Status s = CreateParentDirectory(output); !s.ok()) return Fail(s);
-  if (Status s = WriteMeshFile(output, *mesh, options); !s.ok()) return Fail(s);
-  const auto written = std::chrono::steady_clock::now();
-  const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
-
+  auto report = ConvertMeshFile(input, output, options);
+  if (!report.ok()) return Fail(report.status());
+  const MeshConversionReport& r = *report;
   if (args.Has("json")) {
     JsonWriter json(2);
     json.BeginObject();
     json.Key("input").String(input).Key("output").String(output);
-    json.Key("vertices").Int(static_cast<long long>(mesh->positions.size()));
-    json.Key("triangles").Int(static_cast<long long>(mesh->triangles.size()));
-    json.Key("triangles_read").Int(static_cast<long long>(triangles_read));
-    json.Key("seconds_simplify").Double(simplified.seconds);
-    json.Key("normals").Bool(!mesh->normals.empty()).Key("colors").Bool(!mesh->colors.empty());
-    json.Key("bytes").Int(static_cast<long long>(FileSize(output)));
-    json.Key("seconds_read").Double(seconds(start, read)).Key("seconds_write").Double(seconds(read, written));
+    json.Key("vertices").Int(static_cast<long long>(r.vertices));
+    json.Key("triangles").Int(static_cast<long long>(r.triangles));
+    json.Key("triangles_read").Int(static_cast<long long>(r.triangles_read));
+    json.Key("seconds_simplify").Double(r.simplify.seconds);
+    json.Key("normals").Bool(r.normals).Key("colors").Bool(r.colors);
+    json.Key("bytes").Int(static_cast<long long>(r.bytes));
+    json.Key("seconds_read").Double(r.seconds_read).Key("seconds_write").Double(r.seconds_write);
     json.EndObject();
     std::printf("%s\n", json.str().c_str());
-  } else {
-    if (simplified.collapses > 0) {
-      std::printf("simplified to %zu vertices, %zu triangles (%.2fs)\n", mesh->positions.size(),
-                  mesh->triangles.size(), simplified.seconds);
-    }
-    std::printf("wrote %s: %ju bytes (read %.2fs, write %.2fs)\n", output.c_str(), FileSize(output),
-                seconds(start, read), seconds(read, written) - simplified.seconds);
+    return 0;
   }
+  std::printf("read %s: %zu vertices, %zu triangles%s%s\n", input.c_str(), r.vertices_read, r.triangles_read,
+              r.normals ? ", normals" : "", r.colors ? ", colours" : "");
+  if (r.simplify.collapses > 0) {
+    std::printf("simplified to %zu vertices, %zu triangles (%.2fs)\n", r.vertices, r.triangles, r.simplify.seconds);
+  }
+  std::printf("wrote %s: %ju bytes (read %.2fs, write %.2fs)\n", output.c_str(), r.bytes, r.seconds_read,
+              r.seconds_write);
   return 0;
 }
 

@@ -25,7 +25,6 @@ int RunReconstructCommand(int argc, char** argv, int first, const char* help, bo
 
 #include "core/base/status.h"
 #include "core/features/sift/sift.h"
-#include "core/mesh/mesh.h"
 #include "core/pipeline/dense_stage.h"
 #include "core/pipeline/feature_stage.h"
 #include "core/pipeline/match_stage.h"
@@ -51,10 +50,5 @@ inline const std::set<std::string> kMatchValuedOptions = {
 // reconstruct (reconstruct_command.cc).
 Status ReadDenseArgs(const Args& args, DenseStageOptions* dense);
 inline const std::set<std::string> kDenseValuedOptions = {"level", "method", "max-image-size"};
-
-// Shared by export and mesh (cmd_export.cc): creates the parent directory of an output file, and
-// prints "<verb> <path>: N vertices, M triangles[, normals][, colours]" on stdout.
-Status CreateParentDirectory(const std::string& path);
-void PrintMeshSummary(const char* verb, const std::string& path, const Mesh& mesh);
 
 }  // namespace reconar::tools

@@ -5,6 +5,7 @@
 #include "core/base/progress.h"
 #include "core/io/gray.h"
 #include "core/io/image_io.h"
+#include "core/io/intrinsics_file.h"
 
 namespace reconar {
 
@@ -28,6 +29,19 @@ Result<std::vector<CalibrationImage>> DetectCalibrationImages(const std::vector<
   if (progress) progress->Finish();
   if (tags_found != nullptr) *tags_found = total_tags;
   return images;
+}
+
+Result<PhotoCalibrationReport> CalibrateFromPhotos(const std::vector<std::string>& paths,
+                                                   CalibrationObservations targets,
+                                                   const CalibrationPhotoOptions& photo_options,
+                                                   const CalibrationOptions& options,
+                                                   const std::string& intrinsics_path) {
+  PhotoCalibrationReport report;
+  RECONAR_ASSIGN_OR_RETURN(targets.images, DetectCalibrationImages(paths, photo_options, &report.tags_found));
+  report.images = targets.images.size();
+  RECONAR_ASSIGN_OR_RETURN(report.calibration, CalibrateIntrinsics(targets, options));
+  RECONAR_RETURN_IF_ERROR(WriteIntrinsics(intrinsics_path, report.calibration.intrinsics));
+  return report;
 }
 
 }  // namespace reconar

@@ -21,4 +21,19 @@ Result<std::vector<CalibrationImage>> DetectCalibrationImages(const std::vector<
                                                               const CalibrationPhotoOptions& options,
                                                               int* tags_found = nullptr);
 
+struct PhotoCalibrationReport {
+  CalibrationReport calibration;
+  int tags_found = 0;  // detections in all the photos
+  size_t images = 0;   // photos searched
+};
+
+// `reconar calibrate`: the tags in the photos (DetectCalibrationImages), the intrinsics from their
+// corners (CalibrateIntrinsics; `targets` gives the tag size and the optional layout, its images
+// are filled here) written to `intrinsics_path` (core/io/intrinsics_file.h, atomically).
+Result<PhotoCalibrationReport> CalibrateFromPhotos(const std::vector<std::string>& paths,
+                                                   CalibrationObservations targets,
+                                                   const CalibrationPhotoOptions& photo_options,
+                                                   const CalibrationOptions& options,
+                                                   const std::string& intrinsics_path);
+
 }  // namespace reconar
