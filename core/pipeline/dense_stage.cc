@@ -83,14 +83,38 @@ void AddReports(const PatchMvsReport& part, PatchMvsReport* sum) {
   sum->seconds_filtering += part.seconds_filtering;
 }
 
-// Decodes and undistorts the views of `cluster` that `cache` lacks, and drops the ones it no
-// longer needs, so that at most one cluster's views are held.
+// Before cluster `current` is loaded: drops the cached views no cluster from `current` on needs
+// (`clusters` lists only the clusters that run), and of the views a later cluster needs keeps
+// those needed soonest while their bytes fit `spare_bytes`, so that a photo shared by clusters
+// is decoded once when the memory budget allows.
+void KeepViewsForLaterClusters(const std::vector<std::vector<int>>& clusters, size_t current, size_t spare_bytes,
+                               std::map<int, std::unique_ptr<DenseView>>* cache) {
+  std::vector<std::pair<size_t, int>> later;  // (the next cluster that needs it, view id)
+  for (auto it = cache->begin(); it != cache->end();) {
+    size_t next = clusters.size();
+    for (size_t k = current; k < clusters.size() && next == clusters.size(); ++k) {
+      if (std::binary_search(clusters[k].begin(), clusters[k].end(), it->first)) next = k;
+    }
+    if (next == clusters.size()) {
+      it = cache->erase(it);
+      continue;
+    }
+    if (next > current) later.emplace_back(next, it->first);
+    ++it;
+  }
+  std::sort(later.begin(), later.end());
+  size_t kept_bytes = 0;
+  for (const auto& [next, id] : later) {
+    const DenseView& view = *cache->at(id);
+    kept_bytes += view.rgb.size_bytes() + view.gray.size_bytes();
+    if (kept_bytes > spare_bytes) cache->erase(id);
+  }
+}
+
+// Decodes and undistorts the views of `cluster` that `cache` lacks.
 Status LoadClusterViews(const std::vector<int>& cluster, const Reconstruction& model,
                         const std::vector<std::string>& paths, int level, ThreadPool* pool, Progress* progress,
                         std::map<int, std::unique_ptr<DenseView>>* cache, size_t* loaded) {
-  for (auto it = cache->begin(); it != cache->end();) {
-    it = std::binary_search(cluster.begin(), cluster.end(), it->first) ? std::next(it) : cache->erase(it);
-  }
   std::vector<int> missing;
   for (int id : cluster) {
     if (cache->count(id) == 0) missing.push_back(id);
@@ -259,13 +283,26 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   patchmatch_options.show_progress = options.show_progress;
   ThreadPool pool(num_threads);
   std::map<int, std::unique_ptr<DenseView>> cache;
+  // Views kept between clusters take at most half of what the budget leaves beside one cluster's
+  // estimate (the merged points grow meanwhile).
+  const size_t spare_bytes =
+      options.memory_budget_bytes > report.estimated_bytes ? (options.memory_budget_bytes - report.estimated_bytes) / 2 : 0;
+  std::vector<std::vector<int>> running_clusters;  // sorted ids, for KeepViewsForLaterClusters
+  for (const std::vector<int>& cluster : clustering.clusters) {
+    if (static_cast<int>(cluster.size()) < min_views) continue;
+    running_clusters.push_back(cluster);
+    report.views_in_clusters += cluster.size();
+    std::sort(running_clusters.back().begin(), running_clusters.back().end());
+  }
   std::vector<MergeInput> parts;
+  size_t running = 0;
   for (size_t c = 0; c < clustering.clusters.size(); ++c) {
     const std::vector<int>& cluster = clustering.clusters[c];
     if (static_cast<int>(cluster.size()) < min_views) {
       ++report.clusters_without_points;
       continue;
     }
+    KeepViewsForLaterClusters(running_clusters, running++, spare_bytes, &cache);
     // Progress: one line per phase of each cluster, "dense: cluster 2/4: undistort 5 views: ...".
     const std::string cluster_label =
         "dense: cluster " + std::to_string(c + 1) + "/" + std::to_string(clustering.clusters.size()) + ": ";
@@ -387,6 +424,7 @@ std::string DenseReportJson(const DenseStageReport& report) {
   json.Key("clusters_from_camera_geometry").Bool(report.clusters_from_cameras);
   json.Key("sparse_points_covered").Double(report.sparse_points_covered);
   json.Key("views_undistorted").Int(static_cast<long long>(report.views_undistorted));
+  json.Key("views_in_clusters").Int(static_cast<long long>(report.views_in_clusters));
   json.Key("points_before_merge").Int(static_cast<long long>(report.points_before_merge));
   json.Key("outliers").BeginObject();
   json.Key("isolated_removed").Int(static_cast<long long>(report.outliers.isolated_removed));

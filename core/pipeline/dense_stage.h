@@ -71,7 +71,8 @@ struct DenseStageReport {
   int clusters_without_points = 0;  // too small for the method, or no point survived
   bool clusters_from_cameras = false;
   double sparse_points_covered = 0.0;  // fraction, see ViewClustering::covered_fraction
-  size_t views_undistorted = 0;   // counting views reused by consecutive clusters once
+  size_t views_undistorted = 0;   // photos decoded and undistorted: each once while the budget keeps them
+  size_t views_in_clusters = 0;   // the clusters' sizes summed (a photo in two clusters counts twice)
   size_t points_before_merge = 0;
   OutlierFilterReport outliers;   // all zero when the filter is off
   size_t points = 0;

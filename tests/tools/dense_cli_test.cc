@@ -7,9 +7,11 @@
 //    similarity of the camera centres.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <string>
 
+#include "core/base/json_reader.h"
 #include "core/mesh/mesh_io.h"
 #include "core/sfm/model_io.h"
 #include "tests/dense/middlebury_import.h"
@@ -98,6 +100,25 @@ TEST(DenseCli, TempleWithGroundTruthCamerasLiesInTheObjectBox) {
   EXPECT_GT(score.points, 10000u);
   EXPECT_GT(score.inside, 0.9);
   EXPECT_TRUE(fs::exists(dir + "/dense/report.json"));
+}
+
+// Clusters of at most 4 of the 16 views overlap; each photo is still decoded and undistorted once
+// (the default budget keeps a view until the last cluster that needs it), and the points are
+// those of a run that decodes every cluster's views afresh (the same views either way).
+TEST(DenseCli, APhotoInSeveralClustersIsDecodedOnce) {
+  const std::string dir = testing::MakeTestDirectory("dense_cli_temple_clusters");
+  auto imported = testing::ImportMiddleburyProject(Temple() + "/templeSR_par.txt", dir);
+  ASSERT_TRUE(imported.ok()) << imported.status().ToString();
+  const CommandRun run = RunReconar("dense " + dir + " --level 2 --method pmvs --max-cluster-size 4 --threads 2");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  auto report = ReadJsonFile(dir + "/dense/report.json");
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  const auto count = [&](const char* key) { return static_cast<int>(*report->Find(key)->AsInteger()); };
+  std::printf("%d clusters of %d views in all, %d photos kept, %d decoded and undistorted\n", count("clusters"),
+              count("views_in_clusters"), count("kept_images"), count("views_undistorted"));
+  EXPECT_GT(count("clusters"), 1);
+  EXPECT_GT(count("views_in_clusters"), count("kept_images")) << "the clusters do not overlap: nothing is tested";
+  EXPECT_EQ(count("views_undistorted"), count("kept_images"));
 }
 
 TEST(DenseCli, TempleThroughSfmLiesInTheObjectBox) {
