@@ -92,14 +92,13 @@ std::string ArFrameText(const ArSession& session) {
   return line + text;
 }
 
-std::string PoseSourceCounts(const long (&frames_by_source)[4]) {
-  char text[160];
-  std::snprintf(text, sizeof(text), "posed by tags+map %ld, tags %ld, map %ld; not posed %ld",
-                frames_by_source[static_cast<int>(PoseSourceKind::kTagsAndMap)],
-                frames_by_source[static_cast<int>(PoseSourceKind::kTags)],
-                frames_by_source[static_cast<int>(PoseSourceKind::kMap)],
-                frames_by_source[static_cast<int>(PoseSourceKind::kNone)]);
-  return text;
+std::string PoseSourceSummary(const PoseSourceCounts& frames_by_source) {
+  std::string text = "posed by";
+  for (size_t kind = 1; kind < frames_by_source.size(); ++kind) {
+    text += std::string(kind > 1 ? ", " : " ") + PoseSourceKindName(static_cast<PoseSourceKind>(kind)) + " " +
+            std::to_string(frames_by_source[kind]);
+  }
+  return text + "; not posed " + std::to_string(frames_by_source[static_cast<size_t>(PoseSourceKind::kNone)]);
 }
 
 }  // namespace reconar::tools

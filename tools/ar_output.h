@@ -16,7 +16,7 @@ std::string ArFrameJson(const ArSession& session);
 // "NAME: N tag(s)  id .. at (x, y, z) m, e px ...  [map: STATE, N inliers; pose: SOURCE[, model units]]
 //  [SEARCH + N predicted (M found), T ms]"
 std::string ArFrameText(const ArSession& session);
-// "posed by tags+map A, tags B, map C; not posed D" from frame counts indexed by PoseSourceKind.
-std::string PoseSourceCounts(const long (&frames_by_source)[4]);
+// "posed by tags+map A, tags B, map C; not posed D": every kind that poses, in PoseSourceKind's order.
+std::string PoseSourceSummary(const PoseSourceCounts& frames_by_source);
 
 }  // namespace reconar::tools

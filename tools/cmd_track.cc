@@ -97,7 +97,7 @@ int RunTrack(int argc, char** argv, int first) {
                  r.predicted_found, r.predicted_searched);
   }
   if (options.map) {
-    std::fprintf(stderr, "reconar track: %s%s\n", PoseSourceCounts(r.frames_by_source).c_str(),
+    std::fprintf(stderr, "reconar track: %s%s\n", PoseSourceSummary(r.frames_by_source).c_str(),
                  (*session)->metric() ? "" : "; poses in model units");
   }
   return 0;

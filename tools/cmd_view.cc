@@ -181,7 +181,7 @@ int RunView(int argc, char** argv, int first) {
                report->session.median_track_ms, report->median_render_ms, report->median_frame_ms,
                to_files ? " (render includes the readback)" : "");
   if (session.map) {
-    std::fprintf(stderr, "reconar view: %s%s\n", PoseSourceCounts(report->session.frames_by_source).c_str(),
+    std::fprintf(stderr, "reconar view: %s%s\n", PoseSourceSummary(report->session.frames_by_source).c_str(),
                  session.map->metric ? "" : "; poses in model units");
   }
   if (to_files) {

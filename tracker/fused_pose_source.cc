@@ -18,6 +18,8 @@ const char* PoseSourceKindName(PoseSourceKind kind) {
       return "map";
     case PoseSourceKind::kTagsAndMap:
       return "tags+map";
+    case PoseSourceKind::kCount:
+      break;
   }
   return "unknown";
 }

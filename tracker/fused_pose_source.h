@@ -18,6 +18,7 @@
 // (every buffer is sized at construction; the tag and map trackers give the same guarantee for
 // their tracked frames; a relocalisation allocates).
 #include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -47,9 +48,11 @@ struct FusedPoseSourceOptions {
   Status Check() const;
 };
 
-// Which sources posed a frame.
-enum class PoseSourceKind { kNone, kTags, kMap, kTagsAndMap };
-const char* PoseSourceKindName(PoseSourceKind kind);  // "none", "tags", "map", "tags+map"
+// Which sources posed a frame; reports list them in this order. kCount is no kind: their number.
+enum class PoseSourceKind { kNone, kTagsAndMap, kTags, kMap, kCount };
+const char* PoseSourceKindName(PoseSourceKind kind);  // "none", "tags+map", "tags", "map"
+// Frame counts indexed by PoseSourceKind.
+using PoseSourceCounts = std::array<long, static_cast<size_t>(PoseSourceKind::kCount)>;
 
 class FusedPoseSource final : public PoseSource {
  public:

@@ -77,7 +77,7 @@ Result<ArSessionReport> ArSession::Run(const std::function<Result<bool>(const Ar
       report.predicted_found += tag_report.predicted_found;
       report.predicted_searched += tag_report.predicted_searched;
     }
-    ++report.frames_by_source[static_cast<int>(sources().source())];
+    ++report.frames_by_source[static_cast<size_t>(sources().source())];
     track_ms.push_back(pose_.track_ms);
     RECONAR_ASSIGN_OR_RETURN(const bool go_on, each_frame(*this));
     if (!go_on) break;

@@ -61,8 +61,7 @@ struct ArSessionReport {
   long tag_instances = 0;
   long predicted_found = 0;
   long predicted_searched = 0;
-  // Frames by the source of their pose (FusedPoseSource): indexed by PoseSourceKind.
-  long frames_by_source[4] = {0, 0, 0, 0};
+  PoseSourceCounts frames_by_source{};  // frames by the source of their pose (FusedPoseSource)
   // Tracking time per frame (WorldPose::track_ms), milliseconds.
   double mean_track_ms = 0.0;
   double median_track_ms = 0.0;  // the upper median

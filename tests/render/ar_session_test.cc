@@ -110,7 +110,7 @@ TEST(ArSessionTest, RunHandsEveryFrameOverAndCountsWhatItSaw) {
   EXPECT_EQ(report->frames, kFrames);
   EXPECT_EQ(report->frames_with_tags, kFrames);
   EXPECT_EQ(report->tag_instances, kFrames);
-  EXPECT_EQ(report->frames_by_source[static_cast<int>(PoseSourceKind::kTags)], kFrames);
+  EXPECT_EQ(report->frames_by_source[static_cast<size_t>(PoseSourceKind::kTags)], kFrames);
   EXPECT_GT(report->max_track_ms, 0.0);
   EXPECT_LE(report->median_track_ms, report->max_track_ms);
   EXPECT_LE(report->mean_track_ms, report->max_track_ms);
