@@ -61,6 +61,15 @@ void ExpectUnitNormalsAndColours(const Mesh& cloud) {
   for (const Eigen::Vector3f& n : cloud.normals) ASSERT_NEAR(n.norm(), 1.0f, 1e-3f);
 }
 
+// The temple's photos with their true cameras as a project in a fresh directory; "" when the import
+// failed (a test failure).
+std::string TempleWithTrueCameras(const std::string& prefix) {
+  const std::string dir = testing::MakeTestDirectory(prefix);
+  auto imported = testing::ImportMiddleburyProject(Temple() + "/templeSR_par.txt", dir);
+  EXPECT_TRUE(imported.ok()) << imported.status().ToString();
+  return imported.ok() ? dir : "";
+}
+
 TEST(DenseCli, BadUsageExitsTwoWithAReason) {
   CommandRun run = RunReconar("dense /nonexistent/reconar_project");
   EXPECT_EQ(run.exit_code, 2) << run.output;
@@ -80,9 +89,8 @@ TEST(DenseCli, BadUsageExitsTwoWithAReason) {
 }
 
 TEST(DenseCli, TempleWithGroundTruthCamerasLiesInTheObjectBox) {
-  const std::string dir = testing::MakeTestDirectory("dense_cli_temple_gt");
-  auto imported = testing::ImportMiddleburyProject(Temple() + "/templeSR_par.txt", dir);
-  ASSERT_TRUE(imported.ok()) << imported.status().ToString();
+  const std::string dir = TempleWithTrueCameras("dense_cli_temple_gt");
+  ASSERT_FALSE(dir.empty());
 
   const CommandRun run = RunReconar("dense " + dir + " --level 1 --threads 2");
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -103,12 +111,10 @@ TEST(DenseCli, TempleWithGroundTruthCamerasLiesInTheObjectBox) {
 }
 
 // Clusters of at most 4 of the 16 views overlap; each photo is still decoded and undistorted once
-// (the default budget keeps a view until the last cluster that needs it), and the points are
-// those of a run that decodes every cluster's views afresh (the same views either way).
+// (the default budget keeps a view until the last cluster that needs it).
 TEST(DenseCli, APhotoInSeveralClustersIsDecodedOnce) {
-  const std::string dir = testing::MakeTestDirectory("dense_cli_temple_clusters");
-  auto imported = testing::ImportMiddleburyProject(Temple() + "/templeSR_par.txt", dir);
-  ASSERT_TRUE(imported.ok()) << imported.status().ToString();
+  const std::string dir = TempleWithTrueCameras("dense_cli_temple_clusters");
+  ASSERT_FALSE(dir.empty());
   const CommandRun run = RunReconar("dense " + dir + " --level 2 --method pmvs --max-cluster-size 4 --threads 2");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   auto report = ReadJsonFile(dir + "/dense/report.json");

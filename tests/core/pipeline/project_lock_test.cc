@@ -15,27 +15,30 @@
 namespace reconar {
 namespace {
 
-// A child process that takes the lock, writes one byte to `ready`, then sleeps until killed or
-// for `hold_seconds`.
-pid_t HoldInChild(const std::string& root, double hold_seconds, int ready) {
+// A child process that holds the lock for `hold_seconds` (or until killed); returns its pid once
+// it holds it, -1 when it could not take it.
+pid_t HoldInChild(const std::string& root, double hold_seconds) {
+  int ready[2];
+  if (::pipe(ready) != 0) return -1;
   const pid_t pid = ::fork();
-  if (pid != 0) return pid;
-  Result<ProjectLock> lock = ProjectLock::Acquire(root);
-  const char byte = lock.ok() ? 1 : 0;
-  if (::write(ready, &byte, 1) != 1) ::_exit(2);
-  ::usleep(static_cast<useconds_t>(hold_seconds * 1e6));
-  ::_exit(0);
+  if (pid == 0) {
+    Result<ProjectLock> lock = ProjectLock::Acquire(root);
+    const char byte = lock.ok() ? 1 : 0;
+    if (::write(ready[1], &byte, 1) != 1) ::_exit(2);
+    ::usleep(static_cast<useconds_t>(hold_seconds * 1e6));
+    ::_exit(0);
+  }
+  char byte = 0;
+  const bool held = pid > 0 && ::read(ready[0], &byte, 1) == 1 && byte == 1;
+  ::close(ready[0]);
+  ::close(ready[1]);
+  return held ? pid : -1;
 }
 
 TEST(ProjectLock, ASecondProcessWaitsForTheFirstToFinish) {
   const std::string root = testing::MakeTestDirectory("project_lock_wait");
-  int pipe_fds[2];
-  ASSERT_EQ(::pipe(pipe_fds), 0);
-  const pid_t child = HoldInChild(root, 0.5, pipe_fds[1]);
-  ASSERT_GT(child, 0);
-  char byte = 0;
-  ASSERT_EQ(::read(pipe_fds[0], &byte, 1), 1);
-  ASSERT_EQ(byte, 1) << "the child could not take the lock";
+  const pid_t child = HoldInChild(root, 0.5);
+  ASSERT_GT(child, 0) << "the child could not take the lock";
   int waits = 0;
   const auto start = std::chrono::steady_clock::now();
   Result<ProjectLock> lock = ProjectLock::Acquire(root, [&] { ++waits; });
@@ -45,19 +48,12 @@ TEST(ProjectLock, ASecondProcessWaitsForTheFirstToFinish) {
   EXPECT_GT(waited, 0.2);
   int status = 0;
   ::waitpid(child, &status, 0);
-  ::close(pipe_fds[0]);
-  ::close(pipe_fds[1]);
 }
 
 TEST(ProjectLock, AKilledHolderLeavesNoStaleLock) {
   const std::string root = testing::MakeTestDirectory("project_lock_killed");
-  int pipe_fds[2];
-  ASSERT_EQ(::pipe(pipe_fds), 0);
-  const pid_t child = HoldInChild(root, 60.0, pipe_fds[1]);
-  ASSERT_GT(child, 0);
-  char byte = 0;
-  ASSERT_EQ(::read(pipe_fds[0], &byte, 1), 1);
-  ASSERT_EQ(byte, 1);
+  const pid_t child = HoldInChild(root, 60.0);
+  ASSERT_GT(child, 0) << "the child could not take the lock";
   ::kill(child, SIGKILL);
   int status = 0;
   ::waitpid(child, &status, 0);
@@ -65,8 +61,6 @@ TEST(ProjectLock, AKilledHolderLeavesNoStaleLock) {
   Result<ProjectLock> lock = ProjectLock::Acquire(root, [&] { ++waits; });
   ASSERT_TRUE(lock.ok()) << lock.status().ToString();
   EXPECT_EQ(waits, 0);
-  ::close(pipe_fds[0]);
-  ::close(pipe_fds[1]);
 }
 
 // A child forked before the lock is taken (a fork shares the parent's open lock), told by `go` when
