@@ -1,5 +1,5 @@
-// Markerless relocalisation in a real room (issue 15): the swatbotics room (data/swatbotics_room,
-// README.txt there), whose white walls leave little texture. A map from every other photo in name
+// Markerless relocalisation in a real room (issue 15): the swatbotics room
+// (../shared/data/apriltag_swatbotics_mapping, SOURCE.txt there), whose white walls leave little texture. A map from every other photo in name
 // order (the 1st, 3rd, ...) built with its AprilTags (`reconar sfm --tag-size 0.127`: metres in
 // the world tag's frame); the other 36 photos localised with every tag painted out
 // (tests/support/tag_paint.h). Reference: the poses of the full 72-photo reconstruction, in the
@@ -109,7 +109,9 @@ Result<ProjectTags> ReadProjectTags(const std::string& path) {
 }
 
 TEST(LocalizeRoom, PaintedOutTagsAgainstAMapOfEveryOtherPhoto) {
-  const std::string data = std::string(RECONAR_SOURCE_DIR) + "/data/swatbotics_room";
+  // The dataset as ReconstructCli.SwatboticsRoom reads it: the shared project reuses its stages only
+  // for the same photo paths.
+  const std::string data = testing::SharedDataPath("apriltag_swatbotics_mapping");
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(data)) {
     if (entry.path().extension() == ".JPG") names.push_back(entry.path().filename().string());
