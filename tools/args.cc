@@ -95,6 +95,24 @@ Result<size_t> Args::GetMemoryBudget(size_t fallback) const {
 
 Result<int> Args::GetThreads() const { return GetInt("threads", 0, 0, 1024); }
 
+Result<std::vector<int>> Args::GetIdList(const std::string& name) const {
+  std::set<int> ids;
+  for (const std::string& part : SplitCommas(Get(name))) {
+    const size_t dash = part.find('-', 1);
+    const std::string first = part.substr(0, dash), last = dash == std::string::npos ? first : part.substr(dash + 1);
+    char* end_first = nullptr;
+    char* end_last = nullptr;
+    const long from = std::strtol(first.c_str(), &end_first, 10);
+    const long to = std::strtol(last.c_str(), &end_last, 10);
+    if (first.empty() || last.empty() || *end_first != '\0' || *end_last != '\0' || from < 0 || to < from ||
+        to > (1 << 20)) {
+      return InvalidArgument("--" + name + ": '" + part + "' is not an id or a range of ids (e.g. 0-9,12)");
+    }
+    for (long id = from; id <= to; ++id) ids.insert(static_cast<int>(id));
+  }
+  return std::vector<int>(ids.begin(), ids.end());
+}
+
 std::vector<std::string> SplitCommas(const std::string& text) {
   std::vector<std::string> parts;
   size_t start = 0;

@@ -35,6 +35,9 @@ class Args {
   Result<size_t> GetMemoryBudget(size_t fallback) const;
   // --threads: 0 (one per core) when absent.
   Result<int> GetThreads() const;
+  // A list of ids and ranges, "0-9,12": the ids in increasing order, each once; empty when absent.
+  // InvalidArgument naming the option for anything else.
+  Result<std::vector<int>> GetIdList(const std::string& name) const;
 
  private:
   std::set<std::string> valued_, flags_;

@@ -21,7 +21,7 @@ std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
   valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
   valued.insert(kDenseValuedOptions.begin(), kDenseValuedOptions.end());
-  valued.insert({"tag-size", "tag-family", "world-tag", "memory-budget", "stages", "depth", "trim", "max-faces",
+  valued.insert({"tag-size", "tag-family", "world-tag", "scale-tags", "memory-budget", "stages", "depth", "trim", "max-faces",
                  "formats", "principal-point", "max-error"});
   return valued;
 }
@@ -108,6 +108,10 @@ Result<ReconstructOptions> ReconstructOptionsFromArgs(const Args& args) {
   if (args.Has("tag-size") && !(options.tag_size_m > 0.0)) return InvalidArgument("--tag-size must be positive");
   RECONAR_ASSIGN_OR_RETURN(options.sfm.tags.registration.world_tag, args.GetInt("world-tag", -1, -1, 1 << 20));
   options.sfm.tags.in_adjustment = !args.Has("no-tags-in-ba");
+  RECONAR_ASSIGN_OR_RETURN(options.sfm.tags.registration.scale_tags, args.GetIdList("scale-tags"));
+  if (!options.sfm.tags.registration.scale_tags.empty() && !args.Has("tag-size")) {
+    return InvalidArgument("--scale-tags needs --tag-size");
+  }
   RECONAR_ASSIGN_OR_RETURN(options.num_threads, args.GetThreads());
   RECONAR_ASSIGN_OR_RETURN(options.memory_budget_bytes, args.GetMemoryBudget(options.memory_budget_bytes));
   RECONAR_RETURN_IF_ERROR(ReadDenseAndMeshArgs(args, &options));

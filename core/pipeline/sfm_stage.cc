@@ -167,7 +167,12 @@ std::string SfmStageSettings(const SfmStageOptions& options) {
                              {"tags_in_ba", options.tags.in_adjustment ? 1.0 : 0.0}});
   // Tag projects map differently since images register by their known tags and the world tag is
   // fitted as a square (version 2): their recorded mapping is not reused. Others are unchanged.
-  if (with_tags) settings += " " + StageRecord::Settings({{"tag_mapping", 2.0}});
+  if (with_tags) {
+    settings += " " + StageRecord::Settings({{"tag_mapping", 2.0}});
+    std::string ids;
+    for (int id : options.tags.registration.scale_tags) ids += (ids.empty() ? "" : ",") + std::to_string(id);
+    if (!ids.empty()) settings += " scale_tags=" + ids;
+  }
   return settings;
 }
 

@@ -296,14 +296,26 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
     return report;
   }
 
-  // Scale from every complete tag's mean edge; frame from the world tag.
+  // Scale from the scale tags' mean edge.
+  const auto sets_scale = [&](int id) {
+    return options.scale_tags.empty() ||
+           std::find(options.scale_tags.begin(), options.scale_tags.end(), id) != options.scale_tags.end();
+  };
   double mean_edge = 0.0;
   for (const ModelTag& tag : complete) {
+    if (!sets_scale(tag.id)) continue;
+    report.scale_tags.push_back(tag.id);
     for (int k = 0; k < 4; ++k) {
       mean_edge += (tag.corners[static_cast<size_t>((k + 1) % 4)] - tag.corners[static_cast<size_t>(k)]).norm() / 4.0;
     }
   }
-  mean_edge /= static_cast<double>(complete.size());
+  if (report.scale_tags.empty()) {
+    std::string ids;
+    for (const ModelTag& tag : complete) ids += (ids.empty() ? "" : ", ") + std::to_string(tag.id);
+    report.reason = "none of the scale tags was reconstructed with all four corners; complete tags: " + ids;
+    return report;
+  }
+  mean_edge /= static_cast<double>(report.scale_tags.size());
   if (!(mean_edge > 0.0)) return FailedPrecondition("tag registration: the tags' corners coincide");
   const auto world = std::find_if(complete.begin(), complete.end(), [&](const ModelTag& tag) {
     return options.world_tag < 0 || tag.id == options.world_tag;
@@ -319,11 +331,19 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
                            AlignSimilarity(AsVector(RigidTagCorners(*rec, seen.at(world->id), world->corners, mean_edge,
                                                                     options.max_reprojection_error_px)),
                                            AsVector(IdealCorners(options.tag_size_m)), report.metres_per_model_unit));
+  const auto world_from_tag = [&](const std::array<Eigen::Vector3d, 4>& model_corners) -> std::optional<Rigid3> {
+    std::vector<Eigen::Vector3d> corners;
+    for (const Eigen::Vector3d& c : model_corners) corners.push_back(report.world_from_model.Apply(c));
+    auto fit = AlignSimilarity(AsVector(IdealCorners(options.tag_size_m)), corners, 1.0);
+    if (!fit.ok()) return std::nullopt;
+    return Rigid3{fit->rotation, fit->translation};
+  };
   ApplyToModel(report.world_from_model, rec);
   report.metric = true;
   report.world_tag = world->id;
 
-  std::vector<double> edges;
+  std::vector<double> edges, held_out;
+  const double scale_sum = options.tag_size_m * 4.0 * static_cast<double>(report.scale_tags.size());
   for (const ModelTag& model_tag : complete) {
     RegisteredTag tag;
     tag.id = model_tag.id;
@@ -344,21 +364,22 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
       }
     }
     tag.rms_reprojection_px = count > 0 ? std::sqrt(squares / count) : 0.0;
-    auto fit = AlignSimilarity(AsVector(IdealCorners(options.tag_size_m)), AsVector(tag.corners), 1.0);
-    if (fit.ok()) tag.world_from_tag = Rigid3{fit->rotation, fit->translation};
+    if (const std::optional<Rigid3> pose = world_from_tag(model_tag.corners)) tag.world_from_tag = *pose;
+    // Held out: a scale tag at the scale of the other scale tags, whose edges sum to scale_sum less
+    // its own; a tag that did not set the scale as it stands.
+    const double own = tag.edges_m[0] + tag.edges_m[1] + tag.edges_m[2] + tag.edges_m[3];
+    if (!sets_scale(tag.id)) {
+      for (double e : tag.edges_m) held_out.push_back(e);
+    } else if (report.scale_tags.size() >= 2) {
+      const double rescale =
+          options.tag_size_m * 4.0 * static_cast<double>(report.scale_tags.size() - 1) / (scale_sum - own);
+      for (double e : tag.edges_m) held_out.push_back(e * rescale);
+    }
     report.tags.push_back(tag);
   }
   EdgeFigures(edges, options.tag_size_m, &report.edge_mean_m, &report.edge_std_m, &report.edge_max_abs_error_m);
-  if (report.tags.size() >= 2) {
-    // Edges were scaled so that all of them average tag_size_m; at the scale of the other tags
-    // alone, a tag's edges are multiplied by (sum of all edges - its own) / (tag_size_m * (edges - 4)).
-    const double sum_all = options.tag_size_m * static_cast<double>(edges.size());
-    std::vector<double> held_out;
-    for (const RegisteredTag& tag : report.tags) {
-      const double own = tag.edges_m[0] + tag.edges_m[1] + tag.edges_m[2] + tag.edges_m[3];
-      const double rescale = options.tag_size_m * static_cast<double>(edges.size() - 4) / (sum_all - own);
-      for (double e : tag.edges_m) held_out.push_back(e * rescale);
-    }
+  report.held_out_edges = static_cast<int>(held_out.size());
+  if (!held_out.empty()) {
     EdgeFigures(held_out, options.tag_size_m, &report.held_out_edge_mean_m, &report.held_out_edge_std_m,
                 &report.held_out_edge_max_abs_error_m);
   }
@@ -375,10 +396,14 @@ std::string TagRegistrationJson(const TagRegistrationReport& report, const std::
   json.Key("world_tag").Int(report.world_tag);
   json.Key("tags_seen").Int(report.tags_seen);
   json.Key("metres_per_model_unit").Double(report.metres_per_model_unit);
+  json.Key("scale_tags").BeginArray();
+  for (int id : report.scale_tags) json.Int(id);
+  json.EndArray();
   json.Key("edge_mean_m").Double(report.edge_mean_m);
   json.Key("edge_std_m").Double(report.edge_std_m);
   json.Key("edge_max_abs_error_m").Double(report.edge_max_abs_error_m);
-  if (report.tags.size() >= 2) {
+  json.Key("held_out_edges").Int(report.held_out_edges);
+  if (report.held_out_edges > 0) {
     json.Key("held_out_edge_mean_m").Double(report.held_out_edge_mean_m);
     json.Key("held_out_edge_std_m").Double(report.held_out_edge_std_m);
     json.Key("held_out_edge_max_abs_error_m").Double(report.held_out_edge_max_abs_error_m);

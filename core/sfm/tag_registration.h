@@ -9,14 +9,15 @@
 //
 // RegisterToTags then finds each tag's four corners in the model (the adjusted track, or a
 // triangulation from the registered views when the mapper kept none), takes the scale from the
-// mean edge of all complete tags, and moves the model into the frame of the world tag (tag frame:
-// origin at its centre, x right, y up, z out of the printed tag; metres): world_from_model is the
-// similarity with that scale whose rotation and translation fit the world tag's corners to their
-// ideal places (Umeyama with fixed scale). Those corners are the world tag as a rigid square of
-// that edge whose pose best reprojects into every registered view of it (its four corner points
-// only start the fit and stay when the square does not fit within max_reprojection_error_px rms):
-// four corners triangulated each on its own tilt the frame by their depth errors, which the
-// cameras metres away turn into centimetres.
+// mean edge of the scale tags (every complete tag unless scale_tags names some: the others then
+// check it), and moves the model into the frame of the world tag (tag frame: origin at its
+// centre, x right, y up, z out of the printed tag; metres): world_from_model is the similarity
+// with that scale whose rotation and translation fit the world tag's corners to their ideal places
+// (Umeyama with fixed scale). Those corners are the world tag as a rigid square of that edge whose
+// pose best reprojects into every registered view of it (its four corner points only start the
+// fit and stay when the square does not fit within max_reprojection_error_px rms): four corners
+// triangulated each on its own tilt the frame by their depth errors, which the cameras metres away
+// turn into centimetres.
 #include <array>
 #include <string>
 #include <vector>
@@ -56,6 +57,7 @@ std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vect
 struct TagRegistrationOptions {
   double tag_size_m = 0.0;                 // edge of the black square (libapriltag's width_at_border), > 0
   int world_tag = -1;                      // the tag whose frame becomes the world frame; -1: the lowest complete id
+  std::vector<int> scale_tags;             // the tags whose size sets the scale; empty: every complete tag
   int min_views = 2;                       // registered views a corner needs to be triangulated
   double max_reprojection_error_px = 4.0;  // a triangulated corner's observations beyond this are dropped
 
@@ -80,11 +82,14 @@ struct TagRegistrationReport {
   int world_tag = -1;
   int tags_seen = 0;                 // distinct ids detected in registered images
   double metres_per_model_unit = 0;  // the scale applied
+  std::vector<int> scale_tags;       // the complete tags that set it
   Sim3 world_from_model;
   std::vector<RegisteredTag> tags;                                         // complete tags, by id
   double edge_mean_m = 0.0, edge_std_m = 0.0, edge_max_abs_error_m = 0.0;  // over all edges of all tags
-  // The same with each tag measured at the scale of the other tags only, so that no tag checks the
-  // scale it helped set (the mean above equals the tag size by construction). Two tags or more.
+  // The same with each tag measured at a scale it did not help set: a scale tag at the scale of
+  // the other scale tags, any other tag at the scale tags' (the mean above over the scale tags
+  // equals the tag size by construction). Zero held_out_edges when no tag can be held out.
+  int held_out_edges = 0;
   double held_out_edge_mean_m = 0.0, held_out_edge_std_m = 0.0, held_out_edge_max_abs_error_m = 0.0;
 };
 
@@ -97,8 +102,8 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
                                              const TagRegistrationOptions& options, Reconstruction* rec);
 
 // PROJECT/tags.json: {"metric", "reason", "family", "tag_size_m", "world_tag", "tags_seen",
-// "metres_per_model_unit", "edge_mean_m", "edge_std_m", "edge_max_abs_error_m", "held_out_edge_mean_m",
-// "held_out_edge_std_m", "held_out_edge_max_abs_error_m" (with two tags or more), "tags": [{"id",
+// "metres_per_model_unit", "scale_tags": [ids], "edge_mean_m", "edge_std_m", "edge_max_abs_error_m", "held_out_edges", "held_out_edge_mean_m",
+// "held_out_edge_std_m", "held_out_edge_max_abs_error_m" (when an edge is held out), "tags": [{"id",
 // "views", "adjusted", "corners": [[x, y, z] x 4] (metres, world frame), "edges_m": [4],
 // "rms_reprojection_px", "world_from_tag": {"R": [9, row-major], "t": [3]}}]}.
 std::string TagRegistrationJson(const TagRegistrationReport& report, const std::string& family, double tag_size_m);

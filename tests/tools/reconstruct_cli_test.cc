@@ -144,6 +144,12 @@ TEST(ReconstructCli, PhotosWithoutTagsKeepAnArbitraryScaleAndSaySo) {
   EXPECT_NE(one.output.find("at least 2 photos"), std::string::npos) << one.output;
   const CommandRun bad = RunReconar("reconstruct " + data + " " + project + " --memory-budget 12Q");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  const CommandRun bad_range = RunReconar("reconstruct " + data + " " + project + " --tag-size 0.1 --scale-tags 0-3,9-7");
+  EXPECT_EQ(bad_range.exit_code, 2) << bad_range.output;
+  EXPECT_NE(bad_range.output.find("--scale-tags: '9-7'"), std::string::npos) << bad_range.output;
+  const CommandRun no_size = RunReconar("reconstruct " + data + " " + project + " --scale-tags 1");
+  EXPECT_EQ(no_size.exit_code, 2) << no_size.output;
+  EXPECT_NE(no_size.output.find("--scale-tags needs --tag-size"), std::string::npos) << no_size.output;
 }
 
 // `sfm` is `reconstruct --stages sparse`: either command continues a project the other started,

@@ -172,6 +172,32 @@ TEST(TagRegistrationTest, HeldOutEdgesMeasureEachTagAtTheOtherTagsScale) {
               std::sqrt((2 * (small - mean) * (small - mean) + (large - mean) * (large - mean)) / 3), 1e-7);
 }
 
+// --scale-tags: tags 0 and 1 (exact) set the scale, tag 2 (printed 3 % large) is registered all the
+// same and measured at their scale; a list of tags that were not reconstructed is no scale.
+TEST(TagRegistrationTest, ScaleTagsSetTheScaleAndTheOthersCheckIt) {
+  Scene scene = MakeScene(1.03);
+  TagRegistrationOptions options;
+  options.tag_size_m = kTagSize;
+  options.scale_tags = {0, 1};
+  auto report = RegisterToTags(scene.observations, {}, options, &scene.model);
+  ASSERT_TRUE(report.ok() && report->metric);
+  EXPECT_EQ(report->scale_tags, (std::vector<int>{0, 1}));
+  EXPECT_NEAR(report->metres_per_model_unit, 1.0 / 3.7, 1e-9);
+  ASSERT_EQ(report->tags.size(), 3u);
+  for (double edge : report->tags[2].edges_m) EXPECT_NEAR(edge, 1.03 * kTagSize, 1e-7);
+  // Held out: tags 0 and 1 at each other's scale (exact), tag 2 as measured.
+  EXPECT_EQ(report->held_out_edges, 12);
+  EXPECT_NEAR(report->held_out_edge_max_abs_error_m, 0.03 * kTagSize, 1e-7);
+  EXPECT_NEAR(report->held_out_edge_mean_m, (2 + 1.03) / 3 * kTagSize, 1e-7);
+
+  Scene other = MakeScene();
+  options.scale_tags = {5, 6};
+  auto none = RegisterToTags(other.observations, {}, options, &other.model);
+  ASSERT_TRUE(none.ok()) << none.status().ToString();
+  EXPECT_FALSE(none->metric);
+  EXPECT_NE(none->reason.find("scale tags"), std::string::npos) << none->reason;
+}
+
 TEST(TagRegistrationTest, AnyCompleteTagCanBeTheWorldAndOthersAreRefused) {
   Scene scene = MakeScene();
   TagRegistrationOptions options;
