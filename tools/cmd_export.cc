@@ -34,9 +34,6 @@ int RunExport(int argc, char** argv, int first) {
   const std::string& output = args.positionals()[1];
   MeshConversionOptions options;
   options.file.ply_ascii = args.Has("ascii");
-  if (options.file.ply_ascii && MeshFileFormatOf(output).ok() && *MeshFileFormatOf(output) != MeshFileFormat::kPly) {
-    return Fail(InvalidArgument(output + ": --ascii applies only to .ply output"));
-  }
   auto max_faces = args.GetInt("max-faces", 0, 0, 1 << 30);
   if (!max_faces.ok()) return Fail(max_faces.status());
   options.max_faces = static_cast<size_t>(*max_faces);

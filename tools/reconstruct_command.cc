@@ -21,8 +21,8 @@ std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
   valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
   valued.insert(kDenseValuedOptions.begin(), kDenseValuedOptions.end());
-  valued.insert({"tag-size", "tag-family", "world-tag", "scale-tags", "memory-budget", "stages", "depth", "trim", "max-faces",
-                 "formats", "principal-point", "max-error"});
+  valued.insert({"tag-size", "tag-family", "world-tag", "scale-tags", "memory-budget", "stages", "depth", "trim",
+                 "max-faces", "formats", "principal-point", "max-error"});
   return valued;
 }
 

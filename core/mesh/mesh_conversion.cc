@@ -19,7 +19,7 @@ Result<MeshConversionReport> ConvertMeshFile(const std::string& input, const std
   RECONAR_RETURN_IF_ERROR(ReadableMeshFileFormatOf(input).status());
   RECONAR_ASSIGN_OR_RETURN(const MeshFileFormat output_format, MeshFileFormatOf(output));
   if (options.file.ply_ascii && output_format != MeshFileFormat::kPly) {
-    return InvalidArgument(output + ": ASCII output applies only to .ply files");
+    return InvalidArgument(output + ": --ascii applies only to .ply output");
   }
   MeshConversionReport report;
   const auto start = std::chrono::steady_clock::now();

@@ -309,10 +309,13 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
       mean_edge += (tag.corners[static_cast<size_t>((k + 1) % 4)] - tag.corners[static_cast<size_t>(k)]).norm() / 4.0;
     }
   }
-  if (report.scale_tags.empty()) {
+  const auto complete_ids = [&] {
     std::string ids;
     for (const ModelTag& tag : complete) ids += (ids.empty() ? "" : ", ") + std::to_string(tag.id);
-    report.reason = "none of the scale tags was reconstructed with all four corners; complete tags: " + ids;
+    return ids;
+  };
+  if (report.scale_tags.empty()) {
+    report.reason = "none of the scale tags was reconstructed with all four corners; complete tags: " + complete_ids();
     return report;
   }
   mean_edge /= static_cast<double>(report.scale_tags.size());
@@ -321,10 +324,8 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
     return options.world_tag < 0 || tag.id == options.world_tag;
   });
   if (world == complete.end()) {
-    std::string ids;
-    for (const ModelTag& tag : complete) ids += (ids.empty() ? "" : ", ") + std::to_string(tag.id);
     return InvalidArgument("tag registration: world tag " + std::to_string(options.world_tag) +
-                           " was not reconstructed; complete tags: " + ids);
+                           " was not reconstructed; complete tags: " + complete_ids());
   }
   report.metres_per_model_unit = options.tag_size_m / mean_edge;
   RECONAR_ASSIGN_OR_RETURN(report.world_from_model,
