@@ -122,12 +122,12 @@ Result<AdjustmentCovariance> AdjustmentCovariance::Compute(const RadialProblem& 
     ++free_points;
     block.w.resize(static_cast<Eigen::Index>(block.unknowns.size()), 3);
     for (size_t r = 0; r < w_rows.size(); ++r) block.w.row(static_cast<Eigen::Index>(r)) = w_rows[r];
-    const Eigen::LLT<Eigen::Matrix3d> v_factor(v);
     // A point fixed along one ray only (or seen once) has a V without a well-conditioned inverse.
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(v);
-    block.determined = v_factor.info() == Eigen::Success && eigen.eigenvalues()(0) > 1e-12 * eigen.eigenvalues()(2);
+    const Eigen::Vector3d values = eigen.eigenvalues();  // increasing
+    block.determined = eigen.info() == Eigen::Success && values(0) > 1e-12 * values(2) && values(0) > 0.0;
     if (!block.determined) continue;
-    block.v_inverse = v_factor.solve(Eigen::Matrix3d::Identity());
+    block.v_inverse = eigen.eigenvectors() * values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
     const Eigen::MatrixXd wv = block.w * block.v_inverse;
     const Eigen::MatrixXd update = wv * block.w.transpose();
     for (size_t a = 0; a < block.unknowns.size(); ++a) {
