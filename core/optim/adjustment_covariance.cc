@@ -69,6 +69,7 @@ Result<AdjustmentCovariance> AdjustmentCovariance::Compute(const RadialProblem& 
   RECONAR_ASSIGN_OR_RETURN(const CameraUnknowns unknowns, NumberCameraUnknowns(problem, constancy));
   AdjustmentCovariance covariance;
   covariance.s_size_ = static_cast<size_t>(unknowns.count);
+  covariance.row_of_.assign(covariance.s_size_, -1);
   const auto n = static_cast<Eigen::Index>(unknowns.count);
   Eigen::MatrixXd s = Eigen::MatrixXd::Zero(n, n);
 
@@ -77,7 +78,8 @@ Result<AdjustmentCovariance> AdjustmentCovariance::Compute(const RadialProblem& 
     observations_of[static_cast<size_t>(problem.observations[k].point)].push_back(static_cast<int>(k));
   }
   covariance.points_.resize(observations_of.size());
-  std::vector<int> row_of(static_cast<size_t>(unknowns.count), -1);  // scratch: unknown -> row of W_j
+  covariance.cameras_ = problem.cameras;
+  covariance.camera_unknowns_ = unknowns.of_camera;
   double weighted_squares = 0.0;
   int free_points = 0;
   bool any_constant_camera = false;
@@ -85,49 +87,13 @@ Result<AdjustmentCovariance> AdjustmentCovariance::Compute(const RadialProblem& 
   for (size_t j = 0; j < observations_of.size(); ++j) {
     PointBlock& block = covariance.points_[j];
     block.constant = !constancy.constant_points.empty() && constancy.constant_points[j];
-    Eigen::Matrix3d v = Eigen::Matrix3d::Zero();
-    std::vector<Eigen::RowVector3d> w_rows;
-    for (int k : observations_of[j]) {
-      const BalObservation& o = problem.observations[static_cast<size_t>(k)];
-      Eigen::Matrix<double, 2, kCameraSize, Eigen::RowMajor> jc;
-      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> jp;
-      double predicted[2];
-      if (!ProjectRadial(problem.camera(o.camera), problem.point(static_cast<int>(j)), predicted, jc.data(), jp.data())) {
-        continue;
-      }
-      const Eigen::Vector2d r = o.weight * Eigen::Vector2d(predicted[0] - o.x, predicted[1] - o.y);
-      weighted_squares += r.squaredNorm();
-      jc *= o.weight;
-      jp *= o.weight;
-      const std::array<int, kCameraSize>& camera = unknowns.of_camera[static_cast<size_t>(o.camera)];
-      for (int a = 0; a < kCameraSize; ++a) {
-        const int ua = camera[static_cast<size_t>(a)];
-        if (ua < 0) continue;
-        for (int b = 0; b < kCameraSize; ++b) {
-          const int ub = camera[static_cast<size_t>(b)];
-          if (ub >= 0) s(ua, ub) += jc.col(a).dot(jc.col(b));
-        }
-        if (block.constant) continue;
-        if (row_of[static_cast<size_t>(ua)] < 0) {
-          row_of[static_cast<size_t>(ua)] = static_cast<int>(block.unknowns.size());
-          block.unknowns.push_back(ua);
-          w_rows.push_back(Eigen::RowVector3d::Zero());
-        }
-        w_rows[static_cast<size_t>(row_of[static_cast<size_t>(ua)])] += jc.col(a).transpose() * jp;
-      }
-      if (!block.constant) v += jp.transpose() * jp;
-    }
-    for (int u : block.unknowns) row_of[static_cast<size_t>(u)] = -1;
+    std::vector<BalObservation> observations;
+    observations.reserve(observations_of[j].size());
+    for (int k : observations_of[j]) observations.push_back(problem.observations[static_cast<size_t>(k)]);
+    weighted_squares += covariance.FillPointBlock(problem.point(static_cast<int>(j)), observations, nullptr, &s, &block);
     if (block.constant) continue;
     ++free_points;
-    block.w.resize(static_cast<Eigen::Index>(block.unknowns.size()), 3);
-    for (size_t r = 0; r < w_rows.size(); ++r) block.w.row(static_cast<Eigen::Index>(r)) = w_rows[r];
-    // A point fixed along one ray only (or seen once) has a V without a well-conditioned inverse.
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(v);
-    const Eigen::Vector3d values = eigen.eigenvalues();  // increasing
-    block.determined = eigen.info() == Eigen::Success && values(0) > 1e-12 * values(2) && values(0) > 0.0;
     if (!block.determined) continue;
-    block.v_inverse = eigen.eigenvectors() * values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
     const Eigen::MatrixXd wv = block.w * block.v_inverse;
     const Eigen::MatrixXd update = wv * block.w.transpose();
     for (size_t a = 0; a < block.unknowns.size(); ++a) {
@@ -152,6 +118,82 @@ Result<AdjustmentCovariance> AdjustmentCovariance::Compute(const RadialProblem& 
     }
   }
   return covariance;
+}
+
+double AdjustmentCovariance::FillPointBlock(const double* point, const std::vector<BalObservation>& observations,
+                                            const std::vector<Eigen::Matrix2d>* residual_projections, Eigen::MatrixXd* s,
+                                            PointBlock* block) {
+  double weighted_squares = 0.0;
+  Eigen::Matrix3d v = Eigen::Matrix3d::Zero();
+  std::vector<Eigen::RowVector3d> w_rows;
+  for (size_t k = 0; k < observations.size(); ++k) {
+    const BalObservation& o = observations[k];
+    Eigen::Matrix<double, 2, kCameraSize, Eigen::RowMajor> jc;
+    Eigen::Matrix<double, 2, 3, Eigen::RowMajor> jp;
+    double predicted[2];
+    const double* camera_block = cameras_.data() + static_cast<size_t>(o.camera) * kCameraSize;
+    if (!ProjectRadial(camera_block, point, predicted, jc.data(), jp.data())) continue;
+    Eigen::Vector2d r = o.weight * Eigen::Vector2d(predicted[0] - o.x, predicted[1] - o.y);
+    jc *= o.weight;
+    jp *= o.weight;
+    if (residual_projections != nullptr) {
+      const Eigen::Matrix2d& projection = (*residual_projections)[k];
+      r = projection * r;
+      jc = projection * jc;
+      jp = projection * jp;
+    }
+    weighted_squares += r.squaredNorm();
+    const std::array<int, kCameraSize>& camera = camera_unknowns_[static_cast<size_t>(o.camera)];
+    for (int a = 0; a < kCameraSize; ++a) {
+      const int ua = camera[static_cast<size_t>(a)];
+      if (ua < 0) continue;
+      if (s != nullptr) {
+        for (int b = 0; b < kCameraSize; ++b) {
+          const int ub = camera[static_cast<size_t>(b)];
+          if (ub >= 0) (*s)(ua, ub) += jc.col(a).dot(jc.col(b));
+        }
+      }
+      if (block->constant) continue;
+      if (row_of_[static_cast<size_t>(ua)] < 0) {
+        row_of_[static_cast<size_t>(ua)] = static_cast<int>(block->unknowns.size());
+        block->unknowns.push_back(ua);
+        w_rows.push_back(Eigen::RowVector3d::Zero());
+      }
+      w_rows[static_cast<size_t>(row_of_[static_cast<size_t>(ua)])] += jc.col(a).transpose() * jp;
+    }
+    if (!block->constant) v += jp.transpose() * jp;
+  }
+  for (int u : block->unknowns) row_of_[static_cast<size_t>(u)] = -1;
+  if (block->constant) return weighted_squares;
+  block->w.resize(static_cast<Eigen::Index>(block->unknowns.size()), 3);
+  for (size_t r = 0; r < w_rows.size(); ++r) block->w.row(static_cast<Eigen::Index>(r)) = w_rows[r];
+  // A point fixed along one ray only (or seen once) has a V without a well-conditioned inverse.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(v);
+  const Eigen::Vector3d values = eigen.eigenvalues();  // increasing
+  block->determined = eigen.info() == Eigen::Success && values(0) > 1e-12 * values(2) && values(0) > 0.0;
+  if (block->determined) {
+    block->v_inverse = eigen.eigenvectors() * values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
+  }
+  return weighted_squares;
+}
+
+Result<int> AdjustmentCovariance::AddPoint(const Eigen::Vector3d& position, const std::vector<BalObservation>& observations,
+                                           const std::vector<Eigen::Matrix2d>& residual_projections) {
+  if (!residual_projections.empty() && residual_projections.size() != observations.size()) {
+    return InvalidArgument("adjustment covariance: an added point's residual projections do not match its observations");
+  }
+  const int cameras = static_cast<int>(camera_unknowns_.size());
+  for (const BalObservation& o : observations) {
+    if (o.camera < 0 || o.camera >= cameras) {
+      return InvalidArgument("adjustment covariance: an added point's observation names camera " +
+                             std::to_string(o.camera) + " of " + std::to_string(cameras));
+    }
+  }
+  PointBlock block;
+  FillPointBlock(position.data(), observations, residual_projections.empty() ? nullptr : &residual_projections, nullptr,
+                 &block);
+  points_.push_back(std::move(block));
+  return static_cast<int>(points_.size()) - 1;
 }
 
 double AdjustmentCovariance::Variance(const std::vector<PointGradient>& gradients) const {

@@ -16,6 +16,7 @@
 // every function the similarity does not change (ratios of distances, angles) as it is. A
 // distance in metres is such a function once divided by the scale's own measure (the mean edge
 // of the scale tags in the model): the caller forms it so.
+#include <array>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -48,6 +49,23 @@ class AdjustmentCovariance {
   double variance_factor() const { return variance_factor_; }  // sigma0^2, squared weighted pixels
   int redundancy() const { return redundancy_; }
   int camera_unknowns() const { return static_cast<int>(s_size_); }
+  // Whether the point's observations fix it (a free point seen from two directions).
+  bool determined(int point) const {
+    return point >= 0 && static_cast<size_t>(point) < points_.size() && !points_[static_cast<size_t>(point)].constant &&
+           points_[static_cast<size_t>(point)].determined;
+  }
+
+  // A point the adjustment did not have (a pick in the photos), at `position`, seen by these
+  // observations (their `point` is ignored) of the problem's cameras: its block as if it had been
+  // adjusted with the others, without what its observations would have told about the cameras
+  // (negligible beside the model's, and if anything it makes the point's variance larger).
+  // `residual_projections`, when given (one per observation), multiply each weighted residual:
+  // e.g. e e^T with a unit e keeps only its component along e (an observation that fixes the point
+  // along one image direction only). Returns its index for PointGradient; it is undetermined
+  // (infinite variance) when its observations do not fix it. InvalidArgument for an observation
+  // of a missing camera or projections that do not match the observations.
+  Result<int> AddPoint(const Eigen::Vector3d& position, const std::vector<BalObservation>& observations,
+                       const std::vector<Eigen::Matrix2d>& residual_projections = {});
 
   // The variance of a function of the points with these gradients (one entry per point it depends
   // on), including sigma0^2. A constant point contributes nothing; a point its observations do not
@@ -62,7 +80,16 @@ class AdjustmentCovariance {
     bool constant = false;
     bool determined = true;
   };
+  // The point's V^-1, W and unknowns from its observations (their residuals projected when
+  // `residual_projections` is not null); adds the cameras' J^T J to *s unless null. Returns the
+  // observations' weighted squared residuals.
+  double FillPointBlock(const double* point, const std::vector<BalObservation>& observations,
+                        const std::vector<Eigen::Matrix2d>* residual_projections, Eigen::MatrixXd* s, PointBlock* block);
+
   std::vector<PointBlock> points_;
+  std::vector<double> cameras_;                                          // the problem's camera blocks
+  std::vector<std::array<int, RadialProblem::kCameraSize>> camera_unknowns_;  // per camera parameter, -1: constant
+  std::vector<int> row_of_;                                              // scratch: unknown -> row of a point's W
   Eigen::LLT<Eigen::MatrixXd> s_factor_;  // of the damped S
   size_t s_size_ = 0;
   double variance_factor_ = 0.0;

@@ -20,12 +20,16 @@ double ObservationWeight(const std::vector<MapperImage>& images, const TrackElem
     return weights[static_cast<size_t>(e.keypoint_id)];
   }
   const std::vector<float>& scales = images[static_cast<size_t>(e.image_id)].keypoint_scales;
-  if (!options.weight_by_scale || scales.empty()) return 1.0;
-  const double scale = scales[static_cast<size_t>(e.keypoint_id)];
-  return scale > options.base_scale_px ? options.base_scale_px / scale : 1.0;
+  if (scales.empty()) return 1.0;
+  return ScaleWeight(scales[static_cast<size_t>(e.keypoint_id)], options);
 }
 
 }  // namespace
+
+double ScaleWeight(double keypoint_scale, const MapperOptions& options) {
+  if (!options.weight_by_scale) return 1.0;
+  return keypoint_scale > options.base_scale_px ? options.base_scale_px / keypoint_scale : 1.0;
+}
 
 Result<double> BundleAdjust(MapperModel* model, const std::vector<MapperImage>& images,
                             const std::vector<int>& variable, const MapperAdjustment& adjustment,

@@ -39,6 +39,11 @@ Result<double> BundleAdjust(MapperModel* model, const std::vector<MapperImage>& 
                             const std::vector<int>& variable, const MapperAdjustment& adjustment,
                             const MapperOptions& options, MapperReport* report);
 
+// The weight of an observation of a keypoint detected at `keypoint_scale` (MapperOptions::
+// weight_by_scale: base_scale_px / scale above the base scale, else 1); a keypoint with a weight
+// of its own (a tag corner: kTagCornerWeight) has that instead.
+double ScaleWeight(double keypoint_scale, const MapperOptions& options);
+
 // Records a failed adjustment in `report` (num_failed_ba, first_ba_failure) and returns Ok, so
 // that the mapper carries on with the model as it was; InvalidArgument, a programming error, is
 // returned instead. Ok passes through uncounted.

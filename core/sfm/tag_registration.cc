@@ -168,27 +168,41 @@ std::array<Eigen::Vector3d, 4> RigidTagCorners(const Reconstruction& rec,
 
 }  // namespace
 
+std::vector<TagCornerKeypoint> TagCornerKeypointsOfImage(int image_id, const std::vector<TagObservation>& tags,
+                                                         int first_keypoint) {
+  std::map<int, int> count;
+  for (const TagObservation& tag : tags) ++count[tag.tag_id];
+  std::vector<TagCornerKeypoint> corners;
+  int keypoint = first_keypoint;
+  for (const TagObservation& tag : tags) {
+    if (count[tag.tag_id] != 1) continue;
+    for (int k = 0; k < 4; ++k) corners.push_back({image_id, keypoint++, tag.tag_id, k});
+  }
+  return corners;
+}
+
 std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vector<TagObservation>>& observations,
                                                      double keypoint_scale, double corner_weight,
                                                      std::vector<MapperImage>* images, std::vector<MapperPair>* pairs) {
   std::vector<TagCornerKeypoint> corners;
   std::vector<std::map<int, int>> first_keypoint(images->size());  // per image: tag id -> its corner 0 keypoint
   for (size_t i = 0; i < images->size() && i < observations.size(); ++i) {
-    std::map<int, int> count;
-    for (const TagObservation& tag : observations[i]) ++count[tag.tag_id];
     MapperImage& image = (*images)[i];
+    const std::vector<TagCornerKeypoint> image_corners =
+        TagCornerKeypointsOfImage(static_cast<int>(i), observations[i], static_cast<int>(image.keypoints.size()));
     if (!observations[i].empty()) image.keypoint_weights.resize(image.keypoints.size(), 0.0f);
-    for (const TagObservation& tag : observations[i]) {
-      if (count[tag.tag_id] != 1) continue;  // a printed id twice in one photo: which is which is unknown
-      first_keypoint[i][tag.tag_id] = static_cast<int>(image.keypoints.size());
-      image.tags.push_back({tag.tag_id, static_cast<int>(image.keypoints.size())});
-      for (int k = 0; k < 4; ++k) {
-        corners.push_back({static_cast<int>(i), static_cast<int>(image.keypoints.size()), tag.tag_id, k});
-        image.keypoints.push_back(tag.corners[static_cast<size_t>(k)]);
-        if (!image.keypoint_scales.empty()) image.keypoint_scales.push_back(static_cast<float>(keypoint_scale));
-        image.keypoint_weights.push_back(static_cast<float>(corner_weight));
+    for (const TagCornerKeypoint& corner : image_corners) {
+      if (corner.corner == 0) {
+        first_keypoint[i][corner.tag_id] = corner.keypoint_id;
+        image.tags.push_back({corner.tag_id, corner.keypoint_id});
       }
+      const auto& tag = *std::find_if(observations[i].begin(), observations[i].end(),
+                                      [&](const TagObservation& t) { return t.tag_id == corner.tag_id; });
+      image.keypoints.push_back(tag.corners[static_cast<size_t>(corner.corner)]);
+      if (!image.keypoint_scales.empty()) image.keypoint_scales.push_back(static_cast<float>(keypoint_scale));
+      image.keypoint_weights.push_back(static_cast<float>(corner_weight));
     }
+    corners.insert(corners.end(), image_corners.begin(), image_corners.end());
   }
   std::map<std::pair<int, int>, size_t> pair_of;
   for (size_t p = 0; p < pairs->size(); ++p) {

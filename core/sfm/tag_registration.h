@@ -46,6 +46,12 @@ struct TagCornerKeypoint {
 // (Wang & Olson 2016) against 0.2-0.3 px for SIFT (Lowe 2004's sub-pixel fit).
 inline constexpr double kTagCornerWeight = 2.0;
 
+// Where AddTagCorrespondences puts the corners of one image's tags, `tags`, whose keypoints before
+// them number `first_keypoint`: four consecutive keypoints per tag, in the order of `tags`, for
+// each tag whose id the image shows once (a printed id twice in one photo: which is which is unknown).
+std::vector<TagCornerKeypoint> TagCornerKeypointsOfImage(int image_id, const std::vector<TagObservation>& tags,
+                                                         int first_keypoint);
+
 // observations[i] are the tags seen in images[i]. Corners get `keypoint_scale` as detection scale
 // (when the images carry scales) and `corner_weight` as weight, and each image lists its tags in
 // MapperImage::tags (so that the mapper may register it by them). A pair of images that share tags

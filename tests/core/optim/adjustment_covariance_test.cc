@@ -92,5 +92,64 @@ TEST(AdjustmentCovarianceTest, AConstantPointAddsNothingAndAMismatchedConstancyI
   EXPECT_EQ(AdjustmentCovariance::Compute(problem, constancy).status().code(), StatusCode::kInvalidArgument);
 }
 
+// A point added after the fact (a pick in the photos) has the variance it would have had in the
+// adjustment, up to what its own observations would have told about the cameras.
+TEST(AdjustmentCovarianceTest, AnAddedPointHasTheVarianceItWouldHaveHadInTheAdjustment) {
+  const std::vector<int> groups(8, 0);
+  RadialProblem problem = testing::MakeSyntheticRadial(groups, 80, 0.0, 3);
+  std::mt19937 random(5);
+  std::normal_distribution<double> noise(0.0, 0.5);
+  for (BalObservation& o : problem.observations) {
+    o.x += noise(random);
+    o.y += noise(random);
+  }
+  BundleAdjustmentConstancy constancy;
+  constancy.intrinsics_group = groups;
+  constancy.constant_camera_parameters = {9, 10, 11};
+  ASSERT_TRUE(SolveBundleAdjustment(BundleAdjustmentOptions(), constancy, &problem).ok());
+  auto with_all = AdjustmentCovariance::Compute(problem, constancy);
+  ASSERT_TRUE(with_all.ok()) << with_all.status().ToString();
+
+  // The same problem without point 0; then point 0 added with its observations.
+  RadialProblem without = problem;
+  without.points.erase(without.points.begin(), without.points.begin() + 3);
+  without.observations.clear();
+  std::vector<BalObservation> of_point_0;
+  for (BalObservation o : problem.observations) {
+    if (o.point == 0) {
+      of_point_0.push_back(o);
+      continue;
+    }
+    --o.point;
+    without.observations.push_back(o);
+  }
+  ASSERT_GE(of_point_0.size(), 2u);
+  auto with_added = AdjustmentCovariance::Compute(without, constancy);
+  ASSERT_TRUE(with_added.ok()) << with_added.status().ToString();
+  auto added = with_added->AddPoint(Eigen::Map<const Eigen::Vector3d>(problem.point(0)), of_point_0);
+  ASSERT_TRUE(added.ok()) << added.status().ToString();
+  EXPECT_EQ(*added, without.num_points());
+
+  // |P0 - P1| / |P2 - P3| in both numberings.
+  const auto point = [&](int j) { return Eigen::Map<const Eigen::Vector3d>(problem.point(j)); };
+  const Eigen::Vector3d a = point(0) - point(1), b = point(2) - point(3);
+  const double ratio = a.norm() / b.norm();
+  const Eigen::Vector3d da = a / (a.norm() * b.norm()), db = -ratio * b / b.squaredNorm();
+  const double variance_all = with_all->Variance({{0, da}, {1, -da}, {2, db}, {3, -db}});
+  const double variance_added = with_added->Variance({{*added, da}, {0, -da}, {1, db}, {2, -db}});
+  std::printf("sigma with the point adjusted %.4g, added afterwards %.4g\n", std::sqrt(variance_all),
+              std::sqrt(variance_added));
+  EXPECT_GT(variance_all, 0.0);
+  EXPECT_NEAR(std::sqrt(variance_added), std::sqrt(variance_all), 0.05 * std::sqrt(variance_all));
+
+  // An observation of a camera the problem does not have is refused; one view does not fix a point.
+  std::vector<BalObservation> bad = of_point_0;
+  bad[0].camera = 99;
+  EXPECT_EQ(with_added->AddPoint(point(0), bad).status().code(), StatusCode::kInvalidArgument);
+  auto once = with_added->AddPoint(point(0), {of_point_0[0]});
+  ASSERT_TRUE(once.ok());
+  EXPECT_TRUE(std::isinf(with_added->Variance({{*once, Eigen::Vector3d(1, 0, 0)}})));
+}
+
 }  // namespace
 }  // namespace reconar

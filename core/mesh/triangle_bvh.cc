@@ -1,0 +1,123 @@
+#include "core/mesh/triangle_bvh.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace reconar {
+
+TriangleBvh::TriangleBvh(const Mesh& mesh) {
+  corners_.resize(mesh.triangles.size());
+  std::vector<Eigen::Vector3f> centroids(mesh.triangles.size());
+  order_.reserve(mesh.triangles.size());
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const std::array<uint32_t, 3>& t = mesh.triangles[i];
+    if (t[0] >= mesh.positions.size() || t[1] >= mesh.positions.size() || t[2] >= mesh.positions.size()) continue;
+    const std::array<Eigen::Vector3f, 3> c = {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]};
+    if (!c[0].allFinite() || !c[1].allFinite() || !c[2].allFinite()) continue;
+    corners_[i] = c;
+    centroids[i] = (c[0] + c[1] + c[2]) / 3.0f;
+    order_.push_back(static_cast<int>(i));
+  }
+  nodes_.reserve(2 * (order_.size() / kLeafSize + 1));
+  if (!order_.empty()) Build(0, static_cast<int>(order_.size()), &centroids);
+}
+
+int TriangleBvh::Build(int begin, int end, std::vector<Eigen::Vector3f>* centroids) {
+  const int index = static_cast<int>(nodes_.size());
+  nodes_.emplace_back();
+  Eigen::Vector3f box_min = Eigen::Vector3f::Constant(INFINITY), box_max = -box_min;
+  Eigen::Vector3f centre_min = box_min, centre_max = box_max;
+  for (int k = begin; k < end; ++k) {
+    const int t = order_[static_cast<size_t>(k)];
+    for (const Eigen::Vector3f& c : corners_[static_cast<size_t>(t)]) {
+      box_min = box_min.cwiseMin(c);
+      box_max = box_max.cwiseMax(c);
+    }
+    centre_min = centre_min.cwiseMin((*centroids)[static_cast<size_t>(t)]);
+    centre_max = centre_max.cwiseMax((*centroids)[static_cast<size_t>(t)]);
+  }
+  nodes_[static_cast<size_t>(index)].box_min = box_min;
+  nodes_[static_cast<size_t>(index)].box_max = box_max;
+  if (end - begin <= kLeafSize) {
+    nodes_[static_cast<size_t>(index)].first = begin;
+    nodes_[static_cast<size_t>(index)].count = end - begin;
+    return index;
+  }
+  int axis = 0;
+  (centre_max - centre_min).maxCoeff(&axis);
+  const int middle = begin + (end - begin) / 2;
+  std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
+                   [&](int a, int b) {
+                     return (*centroids)[static_cast<size_t>(a)][axis] < (*centroids)[static_cast<size_t>(b)][axis];
+                   });
+  Build(begin, middle, centroids);
+  const int second = Build(middle, end, centroids);
+  nodes_[static_cast<size_t>(index)].first = second;
+  return index;
+}
+
+namespace {
+
+// The entry distance of the ray into the box, or infinity when it misses it within (near, far).
+double BoxEntry(const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max, const Eigen::Vector3d& origin,
+                const Eigen::Vector3d& inverse_direction, double near, double far) {
+  for (int a = 0; a < 3; ++a) {
+    double t0 = (box_min[a] - origin[a]) * inverse_direction[a];
+    double t1 = (box_max[a] - origin[a]) * inverse_direction[a];
+    if (t0 > t1) std::swap(t0, t1);
+    if (std::isnan(t0) || std::isnan(t1)) continue;  // a zero direction component with the origin on a face
+    near = std::max(near, t0);
+    far = std::min(far, t1);
+    if (near > far) return INFINITY;
+  }
+  return near;
+}
+
+}  // namespace
+
+RayHit TriangleBvh::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double min_distance,
+                              double max_distance) const {
+  RayHit hit;
+  if (nodes_.empty()) return hit;
+  const Eigen::Vector3d inverse = direction.cwiseInverse();
+  double best = max_distance;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[static_cast<size_t>(stack[--top])];
+    if (!(BoxEntry(node.box_min, node.box_max, origin, inverse, min_distance, best) < INFINITY)) continue;
+    if (node.count > 0) {
+      for (int k = node.first; k < node.first + node.count; ++k) {
+        const int t = order_[static_cast<size_t>(k)];
+        const std::array<Eigen::Vector3f, 3>& c = corners_[static_cast<size_t>(t)];
+        const Eigen::Vector3d a = c[0].cast<double>();
+        const Eigen::Vector3d e1 = c[1].cast<double>() - a, e2 = c[2].cast<double>() - a;
+        const Eigen::Vector3d p = direction.cross(e2);
+        const double determinant = e1.dot(p);
+        if (std::abs(determinant) < 1e-300) continue;
+        const Eigen::Vector3d s = origin - a;
+        const double u = s.dot(p) / determinant;
+        if (u < 0.0 || u > 1.0) continue;
+        const Eigen::Vector3d q = s.cross(e1);
+        const double v = direction.dot(q) / determinant;
+        if (v < 0.0 || u + v > 1.0) continue;
+        const double distance = e2.dot(q) / determinant;
+        if (distance > min_distance && distance < best) {
+          best = distance;
+          hit.triangle = t;
+          hit.distance = distance;
+        }
+      }
+      continue;
+    }
+    // Depth is at most about log2(triangles / kLeafSize) + a few: the median split halves each node.
+    if (top + 2 > static_cast<int>(sizeof(stack) / sizeof(stack[0]))) continue;
+    stack[top++] = node.first;
+    stack[top++] = static_cast<int>(&node - nodes_.data()) + 1;
+  }
+  if (hit.triangle >= 0) hit.point = origin + hit.distance * direction;
+  return hit;
+}
+
+}  // namespace reconar

@@ -1,0 +1,50 @@
+#pragma once
+// A bounding-volume hierarchy over a mesh's triangles, for ray queries on large meshes (a point
+// picked in a photo or on the screen met with the model's surface, a visibility test): built once,
+// its nodes in one array, queries allocate nothing.
+//
+// Binary tree of axis-aligned boxes; a node splits its triangles at the median of their centroids
+// along the longest axis of the centroids' box, down to leaves of at most kLeafSize triangles.
+// Rays are met with triangles by Moller & Trumbore (1997), both faces counted.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/mesh/mesh.h"
+
+namespace reconar {
+
+struct RayHit {
+  int triangle = -1;      // index into the mesh's triangles; -1: the ray meets nothing
+  double distance = 0.0;  // along the ray, in units of its direction's length
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+};
+
+class TriangleBvh {
+ public:
+  static constexpr int kLeafSize = 4;
+
+  explicit TriangleBvh(const Mesh& mesh);
+
+  // The nearest triangle the ray origin + t direction meets for min_distance < t < max_distance.
+  RayHit Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double min_distance = 0.0,
+                   double max_distance = 1e300) const;
+
+  int num_triangles() const { return static_cast<int>(order_.size()); }  // the usable ones
+
+ private:
+  struct Node {
+    Eigen::Vector3f box_min, box_max;
+    int first = 0;  // leaf: first index into order_; inner: the second child (the first follows the node)
+    int count = 0;  // leaf: its triangles; inner: 0
+  };
+  int Build(int begin, int end, std::vector<Eigen::Vector3f>* centroids);
+
+  std::vector<std::array<Eigen::Vector3f, 3>> corners_;  // per mesh triangle
+  std::vector<int> order_;  // the usable triangles (indices in range, finite corners) in leaf order
+  std::vector<Node> nodes_;
+};
+
+}  // namespace reconar

@@ -1,0 +1,68 @@
+// TriangleBvh against testing every triangle, on a random soup and on a closed mesh.
+#include "core/mesh/triangle_bvh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+namespace reconar {
+namespace {
+
+// The nearest hit by testing every triangle (Moller-Trumbore), t in (0, inf).
+RayHit BruteForce(const Mesh& mesh, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
+  RayHit best;
+  best.distance = INFINITY;
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (std::max({mesh.triangles[i][0], mesh.triangles[i][1], mesh.triangles[i][2]}) >= mesh.positions.size()) continue;
+    const Eigen::Vector3d a = mesh.positions[mesh.triangles[i][0]].cast<double>();
+    const Eigen::Vector3d e1 = mesh.positions[mesh.triangles[i][1]].cast<double>() - a;
+    const Eigen::Vector3d e2 = mesh.positions[mesh.triangles[i][2]].cast<double>() - a;
+    const Eigen::Matrix3d system = (Eigen::Matrix3d() << -direction, e1, e2).finished();
+    const Eigen::Vector3d tuv = system.colPivHouseholderQr().solve(origin - a);
+    if (tuv(1) < 0 || tuv(2) < 0 || tuv(1) + tuv(2) > 1 || tuv(0) <= 0 || tuv(0) >= best.distance) continue;
+    best.triangle = static_cast<int>(i);
+    best.distance = tuv(0);
+  }
+  return best;
+}
+
+TEST(TriangleBvhTest, FindsTheNearestTriangleAsTestingEveryOneDoes) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> coordinate(-1.0f, 1.0f);
+  Mesh mesh;
+  for (int t = 0; t < 2000; ++t) {
+    const Eigen::Vector3f centre(coordinate(random), coordinate(random), coordinate(random));
+    for (int k = 0; k < 3; ++k) {
+      mesh.positions.push_back(centre + 0.1f * Eigen::Vector3f(coordinate(random), coordinate(random), coordinate(random)));
+    }
+    mesh.triangles.push_back({uint32_t(3 * t), uint32_t(3 * t + 1), uint32_t(3 * t + 2)});
+  }
+  mesh.triangles.push_back({0, 1, 999999});  // out of range: left out, not a crash
+  const TriangleBvh bvh(mesh);
+  EXPECT_EQ(bvh.num_triangles(), 2000);
+  int hits = 0;
+  for (int r = 0; r < 500; ++r) {
+    const Eigen::Vector3d origin = 3.0 * Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random));
+    const Eigen::Vector3d target = 0.5 * Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random));
+    const Eigen::Vector3d direction = target - origin;
+    const RayHit expected = BruteForce(mesh, origin, direction);
+    const RayHit hit = bvh.Intersect(origin, direction);
+    ASSERT_EQ(hit.triangle, expected.triangle) << "ray " << r;
+    if (hit.triangle < 0) continue;
+    ++hits;
+    EXPECT_NEAR(hit.distance, expected.distance, 1e-9);
+    EXPECT_LT((hit.point - (origin + expected.distance * direction)).norm(), 1e-9);
+    // Limited short of the hit, the ray meets nothing: it was the nearest.
+    EXPECT_EQ(bvh.Intersect(origin, direction, 0.0, 0.999 * hit.distance).triangle, -1);
+  }
+  EXPECT_GT(hits, 100);
+}
+
+TEST(TriangleBvhTest, AnEmptyMeshMeetsNothing) {
+  const TriangleBvh bvh{Mesh()};
+  EXPECT_EQ(bvh.Intersect(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()).triangle, -1);
+}
+
+}  // namespace
+}  // namespace reconar
