@@ -239,6 +239,7 @@ struct ProjectMeasurer::State {
   double tag_size = 0.0;
   int world_tag = -1;
   std::vector<int> scale_corners;  // 4 covariance points per scale tag
+  double scale_mean_ = 1.0;        // their mean edge in the model
   double scale_relative_sigma = 0.0;
   double length_relative_sigma = 0.0;
   double calibration = 1.0;
@@ -526,32 +527,44 @@ struct ProjectMeasurer::State {
 
   // The world tag's frame as the corners' centre and the rotation that best fits the ideal square
   // to them, at positions `y`: a world point's place moves with it.
-  Eigen::Vector3d WorldTagFrame(const std::map<int, Eigen::Vector3d>& y, const Eigen::Vector3d& xyz) const {
+  Eigen::Vector3d WorldTagFrame(const std::map<int, Eigen::Vector3d>& y, const Eigen::Vector3d& xyz,
+                                double scale_mean) const {
     Eigen::Matrix<double, 3, 4> ideal, seen;
     for (int corner = 0; corner < 4; ++corner) {
       ideal.col(corner) = Eigen::Vector3d(kTagCornerUnits[corner][0], kTagCornerUnits[corner][1], 0.0);
       seen.col(corner) = y.at(corner_point.at({world_tag, corner}));
     }
     const Eigen::Matrix4d fit = Eigen::umeyama(ideal, seen, false);
-    return seen.rowwise().mean() + ScaleMean(y) / tag_size * fit.topLeftCorner<3, 3>() * xyz;
+    return seen.rowwise().mean() + scale_mean / tag_size * fit.topLeftCorner<3, 3>() * xyz;
   }
 
-  double ScaleMean(const std::map<int, Eigen::Vector3d>& y) const {
+  // The scale tags' mean edge in the model, and its gradient (per scale corner).
+  double ScaleMean(std::vector<PointGradient>* gradient) const {
     double sum = 0.0;
+    const double n = static_cast<double>(scale_corners.size());
     for (size_t t = 0; t < scale_corners.size(); t += 4) {
-      for (size_t k = 0; k < 4; ++k) sum += (y.at(scale_corners[t + (k + 1) % 4]) - y.at(scale_corners[t + k])).norm();
+      for (size_t k = 0; k < 4; ++k) {
+        const int from = scale_corners[t + k], to = scale_corners[t + (k + 1) % 4];
+        const Eigen::Vector3d edge = positions[static_cast<size_t>(to)] - positions[static_cast<size_t>(from)];
+        sum += edge.norm();
+        if (gradient != nullptr) {
+          gradient->push_back({to, edge.normalized() / n});
+          gradient->push_back({from, -edge.normalized() / n});
+        }
+      }
     }
-    return sum / static_cast<double>(scale_corners.size());
+    return sum / n;
   }
 
-  // The item's value at positions y, in metres when metric (the model's scale divided out and the
-  // scale tags' put in), and the points.
+  // The item's value with the points at y and the metric scale (the scale tags' mean edge in
+  // the model) `scale_mean`, which places world points.
   double Function(MeasureKind kind, const std::vector<LocatedPoint>& points, const std::map<int, Eigen::Vector3d>& y,
-                  const std::map<int, Eigen::Vector3d>& y0, std::vector<Eigen::Vector3d>* at) const {
+                  const std::map<int, Eigen::Vector3d>& y0, double scale_mean, std::vector<Eigen::Vector3d>* at) const {
     std::vector<Eigen::Vector3d> p;
     for (const LocatedPoint& point : points) {
       if (point.world) {
-        p.push_back(metric ? point.xyz + WorldTagFrame(y, point.xyz) - WorldTagFrame(y0, point.xyz) : point.xyz);
+        p.push_back(metric ? point.xyz + WorldTagFrame(y, point.xyz, scale_mean) - WorldTagFrame(y0, point.xyz, scale_mean_)
+                           : point.xyz);
         continue;
       }
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -559,12 +572,13 @@ struct ProjectMeasurer::State {
       p.push_back(sum);
     }
     if (at != nullptr) *at = p;
-    const double value = ItemValue(kind, p);
-    if (!metric) return value;
-    return value * std::pow(ScaleMean(y0) / ScaleMean(y), LengthPower(kind));
+    return ItemValue(kind, p);
   }
 
-  // Value and σ before calibration.
+  // Value and σ before calibration. The σ is that of a function the model's similarity does not
+  // change: the value times (M0 / M)^d, M the scale tags' mean edge (metric) or the model's size
+  // (not), d the value's power of length; its gradient is the value's at fixed M (by central
+  // differences over the points it reads) plus (dvalue/dM - d value / M) dM/dY.
   MeasuredItem Evaluate(MeasureKind kind, const std::vector<LocatedPoint>& points) const {
     std::map<int, Eigen::Vector3d> y;
     for (const LocatedPoint& point : points) {
@@ -576,13 +590,10 @@ struct ProjectMeasurer::State {
         }
       }
     }
-    if (metric) {
-      for (int index : scale_corners) y[index] = positions[static_cast<size_t>(index)];
-    }
     const std::map<int, Eigen::Vector3d> y0 = y;
     MeasuredItem item;
     item.kind = kind;
-    item.value = Function(kind, points, y, y0, &item.points);
+    item.value = Function(kind, points, y, y0, scale_mean_, &item.points);
     item.unit = metric ? (LengthPower(kind) == 2 ? "m2" : "m") : (LengthPower(kind) == 2 ? "model units^2" : "model units");
     const double step = 1e-7 * model_spread;  // the central difference's error is far below the σ
     std::vector<PointGradient> gradients;
@@ -591,32 +602,39 @@ struct ProjectMeasurer::State {
       for (int axis = 0; axis < 3; ++axis) {
         const double kept = position[axis];
         position[axis] = kept + step;
-        const double up = Function(kind, points, y, y0, nullptr);
+        const double up = Function(kind, points, y, y0, scale_mean_, nullptr);
         position[axis] = kept - step;
-        const double down = Function(kind, points, y, y0, nullptr);
+        const double down = Function(kind, points, y, y0, scale_mean_, nullptr);
         position[axis] = kept;
         gradient.gradient[axis] = (up - down) / (2.0 * step);
       }
       gradients.push_back(gradient);
     }
-    if (!metric) {
-      // In model units, relative to the model's own size S (the RMS distance of its points from
-      // their centroid c): the value times (S0 / S)^d, whose gradient at point i adds
-      // -d value (Y_i - c) / (N S^2).
+    const double power = LengthPower(kind);
+    if (metric) {
+      const double scale_step = 1e-7 * scale_mean_;
+      const double d_value_d_scale = (Function(kind, points, y0, y0, scale_mean_ + scale_step, nullptr) -
+                                      Function(kind, points, y0, y0, scale_mean_ - scale_step, nullptr)) /
+                                     (2.0 * scale_step);
+      const double d_function_d_scale = d_value_d_scale - power * item.value / scale_mean_;
+      std::vector<PointGradient> scale_gradient;
+      ScaleMean(&scale_gradient);
+      for (PointGradient& g : scale_gradient) g.gradient *= d_function_d_scale;
+      gradients.insert(gradients.end(), scale_gradient.begin(), scale_gradient.end());
+    } else {
+      // M is the RMS distance of spread_points from their centroid c: dM/dY_i = (Y_i - c) / (N M).
       const double n = static_cast<double>(spread_points.size());
-      std::map<int, size_t> slot;
-      for (size_t g = 0; g < gradients.size(); ++g) slot[gradients[g].point] = g;
       for (int i : spread_points) {
-        const Eigen::Vector3d term = -LengthPower(kind) * item.value * (positions[static_cast<size_t>(i)] - model_centroid) /
-                                     (n * model_spread * model_spread);
-        const auto it = slot.find(i);
-        if (it != slot.end()) {
-          gradients[it->second].gradient += term;
-        } else {
-          gradients.push_back({i, term});
-        }
+        gradients.push_back({i, -power * item.value * (positions[static_cast<size_t>(i)] - model_centroid) /
+                                    (n * model_spread * model_spread)});
       }
     }
+    std::map<int, Eigen::Vector3d> merged;  // Variance takes one gradient per point
+    for (const PointGradient& g : gradients) {
+      merged.emplace(g.point, Eigen::Vector3d::Zero()).first->second += g.gradient;
+    }
+    gradients.clear();
+    for (const auto& [index, gradient] : merged) gradients.push_back({index, gradient});
     const double scale_term = LengthPower(kind) * item.value * scale_relative_sigma;
     const double length_term = LengthPower(kind) * item.value * length_relative_sigma;
     double surface_variance = 0.0;
@@ -643,6 +661,7 @@ struct ProjectMeasurer::State {
       scale_corners.insert(scale_corners.end(), corners.begin(), corners.end());
     }
     setup->scale_tags = complete;
+    if (!complete.empty()) scale_mean_ = ScaleMean(nullptr);
     if (complete.empty()) {
       metric = false;
       return;
