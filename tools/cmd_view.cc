@@ -14,6 +14,7 @@
 #include "tools/ar_args.h"
 #include "tools/ar_output.h"
 #include "tools/commands.h"
+#include "tools/view_measure.h"
 
 namespace reconar::tools {
 namespace {
@@ -56,7 +57,9 @@ constexpr char kHelp[] =
     "  --smooth              draw at the tracker's smoothed pose (less jitter on a still camera, but\n"
     "                        it lags behind fast motion); default: each frame's measured pose\n"
     "  --window auto|x11|gbm (default auto)\n"
-    "  --max-frames N        stop after N frames\n";
+    "  --max-frames N        stop after N frames\n"
+    "  --measure \"X1,Y1 X2,Y2\"  with --project: each frame, the distance +- sigma between the model's\n"
+    "                        surface under these two pixels, drawn into --out's PNGs and in --json\n";
 
 Result<Eigen::Vector3d> ParseAxis(const std::string& text) {
   const bool negative = !text.empty() && text[0] == '-';
@@ -99,7 +102,7 @@ Result<ModelPlacement> PlacementFromArgs(const Args& args, const Mesh& mesh, dou
 int RunView(int argc, char** argv, int first) {
   std::set<std::string> valued = kTrackerValuedOptions;
   valued.insert({"model", "project", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
-                 "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces"});
+                 "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces", "measure"});
   Args args(valued, {"no-axes", "smooth", "no-map", "json"});
   // A model or a project, and a camera or frames: one of each.
   const CommandUsage usage = {0, 0, {}, [](const Args& a) {
@@ -132,6 +135,7 @@ int RunView(int argc, char** argv, int first) {
   if (!point_size.ok()) return Fail(point_size.status());
   options.style.point_size_px = static_cast<float>(*point_size);
   options.draw_axes = !args.Has("no-axes");
+  if (Status measure = ReadMeasureArgs(args, &options); !measure.ok()) return Fail(measure);
   options.out_dir = args.Get("out");
   const bool to_files = args.Has("out");
   if (!to_files) {
@@ -166,7 +170,8 @@ int RunView(int argc, char** argv, int first) {
   const bool json = args.Has("json");
   auto report = (*view)->Run([&](const ArSession& frame) {
     if (json) {
-      std::printf("%s\n", ArFrameJson(frame).c_str());
+      const std::string line = ArFrameJson(frame);
+      std::printf("%s\n", options.measure_pixels ? WithMeasurement(line, (*view)->measurement()).c_str() : line.c_str());
       std::fflush(stdout);
     }
     if (stderr_is_terminal && frame.frames() % 10 == 0) {

@@ -255,6 +255,18 @@ struct ProjectMeasurer::State {
 
   explicit State(const Project& p) : project(p) {}
 
+  // Forgets the points added after the first `count`.
+  void Rewind(size_t count) {
+    model.covariance.RemoveAddedPoints(static_cast<int>(count));
+    if (count < positions.size()) positions.resize(count);
+    for (auto it = surface_error.begin(); it != surface_error.end();) {
+      it = it->first >= static_cast<int>(count) ? surface_error.erase(it) : std::next(it);
+    }
+    for (auto it = corner_point.begin(); it != corner_point.end();) {
+      it = it->second >= static_cast<int>(count) ? corner_point.erase(it) : std::next(it);
+    }
+  }
+
   Result<int> AddPoint(const Eigen::Vector3d& position, const std::vector<BalObservation>& observations,
                        const std::vector<Eigen::Matrix2d>& residual_projections = {}) {
     RECONAR_ASSIGN_OR_RETURN(const int index, model.covariance.AddPoint(position, observations, residual_projections));
@@ -818,6 +830,29 @@ Result<MeasuredItem> ProjectMeasurer::Measure(const MeasureItem& item) {
   return measured;
 }
 
+Status ProjectMeasurer::LoadSurface() { return state_->ReadSurface(); }
+
+Result<MeasuredItem> ProjectMeasurer::MeasureBetweenPixels(const Rigid3& cam_from_world, const RadialCamera& camera,
+                                                           const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const size_t mark = state_->positions.size();
+  MeasureItem item;
+  Result<MeasuredItem> measured = [&]() -> Result<MeasuredItem> {
+    for (const Eigen::Vector2d& pixel : {a, b}) {
+      Eigen::Vector2d normalised;
+      if (!camera.Undistort(pixel, &normalised)) {
+        return InvalidArgument("pixel (" + std::to_string(pixel.x()) + ", " + std::to_string(pixel.y()) +
+                               ") is beyond the camera's lens model");
+      }
+      const Eigen::Vector3d direction = cam_from_world.rotation.transpose() * normalised.homogeneous();
+      RECONAR_ASSIGN_OR_RETURN(MeasurePoint point, PointOnSurface(CameraCenterInWorld(cam_from_world), direction));
+      item.points.push_back(std::move(point));
+    }
+    return Measure(item);
+  }();
+  state_->Rewind(mark);
+  return measured;
+}
+
 Result<MeasurePoint> ProjectMeasurer::PointOnSurface(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
   RECONAR_ASSIGN_OR_RETURN(const int index, state_->PlaceOnSurface(origin, direction, nullptr, "the picked point"));
   MeasurePoint point;
@@ -846,19 +881,23 @@ std::string MeasurementsJson(const MeasureSetup& setup, const std::vector<Measur
   json.Key("seconds_setup").Double(setup.seconds_setup);
   json.EndObject();
   json.Key("items").BeginArray();
-  for (const MeasuredItem& item : items) {
-    json.BeginObject().Key("kind").String(MeasureKindName(item.kind));
-    json.Key("point_names").BeginArray();
-    for (const std::string& text : item.point_texts) json.String(text);
-    json.EndArray();
-    json.Key("points").BeginArray();
-    for (const Eigen::Vector3d& p : item.points) json.BeginArray().Double(p.x()).Double(p.y()).Double(p.z()).EndArray();
-    json.EndArray();
-    json.Key("value").Double(item.value).Key("sigma").Double(item.sigma).Key("unit").String(item.unit);
-    json.EndObject();
-  }
+  for (const MeasuredItem& item : items) json.Raw(MeasuredItemJson(item));
   json.EndArray().EndObject();
   return json.str() + "\n";
+}
+
+std::string MeasuredItemJson(const MeasuredItem& item) {
+  JsonWriter json;
+  json.BeginObject().Key("kind").String(MeasureKindName(item.kind));
+  json.Key("point_names").BeginArray();
+  for (const std::string& text : item.point_texts) json.String(text);
+  json.EndArray();
+  json.Key("points").BeginArray();
+  for (const Eigen::Vector3d& p : item.points) json.BeginArray().Double(p.x()).Double(p.y()).Double(p.z()).EndArray();
+  json.EndArray();
+  json.Key("value").Double(item.value).Key("sigma").Double(item.sigma).Key("unit").String(item.unit);
+  json.EndObject();
+  return json.str();
 }
 
 }  // namespace reconar

@@ -34,6 +34,8 @@
 #include <Eigen/Core>
 
 #include "core/base/status.h"
+#include "core/math/radial_camera.h"
+#include "core/math/rigid3.h"
 #include "core/pipeline/project.h"
 
 namespace reconar {
@@ -125,6 +127,16 @@ class ProjectMeasurer {
   // nothing, FailedPrecondition when the project has no mesh.
   Result<MeasurePoint> PointOnSurface(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction);
 
+  // Reads the mesh and the dense points now rather than at the first pixel met with the surface
+  // (the view calls it before its first frame). Errors as a pixel point would have them.
+  Status LoadSurface();
+
+  // The view's measure: the distance between the surface points under two pixels of a frame
+  // taken by `camera` at `cam_from_world` (world frame), with its σ. The points are placed for
+  // this call only, so that a measure every frame does not grow the measurer.
+  Result<MeasuredItem> MeasureBetweenPixels(const Rigid3& cam_from_world, const RadialCamera& camera,
+                                            const Eigen::Vector2d& a, const Eigen::Vector2d& b);
+
   const MeasureSetup& setup() const { return setup_; }
 
  private:
@@ -134,8 +146,11 @@ class ProjectMeasurer {
   MeasureSetup setup_;
 };
 
-// {"metric": bool, "unit": ..., "setup": {...}, "items": [{"kind", "points": [[x,y,z]...],
-// "point_names": [...], "value", "sigma" (null when unknown), "unit"}]}.
+// One item on one line: {"kind", "point_names": [...], "points": [[x,y,z]...], "value", "sigma"
+// (null when infinite), "unit"}.
+std::string MeasuredItemJson(const MeasuredItem& item);
+
+// {"metric": bool, "setup": {...}, "items": [MeasuredItemJson...]}.
 std::string MeasurementsJson(const MeasureSetup& setup, const std::vector<MeasuredItem>& items);
 
 }  // namespace reconar

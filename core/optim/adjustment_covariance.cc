@@ -78,6 +78,7 @@ Result<AdjustmentCovariance> AdjustmentCovariance::Compute(const RadialProblem& 
     observations_of[static_cast<size_t>(problem.observations[k].point)].push_back(static_cast<int>(k));
   }
   covariance.points_.resize(observations_of.size());
+  covariance.adjusted_points_ = observations_of.size();
   covariance.cameras_ = problem.cameras;
   covariance.camera_unknowns_ = unknowns.of_camera;
   double weighted_squares = 0.0;
@@ -194,6 +195,11 @@ Result<int> AdjustmentCovariance::AddPoint(const Eigen::Vector3d& position, cons
                  &block);
   points_.push_back(std::move(block));
   return static_cast<int>(points_.size()) - 1;
+}
+
+void AdjustmentCovariance::RemoveAddedPoints(int count) {
+  const size_t keep = std::max(adjusted_points_, static_cast<size_t>(std::max(count, 0)));
+  if (keep < points_.size()) points_.resize(keep);
 }
 
 double AdjustmentCovariance::Variance(const std::vector<PointGradient>& gradients) const {

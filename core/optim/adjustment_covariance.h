@@ -67,6 +67,10 @@ class AdjustmentCovariance {
   Result<int> AddPoint(const Eigen::Vector3d& position, const std::vector<BalObservation>& observations,
                        const std::vector<Eigen::Matrix2d>& residual_projections = {});
 
+  // Drops the points added after the first `count` (AddPoint's), so that a caller adding points
+  // for one question at a time does not grow it. The adjusted points stay whatever `count` says.
+  void RemoveAddedPoints(int count);
+
   // The variance of a function of the points with these gradients (one entry per point it depends
   // on), including sigma0^2. A constant point contributes nothing; a point its observations do not
   // fix (fewer than two views, or all along one ray) makes it infinite.
@@ -87,6 +91,7 @@ class AdjustmentCovariance {
                         const std::vector<Eigen::Matrix2d>* residual_projections, Eigen::MatrixXd* s, PointBlock* block);
 
   std::vector<PointBlock> points_;
+  size_t adjusted_points_ = 0;  // the problem's; AddPoint's follow
   std::vector<double> cameras_;                                          // the problem's camera blocks
   std::vector<std::array<int, RadialProblem::kCameraSize>> camera_unknowns_;  // per camera parameter, -1: constant
   std::vector<int> row_of_;                                              // scratch: unknown -> row of a point's W

@@ -1,12 +1,15 @@
 #include "render/ar/ar_view.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
 #include "core/base/atomic_file.h"
 #include "core/base/median.h"
 #include "core/io/image_write.h"
+#include "render/ar/bitmap_text.h"
 
 namespace reconar {
 namespace {
@@ -25,6 +28,58 @@ std::string OutputName(const Frame& frame) {
 
 double MsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void SetPixel(int x, int y, const std::array<uint8_t, 3>& colour, Image<uint8_t>* rgb) {
+  if (x < 0 || y < 0 || x >= rgb->width() || y >= rgb->height()) return;
+  uint8_t* pixel = rgb->row(y) + 3 * x;
+  pixel[0] = colour[0];
+  pixel[1] = colour[1];
+  pixel[2] = colour[2];
+}
+
+// A line `width` pixels wide from a to b, and a ring round each end.
+void DrawMeasureLine(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const std::array<uint8_t, 3>& colour,
+                     Image<uint8_t>* rgb) {
+  const double length = (b - a).norm();
+  const int steps = std::max(1, static_cast<int>(2.0 * length));
+  for (int k = 0; k <= steps; ++k) {
+    const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(k) / steps);
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) SetPixel(static_cast<int>(std::lround(p.x())) + dx, static_cast<int>(std::lround(p.y())) + dy, colour, rgb);
+    }
+  }
+  for (const Eigen::Vector2d& end : {a, b}) {
+    for (int k = 0; k < 64; ++k) {
+      const double angle = 2.0 * M_PI * k / 64;
+      for (double radius : {6.0, 7.0}) {
+        SetPixel(static_cast<int>(std::lround(end.x() + radius * std::cos(angle))),
+                 static_cast<int>(std::lround(end.y() + radius * std::sin(angle))), colour, rgb);
+      }
+    }
+  }
+}
+
+// "0.1271 m +- 1.2 mm" (or the reason there is none) on a dark box beside the line's middle.
+void DrawMeasureLabel(const ViewMeasurement& measurement, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                      Image<uint8_t>* rgb) {
+  char text[96];
+  if (measurement.measured && measurement.item.unit == "m") {
+    std::snprintf(text, sizeof(text), "%.4f m +- %.1f mm", measurement.item.value, 1000.0 * measurement.item.sigma);
+  } else if (measurement.measured) {
+    std::snprintf(text, sizeof(text), "%.4g +- %.2g (model units)", measurement.item.value, measurement.item.sigma);
+  } else {
+    std::snprintf(text, sizeof(text), "no surface under a point");
+  }
+  const int scale = std::max(2, rgb->height() / 240);
+  const int width = TextWidthPx(text, scale), height = kGlyphHeight * scale;
+  const Eigen::Vector2d middle = 0.5 * (a + b);
+  const int x = std::clamp(static_cast<int>(middle.x()) - width / 2, 0, std::max(0, rgb->width() - width));
+  const int y = std::clamp(static_cast<int>(middle.y()) + 12, 0, std::max(0, rgb->height() - height - 2 * scale));
+  for (int row = y - scale; row < y + height + scale; ++row) {
+    for (int column = x - scale; column < x + width + scale; ++column) SetPixel(column, row, {0, 0, 0}, rgb);
+  }
+  DrawText(text, x, y, scale, {255, 255, 0}, rgb);
 }
 
 }  // namespace
@@ -76,8 +131,19 @@ Status ArView::Draw(bool* drawn_model) {
   RECONAR_RETURN_IF_ERROR(renderer_->BeginFrame());
   RECONAR_RETURN_IF_ERROR(renderer_->DrawBackground(session_->frame().rgb, 3));
   const WorldPose& pose = session_->pose();
+  measurement_ = ViewMeasurement();
   if (!pose.found) return Status::Ok();
   const CameraIntrinsics& intrinsics = session_->intrinsics();
+  if (options_.measurer && options_.measure_pixels) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::array<Eigen::Vector2d, 2>& pixels = *options_.measure_pixels;
+    Result<MeasuredItem> item =
+        options_.measurer->MeasureBetweenPixels(pose.cam_from_world, intrinsics.Camera(), pixels[0], pixels[1]);
+    measurement_.measured = item.ok();
+    if (item.ok()) measurement_.item = std::move(*item);
+    if (!item.ok()) measurement_.error = item.status().message();
+    measurement_.ms = MsSince(start);
+  }
   const Eigen::Matrix4d cam_from_model =
       options_.placement ? CamFromModel(pose.cam_from_world, *options_.placement) : pose.cam_from_world.Matrix();
   RECONAR_RETURN_IF_ERROR(renderer_->DrawMesh(model_, intrinsics, cam_from_model, options_.style));
@@ -101,6 +167,13 @@ Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& sessi
     if (drawn.ok()) {
       if (to_files) {
         drawn = renderer_->ReadRgb(&rgb_);
+        if (drawn.ok() && options_.measure_pixels && session.pose().found) {
+          const std::array<Eigen::Vector2d, 2>& pixels = *options_.measure_pixels;
+          const std::array<uint8_t, 3> colour = measurement_.measured ? std::array<uint8_t, 3>{255, 255, 0}
+                                                                       : std::array<uint8_t, 3>{255, 64, 64};
+          DrawMeasureLine(pixels[0], pixels[1], colour, &rgb_);
+          DrawMeasureLabel(measurement_, pixels[0], pixels[1], &rgb_);
+        }
       } else {
         drawn = renderer_->PresentToDefaultFramebuffer(context_->width(), context_->height());
         if (drawn.ok()) drawn = context_->SwapBuffers();

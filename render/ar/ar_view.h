@@ -3,6 +3,7 @@
 // OverlayRenderer: the video as background, the model at cam_from_world * world_from_model, the
 // axes of the world's tags in view; then shown in a window (X11, or full screen through GBM/KMS)
 // or written as one PNG per frame.
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -10,6 +11,7 @@
 
 #include "core/base/image.h"
 #include "core/base/status.h"
+#include "core/measure/measurement.h"
 #include "core/mesh/mesh.h"
 #include "platform/egl/egl_context.h"
 #include "render/ar/ar_session.h"
@@ -30,6 +32,18 @@ struct ArViewOptions {
   MeshStyle style;
   int samples = 0;  // multisample anti-aliasing (0 = off)
   bool draw_axes = true;
+  // Set with measure_pixels: each posed frame, the distance between the model's surface under these
+  // two pixels (the view's tap-to-measure), drawn into the PNGs with its σ.
+  std::shared_ptr<ProjectMeasurer> measurer;
+  std::optional<std::array<Eigen::Vector2d, 2>> measure_pixels;
+};
+
+// The frame's measure (ArViewOptions::measure_pixels).
+struct ViewMeasurement {
+  bool measured = false;  // false: no pose, or `error` says why
+  MeasuredItem item;
+  std::string error;
+  double ms = 0.0;  // placing the two points and measuring
 };
 
 struct ArViewReport {
@@ -55,6 +69,9 @@ class ArView {
   // pose and its sources).
   Result<ArViewReport> Run(const std::function<void(const ArSession& session)>& each_frame = nullptr);
 
+  // The last frame's measure, when ArViewOptions::measure_pixels is set.
+  const ViewMeasurement& measurement() const { return measurement_; }
+
  private:
   ArView(const ArViewOptions& options, std::unique_ptr<ArSession> session, std::unique_ptr<EglContext> context,
          std::unique_ptr<OverlayRenderer> renderer, MeshDrawable model);
@@ -68,6 +85,7 @@ class ArView {
   std::unique_ptr<OverlayRenderer> renderer_;
   MeshDrawable model_;
   Image<uint8_t> rgb_;
+  ViewMeasurement measurement_;
 };
 
 }  // namespace reconar

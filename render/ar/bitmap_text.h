@@ -1,7 +1,7 @@
 #pragma once
-// Words on the capture's preview without a font library: a built-in 5 x 7 pixel font (a cell of
-// 6 x 8 with the spacing), drawn on the CPU at an integer scale. It holds what the preview says:
-// lower-case letters, digits, space and : , . % / - ( ) '. Any other character is drawn as a
+// Words on the capture's preview and the view's measurements without a font library: a built-in
+// 5 x 7 pixel font (a cell of 6 x 8 with the spacing), drawn on the CPU at an integer scale. It
+// holds what they say: lower-case letters, digits, space and : , . % / - + ( ) '. Any other character is drawn as a
 // hollow box, so that a missing glyph shows instead of vanishing.
 #include <array>
 #include <cstdint>

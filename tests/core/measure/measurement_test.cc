@@ -198,6 +198,17 @@ TEST_F(MeasureTest, DistancesBetweenTagsPixelsAndWorldPointsAreTheScenesWithASig
   ASSERT_TRUE(tap_distance.ok()) << tap_distance.status().ToString();
   EXPECT_NEAR(tap_distance->value, (a - b).norm(), 1e-6);
   EXPECT_FALSE(measurer->PointOnSurface(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, 1)).ok());
+  // The view's measure: two pixels of a frame from a camera of the project's kind, repeated.
+  const Rigid3 frame_pose = CamFromWorldLookingAt(Eigen::Vector3d(0.1, 0.2, 2.5), Eigen::Vector3d(0.1, 0.2, 0.0),
+                                                  Eigen::Vector3d(0, 1, 0));
+  const RadialCamera& lens = model_.cameras[0];
+  const auto pixel_of = [&](const Eigen::Vector3d& p) { return lens.Project(frame_pose.rotation * p + frame_pose.translation); };
+  for (int frame = 0; frame < 3; ++frame) {
+    Result<MeasuredItem> on_screen = measurer->MeasureBetweenPixels(frame_pose, lens, pixel_of(a), pixel_of(b));
+    ASSERT_TRUE(on_screen.ok()) << on_screen.status().ToString();
+    EXPECT_NEAR(on_screen->value, (a - b).norm(), 1e-6);
+    EXPECT_GT(on_screen->sigma, 0.0);
+  }
   // From behind the wall: its back face is not a surface a photo saw.
   EXPECT_FALSE(measurer->PointOnSurface(Eigen::Vector3d(0.7, -0.4, -2.0), Eigen::Vector3d(0, 0, 1)).ok());
 }
