@@ -4,7 +4,6 @@
 
 #include "core/base/json_reader.h"
 #include "core/features/sift/sift_io.h"
-#include "core/math/rotation.h"
 #include "core/sfm/mapper_adjustment.h"
 #include "core/sfm/model_io.h"
 #include "core/sfm/tag_observations.h"
@@ -45,12 +44,7 @@ Result<ProjectCovariance> ComputeProjectCovariance(const Project& project) {
     if (!image.registered) continue;
     const int camera_index = problem.num_cameras();
     result.problem_camera[i] = camera_index;
-    const SfmCamera& camera = model.cameras[static_cast<size_t>(image.camera_id)];
-    const Eigen::Vector3d w = AngleAxisFromRotation(image.cam_from_world.rotation);
-    const Eigen::Vector3d& t = image.cam_from_world.translation;
-    const double block[12] = {w.x(),        w.y(),     w.z(),     t.x(),     t.y(),     t.z(),
-                              camera.focal, camera.k1, camera.k2, camera.cx, camera.cy, camera.aspect};
-    problem.cameras.insert(problem.cameras.end(), block, block + 12);
+    AppendCameraBlock(image, model.cameras[static_cast<size_t>(image.camera_id)], &problem);
     constancy.intrinsics_group.push_back(image.camera_id);
     RECONAR_ASSIGN_OR_RETURN(const FeatureFile features, ReadFeatureFile(project.MatchedFeaturePath(image.name)));
     for (const SiftKeypoint& keypoint : features.features.keypoints) scales[i].push_back(keypoint.scale);

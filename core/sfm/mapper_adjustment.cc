@@ -26,6 +26,14 @@ double ObservationWeight(const std::vector<MapperImage>& images, const TrackElem
 
 }  // namespace
 
+void AppendCameraBlock(const SfmImage& image, const SfmCamera& camera, RadialProblem* problem) {
+  const Eigen::Vector3d w = AngleAxisFromRotation(image.cam_from_world.rotation);
+  const Eigen::Vector3d& t = image.cam_from_world.translation;
+  const double block[12] = {w.x(),        w.y(),     w.z(),     t.x(),     t.y(),     t.z(),
+                            camera.focal, camera.k1, camera.k2, camera.cx, camera.cy, camera.aspect};
+  problem->cameras.insert(problem->cameras.end(), block, block + 12);
+}
+
 double ScaleWeight(double keypoint_scale, const MapperOptions& options) {
   if (!options.weight_by_scale) return 1.0;
   return keypoint_scale > options.base_scale_px ? options.base_scale_px / keypoint_scale : 1.0;
@@ -64,12 +72,7 @@ Result<double> BundleAdjust(MapperModel* model, const std::vector<MapperImage>& 
   }
   for (int image : image_of_slot) {
     const SfmImage& img = rec.images[static_cast<size_t>(image)];
-    const SfmCamera& cam = rec.cameras[static_cast<size_t>(img.camera_id)];
-    const Eigen::Vector3d w = AngleAxisFromRotation(img.cam_from_world.rotation);
-    const Eigen::Vector3d& t = img.cam_from_world.translation;
-    const double block[12] = {w.x(),     w.y(),  w.z(),  t.x(),  t.y(),  t.z(),
-                              cam.focal, cam.k1, cam.k2, cam.cx, cam.cy, cam.aspect};
-    problem.cameras.insert(problem.cameras.end(), block, block + 12);
+    AppendCameraBlock(img, rec.cameras[static_cast<size_t>(img.camera_id)], &problem);
   }
   BundleAdjustmentOptions solver;
   solver.max_iterations = adjustment.iterations;

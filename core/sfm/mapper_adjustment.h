@@ -6,8 +6,10 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/optim/bal_problem.h"
 #include "core/sfm/mapper.h"
 #include "core/sfm/mapper_model.h"
+#include "core/sfm/reconstruction.h"
 
 namespace reconar {
 
@@ -38,6 +40,10 @@ struct MapperAdjustment {
 Result<double> BundleAdjust(MapperModel* model, const std::vector<MapperImage>& images,
                             const std::vector<int>& variable, const MapperAdjustment& adjustment,
                             const MapperOptions& options, MapperReport* report);
+
+// Appends the image's pose and its camera's intrinsics as the bundle adjuster's camera block
+// (angle-axis, translation, focal, k1, k2, cx, cy, aspect: core/optim/radial_camera_model.h).
+void AppendCameraBlock(const SfmImage& image, const SfmCamera& camera, RadialProblem* problem);
 
 // The weight of an observation of a keypoint detected at `keypoint_scale` (MapperOptions::
 // weight_by_scale: base_scale_px / scale above the base scale, else 1); a keypoint with a weight
