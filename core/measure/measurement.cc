@@ -66,8 +66,10 @@ double ItemValue(MeasureKind kind, const std::vector<Eigen::Vector3d>& p) {
       return 0.5 * twice_area.norm();
     }
     case MeasureKind::kHeight: {
-      const Eigen::Vector3d normal = (p[2] - p[1]).cross(p[3] - p[1]).normalized();
-      return normal.dot(p[0] - p[1]);
+      const Eigen::Vector3d normal = (p[2] - p[1]).cross(p[3] - p[1]);
+      const double scale = std::max((p[2] - p[1]).squaredNorm(), (p[3] - p[1]).squaredNorm());
+      if (!(normal.norm() > 1e-9 * scale)) return kNaN;  // the plane's points on one line
+      return normal.normalized().dot(p[0] - p[1]);
     }
   }
   return kNaN;

@@ -188,6 +188,10 @@ TEST_F(MeasureTest, DistancesBetweenTagsPixelsAndWorldPointsAreTheScenesWithASig
   Result<MeasuredItem> above = measurer->Measure(height);
   ASSERT_TRUE(above.ok()) << above.status().ToString();
   EXPECT_NEAR(above->value, 0.35, 1e-9);
+  height.points[3] = *ParseMeasurePoint("tag:0:c0");  // a plane through two points only
+  Result<MeasuredItem> no_plane = measurer->Measure(height);
+  EXPECT_EQ(no_plane.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(no_plane.status().message().find("on one line"), std::string::npos) << no_plane.status().message();
 
   // The view's tap: a ray from above the wall.
   Result<MeasurePoint> tapped = measurer->PointOnSurface(Eigen::Vector3d(0.7, -0.4, 2.0), Eigen::Vector3d(0, 0, -1));
