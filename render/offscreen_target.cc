@@ -109,6 +109,30 @@ Status OffscreenTarget::ReadRgb(Image<uint8_t>* rgb) {
   return CheckGlError("OffscreenTarget::ReadRgb");
 }
 
+Letterbox LetterboxIn(int image_width, int image_height, int window_width, int window_height) {
+  Letterbox box;
+  if (image_width <= 0 || image_height <= 0 || window_width <= 0 || window_height <= 0) return box;
+  const double scale =
+      std::min(static_cast<double>(window_width) / image_width, static_cast<double>(window_height) / image_height);
+  box.width = static_cast<int>(image_width * scale + 0.5);
+  box.height = static_cast<int>(image_height * scale + 0.5);
+  box.x0 = (window_width - box.width) / 2;
+  box.y0 = (window_height - box.height) / 2;
+  return box;
+}
+
+bool Letterbox::ImagePixel(int image_width, int image_height, double x, double y, double* image_x,
+                           double* image_y) const {
+  if (width <= 0 || height <= 0) return false;
+  // Window pixel centres at +0.5; image pixel centres at integers.
+  const double u = (x + 0.5 - x0) * image_width / width - 0.5;
+  const double v = (y + 0.5 - y0) * image_height / height - 0.5;
+  if (!(u >= -0.5 && v >= -0.5 && u <= image_width - 0.5 && v <= image_height - 0.5)) return false;
+  *image_x = u;
+  *image_y = v;
+  return true;
+}
+
 Status OffscreenTarget::PresentToDefaultFramebuffer(int window_width, int window_height) {
   if (window_width <= 0 || window_height <= 0) {
     return InvalidArgument("OffscreenTarget::PresentToDefaultFramebuffer: window size " + std::to_string(window_width) +
@@ -120,15 +144,11 @@ Status OffscreenTarget::PresentToDefaultFramebuffer(int window_width, int window
   glDisable(GL_SCISSOR_TEST);
   glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
-  // Largest rectangle of the image's aspect ratio inside the window, centred.
-  const double scale =
-      std::min(static_cast<double>(window_width) / width_, static_cast<double>(window_height) / height_);
-  const int shown_width = static_cast<int>(width_ * scale + 0.5);
-  const int shown_height = static_cast<int>(height_ * scale + 0.5);
-  const int x0 = (window_width - shown_width) / 2;
-  const int y0 = (window_height - shown_height) / 2;
-  // Our row 0 is the image's top; the window's row 0 is its bottom: swap the destination rows.
-  glBlitFramebuffer(0, 0, width_, height_, x0, y0 + shown_height, x0 + shown_width, y0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  const Letterbox box = LetterboxIn(width_, height_, window_width, window_height);
+  // Our row 0 is the image's top; the window's row 0 is its bottom: swap the destination rows (the
+  // box is centred, so its offset from the bottom is its offset from the top).
+  glBlitFramebuffer(0, 0, width_, height_, box.x0, box.y0 + box.height, box.x0 + box.width, box.y0, GL_COLOR_BUFFER_BIT,
+                    GL_LINEAR);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return CheckGlError("OffscreenTarget::PresentToDefaultFramebuffer");
 }

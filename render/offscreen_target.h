@@ -11,6 +11,17 @@
 
 namespace reconar {
 
+// Where PresentToDefaultFramebuffer shows an image in a window: the largest rectangle of the
+// image's aspect ratio, centred (window pixels, row 0 at the top).
+struct Letterbox {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+
+  // The image pixel (centre of the top-left pixel at 0, 0) under the window pixel (x, y), or
+  // false when (x, y) is outside the image.
+  bool ImagePixel(int image_width, int image_height, double x, double y, double* image_x, double* image_y) const;
+};
+Letterbox LetterboxIn(int image_width, int image_height, int window_width, int window_height);
+
 class OffscreenTarget {
  public:
   // Needs a current GLES 3 context. `samples` is clamped to GL_MAX_SAMPLES; 0 = single-sampled.

@@ -59,7 +59,8 @@ constexpr char kHelp[] =
     "  --window auto|x11|gbm (default auto)\n"
     "  --max-frames N        stop after N frames\n"
     "  --measure \"X1,Y1 X2,Y2\"  with --project: each frame, the distance +- sigma between the model's\n"
-    "                        surface under these two pixels, drawn into --out's PNGs and in --json\n";
+    "                        surface under these two pixels, drawn and in --json (in a window: click\n"
+    "                        two points instead)\n";
 
 Result<Eigen::Vector3d> ParseAxis(const std::string& text) {
   const bool negative = !text.empty() && text[0] == '-';
@@ -170,8 +171,7 @@ int RunView(int argc, char** argv, int first) {
   const bool json = args.Has("json");
   auto report = (*view)->Run([&](const ArSession& frame) {
     if (json) {
-      const std::string line = ArFrameJson(frame);
-      std::printf("%s\n", options.measure_pixels ? WithMeasurement(line, (*view)->measurement()).c_str() : line.c_str());
+      std::printf("%s\n", WithMeasurement(ArFrameJson(frame), (*view)->measurement()).c_str());
       std::fflush(stdout);
     }
     if (stderr_is_terminal && frame.frames() % 10 == 0) {

@@ -9,8 +9,10 @@
 // kAuto picks kX11Window when DISPLAY is set, else kGbm when /dev/dri exists, else kSurfaceless.
 // The context is made current on the creating thread; use the object from that thread only.
 // This header does not include EGL or X11 headers (X11 macros such as Status would clash).
+#include <array>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/base/status.h"
 
@@ -45,6 +47,9 @@ struct WindowEvents {
   bool close_requested = false;  // the window manager's close button (WM_DELETE_WINDOW)
   bool quit_key = false;         // 'q' or Escape pressed in the window
   bool resized = false;          // width() / height() changed
+  // Presses of the first button (a mouse click, or a touch the window system turns into one),
+  // window pixels (x, y) with row 0 at the top, in order.
+  std::vector<std::array<int, 2>> taps;
 
   bool should_quit() const { return close_requested || quit_key; }
 };

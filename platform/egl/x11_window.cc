@@ -45,7 +45,7 @@ class X11Window final : public NativeOutput {
     colormap_ = XCreateColormap(display_, root, visual->visual, AllocNone);
     XSetWindowAttributes attributes{};
     attributes.colormap = colormap_;
-    attributes.event_mask = KeyPressMask | StructureNotifyMask | ExposureMask;
+    attributes.event_mask = KeyPressMask | ButtonPressMask | StructureNotifyMask | ExposureMask;
     window_ = XCreateWindow(display_, root, 0, 0, static_cast<unsigned>(width_), static_cast<unsigned>(height_), 0,
                             visual->depth, InputOutput, visual->visual, CWColormap | CWEventMask, &attributes);
     XFree(visual);
@@ -68,6 +68,8 @@ class X11Window final : public NativeOutput {
       } else if (event.type == KeyPress) {
         const KeySym key = XLookupKeysym(&event.xkey, 0);
         if (key == XK_q || key == XK_Escape) events.quit_key = true;
+      } else if (event.type == ButtonPress && event.xbutton.button == Button1) {
+        events.taps.push_back({event.xbutton.x, event.xbutton.y});
       } else if (event.type == ConfigureNotify) {
         if (event.xconfigure.width != width_ || event.xconfigure.height != height_) {
           width_ = event.xconfigure.width;

@@ -155,6 +155,32 @@ Status ArView::Draw(bool* drawn_model) {
   return Status::Ok();
 }
 
+void ArView::DrawMeasureMarks() {
+  if (!options_.measure_pixels) {
+    DrawMeasureLine(*first_tap_, *first_tap_, {255, 255, 0}, &rgb_);
+    return;
+  }
+  const std::array<Eigen::Vector2d, 2>& pixels = *options_.measure_pixels;
+  const std::array<uint8_t, 3> colour =
+      measurement_.measured ? std::array<uint8_t, 3>{255, 255, 0} : std::array<uint8_t, 3>{255, 64, 64};
+  DrawMeasureLine(pixels[0], pixels[1], colour, &rgb_);
+  DrawMeasureLabel(measurement_, pixels[0], pixels[1], &rgb_);
+}
+
+void ArView::TakeTaps(const std::vector<std::array<int, 2>>& taps) {
+  const Letterbox box = LetterboxIn(renderer_->width(), renderer_->height(), context_->width(), context_->height());
+  for (const std::array<int, 2>& tap : taps) {
+    Eigen::Vector2d pixel;
+    if (!box.ImagePixel(renderer_->width(), renderer_->height(), tap[0], tap[1], &pixel.x(), &pixel.y())) continue;
+    if (first_tap_ && !options_.measure_pixels) {  // the second tap: measure from the first
+      options_.measure_pixels = std::array<Eigen::Vector2d, 2>{*first_tap_, pixel};
+    } else {  // the first, or a third that starts again
+      first_tap_ = pixel;
+      options_.measure_pixels.reset();
+    }
+  }
+}
+
 Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& session)>& each_frame) {
   const bool to_files = !options_.out_dir.empty();
   std::vector<double> render_ms, frame_ms;
@@ -165,17 +191,18 @@ Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& sessi
     Status drawn = Draw(&drawn_model);
     if (drawn_model) ++report.frames_with_model;
     if (drawn.ok()) {
+      const bool marks = session.pose().found && (options_.measure_pixels || first_tap_);
       if (to_files) {
         drawn = renderer_->ReadRgb(&rgb_);
-        if (drawn.ok() && options_.measure_pixels && session.pose().found) {
-          const std::array<Eigen::Vector2d, 2>& pixels = *options_.measure_pixels;
-          const std::array<uint8_t, 3> colour = measurement_.measured ? std::array<uint8_t, 3>{255, 255, 0}
-                                                                       : std::array<uint8_t, 3>{255, 64, 64};
-          DrawMeasureLine(pixels[0], pixels[1], colour, &rgb_);
-          DrawMeasureLabel(measurement_, pixels[0], pixels[1], &rgb_);
-        }
+        if (drawn.ok() && marks) DrawMeasureMarks();
       } else {
-        drawn = renderer_->PresentToDefaultFramebuffer(context_->width(), context_->height());
+        if (marks) {  // the marks are drawn on the CPU: read the frame back, mark it, show that
+          drawn = renderer_->ReadRgb(&rgb_);
+          if (drawn.ok()) DrawMeasureMarks();
+          if (drawn.ok()) drawn = renderer_->BeginFrame();
+          if (drawn.ok()) drawn = renderer_->DrawBackground(static_cast<const Image<uint8_t>&>(rgb_).view(), 3);
+        }
+        if (drawn.ok()) drawn = renderer_->PresentToDefaultFramebuffer(context_->width(), context_->height());
         if (drawn.ok()) drawn = context_->SwapBuffers();
       }
     }
@@ -185,7 +212,10 @@ Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& sessi
     if (!drawn.ok()) return drawn.WithContext(name);
     if (to_files) RECONAR_RETURN_IF_ERROR(WritePng(options_.out_dir + "/" + name, rgb_.view(), 3));
     if (each_frame) each_frame(session);
-    return to_files || !context_->PollEvents().should_quit();
+    if (to_files) return true;
+    const WindowEvents events = context_->PollEvents();
+    if (options_.measurer) TakeTaps(events.taps);
+    return !events.should_quit();
   };
   RECONAR_ASSIGN_OR_RETURN(report.session, session_->Run(draw_frame));
   report.median_render_ms = Median(std::move(render_ms));

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/base/image.h"
 #include "core/base/status.h"
@@ -33,7 +34,8 @@ struct ArViewOptions {
   int samples = 0;  // multisample anti-aliasing (0 = off)
   bool draw_axes = true;
   // Set with measure_pixels: each posed frame, the distance between the model's surface under these
-  // two pixels (the view's tap-to-measure), drawn into the PNGs with its σ.
+  // two pixels (the view's tap-to-measure), drawn with its σ into the PNGs or the window. In a
+  // window without measure_pixels, two clicks (taps) on the picture set them, a third starts again.
   std::shared_ptr<ProjectMeasurer> measurer;
   std::optional<std::array<Eigen::Vector2d, 2>> measure_pixels;
 };
@@ -85,7 +87,13 @@ class ArView {
   std::unique_ptr<OverlayRenderer> renderer_;
   MeshDrawable model_;
   Image<uint8_t> rgb_;
+  // The line between the measured pixels (or the ring of a first tap) and the label, into rgb_.
+  void DrawMeasureMarks();
+  // Window clicks, in window pixels, into measure pixels (see ArViewOptions::measurer).
+  void TakeTaps(const std::vector<std::array<int, 2>>& taps);
+
   ViewMeasurement measurement_;
+  std::optional<Eigen::Vector2d> first_tap_;
 };
 
 }  // namespace reconar
