@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "platform/egl/native_output.h"
+#include "platform/input/touch_input.h"
 
 namespace reconar {
 namespace {
@@ -116,7 +117,16 @@ class KmsOutput final : public NativeOutput {
   int height() const override { return path_.mode.vdisplay; }
   void* native_window() override { return surface_; }
 
+  // A touch screen's taps, when there is one that can be read (else none: the view still runs).
+  WindowEvents PollEvents() override {
+    WindowEvents events;
+    if (touch_ != nullptr) touch_->Poll(&events.taps);
+    return events;
+  }
+
   Status CreateWindow(EGLint) override {
+    Result<std::unique_ptr<TouchInput>> touch = TouchInput::Open(width(), height());
+    if (touch.ok()) touch_ = std::move(*touch);
     surface_ = gbm_surface_create(gbm_, path_.mode.hdisplay, path_.mode.vdisplay, GBM_FORMAT_XRGB8888,
                                   GBM_BO_USE_SCANOUT | GBM_BO_USE_RENDERING);
     if (surface_ == nullptr) {
@@ -196,6 +206,7 @@ class KmsOutput final : public NativeOutput {
   gbm_surface* surface_ = nullptr;
   gbm_bo* front_ = nullptr;            // the buffer on screen, released after the next flip
   drmModeCrtc* saved_crtc_ = nullptr;  // the mode before ours, restored on destruction
+  std::unique_ptr<TouchInput> touch_;
 };
 
 }  // namespace
