@@ -675,11 +675,12 @@ struct ProjectMeasurer::State {
       scale_corners.insert(scale_corners.end(), corners.begin(), corners.end());
     }
     setup->scale_tags = complete;
-    if (!complete.empty()) scale_mean_ = ScaleMean(nullptr);
     if (complete.empty()) {
       metric = false;
       return;
     }
+    scale_mean_ = ScaleMean(nullptr);
+    const double mean = scale_mean_;
     std::vector<double> edges;
     for (size_t t = 0; t < scale_corners.size(); t += 4) {
       for (size_t k = 0; k < 4; ++k) {
@@ -687,8 +688,7 @@ struct ProjectMeasurer::State {
                          positions[static_cast<size_t>(scale_corners[t + k])]).norm());
       }
     }
-    double mean = 0.0, spread = 0.0;
-    for (double e : edges) mean += e / static_cast<double>(edges.size());
+    double spread = 0.0;
     for (double e : edges) spread += (e - mean) * (e - mean) / static_cast<double>(edges.size() - 1);
     scale_relative_sigma = std::sqrt(spread) / mean / std::sqrt(static_cast<double>(edges.size()));
     setup->scale_relative_sigma = scale_relative_sigma;
