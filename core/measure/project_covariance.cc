@@ -53,9 +53,7 @@ Result<ProjectCovariance> ComputeProjectCovariance(const Project& project) {
     if (tags == tags_of_image.end()) continue;
     for (const TagCornerKeypoint& corner :
          TagCornerKeypointsOfImage(static_cast<int>(i), *tags->second, static_cast<int>(scales[i].size()))) {
-      const TagObservation& tag = *std::find_if(tags->second->begin(), tags->second->end(),
-                                                [&](const TagObservation& o) { return o.tag_id == corner.tag_id; });
-      const Eigen::Vector2d& pixel = tag.corners[static_cast<size_t>(corner.corner)];
+      const Eigen::Vector2d& pixel = corner.pixel;
       TagCornerInModel& in_model = result.tag_corners[{corner.tag_id, corner.corner}];
       in_model.observations.push_back({camera_index, -1, pixel.x(), pixel.y(), kTagCornerWeight});
       const auto keypoint = static_cast<size_t>(corner.keypoint_id);

@@ -176,7 +176,7 @@ std::vector<TagCornerKeypoint> TagCornerKeypointsOfImage(int image_id, const std
   int keypoint = first_keypoint;
   for (const TagObservation& tag : tags) {
     if (count[tag.tag_id] != 1) continue;
-    for (int k = 0; k < 4; ++k) corners.push_back({image_id, keypoint++, tag.tag_id, k});
+    for (int k = 0; k < 4; ++k) corners.push_back({image_id, keypoint++, tag.tag_id, k, tag.corners[static_cast<size_t>(k)]});
   }
   return corners;
 }
@@ -196,9 +196,7 @@ std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vect
         first_keypoint[i][corner.tag_id] = corner.keypoint_id;
         image.tags.push_back({corner.tag_id, corner.keypoint_id});
       }
-      const auto& tag = *std::find_if(observations[i].begin(), observations[i].end(),
-                                      [&](const TagObservation& t) { return t.tag_id == corner.tag_id; });
-      image.keypoints.push_back(tag.corners[static_cast<size_t>(corner.corner)]);
+      image.keypoints.push_back(corner.pixel);
       if (!image.keypoint_scales.empty()) image.keypoint_scales.push_back(static_cast<float>(keypoint_scale));
       image.keypoint_weights.push_back(static_cast<float>(corner_weight));
     }

@@ -39,6 +39,7 @@ struct TagCornerKeypoint {
   int keypoint_id = -1;
   int tag_id = -1;
   int corner = -1;  // 0..3, kTagCornerUnits order
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // where the image shows it
 };
 
 // Bundle-adjustment weight of a tag corner against a keypoint detected at the base scale: the
