@@ -21,6 +21,8 @@ constexpr char kHelp[] =
     "  --tag-size M          edge of the tags' black square in metres; enables tag registration\n"
     "  --tag-family F        tag36h11 (default), tag25h9, tag16h5, tagStandard41h12, tagCircle21h7\n"
     "  --world-tag ID        the tag whose frame is the world frame (default: the lowest id seen)\n"
+    "  --layout FILE         the world frame of a tag layout (tags.layout format, e.g. another\n"
+    "                        project's): fitted to every reconstructed tag it holds\n"
     "  --scale-tags IDS      only these tags' size sets the scale, e.g. 0-9,12 (default: every tag);\n"
     "                        the others still register and check it (tags.json held_out_*)\n"
     "  --no-tags-in-ba       only triangulate the tags from the final cameras (not as constraints)\n"

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/base/atomic_file.h"
+#include "core/sfm/tag_layout.h"
 #include "tools/commands.h"
 #include "tracker/photo_tags.h"
 #ifdef RECONAR_HAVE_VIEW
@@ -21,7 +22,7 @@ std::set<std::string> ValuedOptions() {
   std::set<std::string> valued = kSiftValuedOptions;
   valued.insert(kMatchValuedOptions.begin(), kMatchValuedOptions.end());
   valued.insert(kDenseValuedOptions.begin(), kDenseValuedOptions.end());
-  valued.insert({"tag-size", "tag-family", "world-tag", "scale-tags", "memory-budget", "stages", "depth", "trim",
+  valued.insert({"tag-size", "tag-family", "world-tag", "scale-tags", "layout", "memory-budget", "stages", "depth", "trim",
                  "max-faces", "formats", "principal-point", "max-error"});
   return valued;
 }
@@ -111,6 +112,11 @@ Result<ReconstructOptions> ReconstructOptionsFromArgs(const Args& args) {
   RECONAR_ASSIGN_OR_RETURN(options.sfm.tags.registration.scale_tags, args.GetIdList("scale-tags"));
   if (!options.sfm.tags.registration.scale_tags.empty() && !args.Has("tag-size")) {
     return InvalidArgument("--scale-tags needs --tag-size");
+  }
+  if (args.Has("layout")) {
+    if (!args.Has("tag-size")) return InvalidArgument("--layout needs --tag-size");
+    if (args.Has("world-tag")) return InvalidArgument("--layout and --world-tag both choose the world frame: give one");
+    RECONAR_ASSIGN_OR_RETURN(options.sfm.tags.registration.layout, ReadTagLayout(args.Get("layout")));
   }
   RECONAR_ASSIGN_OR_RETURN(options.num_threads, args.GetThreads());
   RECONAR_ASSIGN_OR_RETURN(options.memory_budget_bytes, args.GetMemoryBudget(options.memory_budget_bytes));

@@ -15,13 +15,15 @@
 namespace reconar {
 namespace {
 
-// "metres, world tag N" and true when tags.json says the model is metric.
+// "metres, world tag N" (or the declared layout's frame) and true when tags.json says the model is metric.
 std::pair<std::string, bool> ModelFrame(const Project& project) {
   auto tags = ReadJsonFile(project.TagsJsonPath());
   if (!tags.ok()) return {"arbitrary", false};
   const JsonValue* metric = tags->Find("metric");
   const JsonValue* world_tag = tags->Find("world_tag");
   if (metric == nullptr || !metric->is_bool() || !metric->bool_value()) return {"arbitrary", false};
+  const JsonValue* frame = tags->Find("frame");
+  if (frame != nullptr && frame->is_string() && frame->string() == "layout") return {"metres, the declared layout's frame", true};
   const int tag = world_tag != nullptr && world_tag->is_number() ? static_cast<int>(world_tag->number()) : 0;
   return {"metres, world tag " + std::to_string(tag), true};
 }

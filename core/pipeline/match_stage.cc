@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/base/atomic_file.h"
+#include "core/base/fnv_hash.h"
 #include "core/base/json_writer.h"
 #include "core/base/log.h"
 #include "core/base/progress.h"
@@ -67,15 +68,13 @@ Result<std::vector<std::pair<int, int>>> ChoosePairs(const Project& project, con
 
 std::string ExtractAgainDigest(const std::map<std::string, std::string>& names) {
   if (names.empty()) return "";
-  uint64_t hash = 0xcbf29ce484222325ull;
+  Fnv1a64 hash;
   for (const auto& entry : names) {
-    for (const char c : entry.first + '\n') {
-      hash ^= static_cast<unsigned char>(c);
-      hash *= 0x100000001b3ull;
-    }
+    hash.Add(entry.first);
+    hash.Add("\n");
   }
   char text[40];
-  std::snprintf(text, sizeof(text), " again=%zu:%016llx", names.size(), static_cast<unsigned long long>(hash));
+  std::snprintf(text, sizeof(text), " again=%zu:%016llx", names.size(), static_cast<unsigned long long>(hash.value()));
   return text;
 }
 

@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <set>
 
 #include "core/base/atomic_file.h"
 #include "core/base/elapsed.h"
+#include "core/base/fnv_hash.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/features/sift/sift_io.h"
@@ -16,6 +19,7 @@
 #include "core/pipeline/matches_file.h"
 #include "core/pipeline/stage_record.h"
 #include "core/sfm/model_io.h"
+#include "core/sfm/tag_layout.h"
 
 namespace reconar {
 namespace {
@@ -172,6 +176,15 @@ std::string SfmStageSettings(const SfmStageOptions& options) {
     std::string ids;
     for (int id : options.tags.registration.scale_tags) ids += (ids.empty() ? "" : ",") + std::to_string(id);
     if (!ids.empty()) settings += " scale_tags=" + ids;
+    const TagLayout& layout = options.tags.registration.layout;
+    if (!layout.empty()) {
+      Fnv1a64 hash;
+      hash.Add(FormatTagLayout(layout.tags()));
+      char text[40];
+      std::snprintf(text, sizeof(text), " layout=%zu:%016llx", layout.tags().size(),
+                    static_cast<unsigned long long>(hash.value()));
+      settings += text;
+    }
   }
   return settings;
 }
@@ -218,6 +231,17 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
                          "image " + image.image_name + " is missing from " + project.ImageListPath());
       }
       tag_observations[static_cast<size_t>(it->second)] = image.tags;
+    }
+    const TagLayout& layout = options.tags.registration.layout;
+    if (!layout.empty()) {
+      std::set<int> detected;
+      for (const ImageTagObservations& image : detections.images) {
+        for (const TagObservation& tag : image.tags) detected.insert(tag.tag_id);
+      }
+      if (std::none_of(detected.begin(), detected.end(), [&](int id) { return layout.Find(id) != nullptr; })) {
+        return InvalidArgument("the layout holds none of the tags detected in the photos (" +
+                               std::to_string(detected.size()) + " ids, " + project.TagDetectionsPath() + ")");
+      }
     }
     if (options.tags.in_adjustment) {
       corner_keypoints = AddTagCorrespondences(tag_observations, options.mapper.base_scale_px, kTagCornerWeight,

@@ -340,10 +340,38 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
                            " was not reconstructed; complete tags: " + complete_ids());
   }
   report.metres_per_model_unit = options.tag_size_m / mean_edge;
-  RECONAR_ASSIGN_OR_RETURN(report.world_from_model,
-                           AlignSimilarity(AsVector(RigidTagCorners(*rec, seen.at(world->id), world->corners, mean_edge,
-                                                                    options.max_reprojection_error_px)),
-                                           AsVector(IdealCorners(options.tag_size_m)), report.metres_per_model_unit));
+  if (options.layout.empty()) {
+    RECONAR_ASSIGN_OR_RETURN(report.world_from_model,
+                             AlignSimilarity(AsVector(RigidTagCorners(*rec, seen.at(world->id), world->corners, mean_edge,
+                                                                      options.max_reprojection_error_px)),
+                                             AsVector(IdealCorners(options.tag_size_m)), report.metres_per_model_unit));
+  } else {
+    // Every complete tag of the layout, its four corners onto their places there: the frame is
+    // then as good as all those tags together, not one tag's corners.
+    std::vector<Eigen::Vector3d> model_corners, layout_corners;
+    for (const ModelTag& tag : complete) {
+      const LayoutTag* placed = options.layout.Find(tag.id);
+      if (placed == nullptr) continue;
+      report.layout_tags.push_back(tag.id);
+      const std::array<Eigen::Vector3d, 4> ideal = IdealCorners(placed->size);
+      for (size_t k = 0; k < 4; ++k) {
+        model_corners.push_back(tag.corners[k]);
+        layout_corners.push_back(placed->layout_from_tag * ideal[k]);
+      }
+    }
+    if (report.layout_tags.empty()) {
+      return InvalidArgument("tag registration: the layout holds none of the reconstructed tags (" + complete_ids() + ")");
+    }
+    RECONAR_ASSIGN_OR_RETURN(report.world_from_model,
+                             AlignSimilarity(model_corners, layout_corners, report.metres_per_model_unit));
+    double squares = 0.0;
+    for (size_t i = 0; i < model_corners.size(); ++i) {
+      const double distance = (report.world_from_model.Apply(model_corners[i]) - layout_corners[i]).norm();
+      squares += distance * distance;
+      report.layout_max_m = std::max(report.layout_max_m, distance);
+    }
+    report.layout_rms_m = std::sqrt(squares / static_cast<double>(model_corners.size()));
+  }
   const auto world_from_tag = [&](const std::array<Eigen::Vector3d, 4>& model_corners) -> std::optional<Rigid3> {
     std::vector<Eigen::Vector3d> corners;
     for (const Eigen::Vector3d& c : model_corners) corners.push_back(report.world_from_model.Apply(c));
@@ -407,6 +435,14 @@ std::string TagRegistrationJson(const TagRegistrationReport& report, const std::
   json.Key("family").String(family);
   json.Key("tag_size_m").Double(tag_size_m);
   json.Key("world_tag").Int(report.world_tag);
+  json.Key("frame").String(report.layout_tags.empty() ? "world_tag" : "layout");
+  if (!report.layout_tags.empty()) {
+    json.Key("layout_tags").BeginArray();
+    for (int id : report.layout_tags) json.Int(id);
+    json.EndArray();
+    json.Key("layout_rms_m").Double(report.layout_rms_m);
+    json.Key("layout_max_m").Double(report.layout_max_m);
+  }
   json.Key("tags_seen").Int(report.tags_seen);
   json.Key("metres_per_model_unit").Double(report.metres_per_model_unit);
   json.Key("scale_tags").BeginArray();

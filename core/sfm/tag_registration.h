@@ -29,6 +29,7 @@
 #include "core/math/sim3.h"
 #include "core/sfm/mapper.h"
 #include "core/sfm/reconstruction.h"
+#include "core/sfm/tag_layout.h"
 #include "core/sfm/tag_observations.h"
 
 namespace reconar {
@@ -65,6 +66,10 @@ struct TagRegistrationOptions {
   double tag_size_m = 0.0;                 // edge of the black square (libapriltag's width_at_border), > 0
   int world_tag = -1;                      // the tag whose frame becomes the world frame; -1: the lowest complete id
   std::vector<int> scale_tags;             // the tags whose size sets the scale; empty: every complete tag
+  // A layout the user declares (tag_layout.h, e.g. an earlier project's tags.layout or a survey):
+  // when it holds any complete tag, the world frame is the layout's, fitted to every complete tag
+  // it holds (their corners, rigidly, at the scale the scale tags set), instead of the world tag's.
+  TagLayout layout;
   int min_views = 2;                       // registered views a corner needs to be triangulated
   double max_reprojection_error_px = 4.0;  // a triangulated corner's observations beyond this are dropped
 
@@ -87,6 +92,10 @@ struct TagRegistrationReport {
   bool metric = false;
   std::string reason;
   int world_tag = -1;
+  // With a layout: the complete tags it holds, that fixed the frame, and the distances of their
+  // corners from their places in the layout after the fit (metres).
+  std::vector<int> layout_tags;
+  double layout_rms_m = 0.0, layout_max_m = 0.0;
   int tags_seen = 0;                 // distinct ids detected in registered images
   double metres_per_model_unit = 0;  // the scale applied
   std::vector<int> scale_tags;       // the complete tags that set it
@@ -102,13 +111,14 @@ struct TagRegistrationReport {
 
 // observations[i] are the tags seen in rec->images[i]; `corner_keypoints` (may be empty) says which
 // of their keypoints carry corners. On success with report.metric, *rec is moved into the world
-// frame (points, poses; intrinsics are unchanged). InvalidArgument for bad options or when the
-// requested world tag is not among the complete tags.
+// frame (points, poses; intrinsics are unchanged). InvalidArgument for bad options, when the
+// requested world tag is not among the complete tags, or when a layout holds none of them.
 Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagObservation>>& observations,
                                              const std::vector<TagCornerKeypoint>& corner_keypoints,
                                              const TagRegistrationOptions& options, Reconstruction* rec);
 
-// PROJECT/tags.json: {"metric", "reason", "family", "tag_size_m", "world_tag", "tags_seen",
+// PROJECT/tags.json: {"metric", "reason", "family", "tag_size_m", "world_tag", "frame" ("world_tag" or
+// "layout"), with a layout "layout_tags": [ids], "layout_rms_m", "layout_max_m"; "tags_seen",
 // "metres_per_model_unit", "scale_tags": [ids], "edge_mean_m", "edge_std_m", "edge_max_abs_error_m", "held_out_edges", "held_out_edge_mean_m",
 // "held_out_edge_std_m", "held_out_edge_max_abs_error_m" (when an edge is held out), "tags": [{"id",
 // "views", "adjusted", "corners": [[x, y, z] x 4] (metres, world frame), "edges_m": [4],

@@ -198,6 +198,47 @@ TEST(TagRegistrationTest, ScaleTagsSetTheScaleAndTheOthersCheckIt) {
   EXPECT_NE(none->reason.find("scale tags"), std::string::npos) << none->reason;
 }
 
+// A declared layout sets the world frame: the scene's tags placed in a frame turned and moved
+// from the world, the model lands in that frame; from all its tags, or from the one it holds.
+TEST(TagRegistrationTest, ALayoutSetsTheFrameFromTheTagsItHolds) {
+  const Rigid3 layout_from_world{Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, 1, -0.2).normalized()).toRotationMatrix(),
+                                 Eigen::Vector3d(1.5, -0.4, 2.0)};
+  for (const std::vector<int>& ids : {std::vector<int>{0, 1, 2}, std::vector<int>{1}}) {
+    Scene scene = MakeScene();
+    TagRegistrationOptions options;
+    options.tag_size_m = kTagSize;
+    for (int id : ids) {
+      ASSERT_TRUE(options.layout.Add({id, kTagSize, layout_from_world * scene.world_from_tag[static_cast<size_t>(id)]}).ok());
+    }
+    auto report = RegisterToTags(scene.observations, {}, options, &scene.model);
+    ASSERT_TRUE(report.ok()) << report.status().ToString();
+    ASSERT_TRUE(report->metric) << report->reason;
+    EXPECT_EQ(report->layout_tags, ids);
+    EXPECT_LT(report->layout_max_m, 1e-7);
+    for (const RegisteredTag& tag : report->tags) {
+      for (int k = 0; k < 4; ++k) {
+        EXPECT_LT((tag.corners[static_cast<size_t>(k)] -
+                   layout_from_world * TagCorner(scene.world_from_tag[static_cast<size_t>(tag.id)], k))
+                      .norm(),
+                  1e-7);
+      }
+    }
+    for (size_t c = 0; c < scene.model.images.size(); ++c) {
+      EXPECT_LT((scene.model.images[c].Center() - layout_from_world * scene.camera_centres_world[c]).norm(), 1e-7);
+    }
+    const std::string json = TagRegistrationJson(*report, "tag36h11", kTagSize);
+    EXPECT_NE(json.find("\"frame\": \"layout\""), std::string::npos) << json;
+  }
+  Scene scene = MakeScene();
+  TagRegistrationOptions options;
+  options.tag_size_m = kTagSize;
+  ASSERT_TRUE(options.layout.Add({7, kTagSize, Rigid3::Identity()}).ok());
+  const auto refused = RegisterToTags(scene.observations, {}, options, &scene.model);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("holds none of the reconstructed tags (0, 1, 2)"), std::string::npos)
+      << refused.status().message();
+}
+
 TEST(TagRegistrationTest, AnyCompleteTagCanBeTheWorldAndOthersAreRefused) {
   Scene scene = MakeScene();
   TagRegistrationOptions options;
