@@ -244,6 +244,7 @@ struct ProjectMeasurer::State {
   double scale_mean_ = 1.0;        // their mean edge in the model
   double scale_relative_sigma = 0.0;
   double length_relative_sigma = 0.0;
+  double square_check_rms = 0.0;  // tags.json "square_check": the squares' cross-check
   double calibration = 1.0;
   std::vector<int> spread_points;  // the model's points that its observations fix
   Eigen::Vector3d model_centroid = Eigen::Vector3d::Zero();
@@ -711,6 +712,13 @@ struct ProjectMeasurer::State {
       }
     }
     length_relative_sigma = std::sqrt(std::max(0.0, relative_variance - explained));
+    if (square_check_rms > 0.0) {
+      // The scale tags were held as squares: their own edges no longer show how the model's scale
+      // varies; the tags the mapper's cross-check left out of the squares do.
+      length_relative_sigma = square_check_rms;
+      scale_relative_sigma = square_check_rms / std::sqrt(static_cast<double>(complete.size()));
+      setup->scale_relative_sigma = scale_relative_sigma;
+    }
     setup->length_relative_sigma = length_relative_sigma;
     std::vector<double> normalised;
     for (size_t t = 0; t < scale_corners.size(); t += 4) {
@@ -792,6 +800,11 @@ Result<ProjectMeasurer> ProjectMeasurer::Open(const Project& project, const Meas
           const JsonValue* id = (*all)[k].Find("id");
           if (id != nullptr && id->AsInteger()) setup.scale_tags.push_back(static_cast<int>(*id->AsInteger()));
         }
+      }
+      const JsonValue* check = tags.Find("square_check");
+      const JsonValue* check_rms = check != nullptr ? check->Find("rms_relative_error") : nullptr;
+      if (check_rms != nullptr && check_rms->is_number() && check_rms->number() > 0.0) {
+        state->square_check_rms = check_rms->number();
       }
       state->SetUpScale(&setup);
     }

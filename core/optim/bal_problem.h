@@ -1,6 +1,7 @@
 #pragma once
 // "Bundle Adjustment in the Large" problems (Agarwal, Snavely, Seitz & Szeliski, ECCV 2010):
 // the text format and the in-memory problem the bundle adjuster works on.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,21 @@ struct BalObservation {
   double weight = 1.0;  // the residual is multiplied by this (1 / its standard deviation)
 };
 
+// A point held to a place in a frame: the residual weight * ((R(w) X + t) / s - local), three
+// components, outside the robust loss, where the frame is a camera block whose pose (w, t) is
+// frame_from_world and whose focal slot (index 6) is the frame's scale s; the residual does not
+// change when the whole problem is scaled. A printed tag is such a frame: its four corners
+// anchored at (+-1/2, +-1/2, 0), s its edge (free, and shared by every tag through an intrinsics
+// group), keep the corners a square while its pose and edge move with the cameras; weight = 1 / the
+// corners' standard deviation relative to the edge. The frame block projects nothing: its other
+// intrinsic slots have no effect.
+struct PointAnchor {
+  int frame = 0;
+  int point = 0;
+  double local[3] = {0.0, 0.0, 0.0};
+  double weight = 1.0;
+};
+
 // Cameras of CameraSize doubles each, points of 3, and the observations linking them. The
 // camera model that gives the doubles their meaning is chosen by the bundle adjuster's overload:
 // BalProblem (bal_camera_model.h) or RadialProblem (radial_camera_model.h).
@@ -27,6 +43,7 @@ struct BundleProblem {
   std::vector<double> cameras;  // kCameraSize doubles per camera
   std::vector<double> points;   // kPointSize doubles per point
   std::vector<BalObservation> observations;
+  std::vector<PointAnchor> point_anchors;  // optional
 
   int num_cameras() const { return static_cast<int>(cameras.size()) / kCameraSize; }
   int num_points() const { return static_cast<int>(points.size()) / kPointSize; }
@@ -48,6 +65,16 @@ struct BundleProblem {
       if (o.camera < 0 || o.camera >= num_cameras() || o.point < 0 || o.point >= num_points()) {
         return InvalidArgument("BundleProblem: observation " + std::to_string(k) +
                                " indexes a missing camera or point");
+      }
+    }
+    for (size_t k = 0; k < point_anchors.size(); ++k) {
+      const PointAnchor& anchor = point_anchors[k];
+      if (anchor.frame < 0 || anchor.frame >= num_cameras() || anchor.point < 0 || anchor.point >= num_points()) {
+        return InvalidArgument("BundleProblem: point anchor " + std::to_string(k) + " indexes a missing frame or point");
+      }
+      if (!(anchor.weight >= 0.0) || !std::isfinite(anchor.weight) || !std::isfinite(anchor.local[0]) ||
+          !std::isfinite(anchor.local[1]) || !std::isfinite(anchor.local[2])) {
+        return InvalidArgument("BundleProblem: point anchor " + std::to_string(k) + " is not finite");
       }
     }
     return Status::Ok();

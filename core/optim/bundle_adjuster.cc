@@ -63,6 +63,34 @@ struct Grouping {
   }
 };
 
+// Residual rows of a point anchor (bal_problem.h), two per solver observation: part 0 the x and
+// y components of weight * ((R(w) X + t) / s - local), part 1 its z component and a zero row. The
+// Jacobians, when asked for, are 2 x CameraSize and 2 x 3, row-major.
+template <int CameraSize>
+void AnchorResidual(const PointAnchor& anchor, int part, const double* frame, const double* point, double* residual,
+                    double* jac_frame, double* jac_point) {
+  const Eigen::Map<const Eigen::Vector3d> w(frame), x(point);
+  const AngleAxisRotation rotation(w, x);
+  const double scale = anchor.weight / frame[6];  // d residual / d (R X + t)
+  const Eigen::Vector3d in_frame = rotation.rx + Eigen::Map<const Eigen::Vector3d>(frame + 3);
+  const Eigen::Vector3d r = scale * in_frame - anchor.weight * Eigen::Map<const Eigen::Vector3d>(anchor.local);
+  const int first = 2 * part, rows = part == 0 ? 2 : 1;
+  residual[0] = r[first];
+  residual[1] = part == 0 ? r[1] : 0.0;
+  if (jac_frame != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, CameraSize, Eigen::RowMajor>> jc(jac_frame);
+    jc.setZero();
+    jc.block(0, 0, rows, 3) = scale * rotation.JacobianWrtAngleAxis().middleRows(first, rows);
+    jc.block(0, 3, rows, 3) = scale * Eigen::Matrix3d::Identity().middleRows(first, rows);
+    jc.block(0, 6, rows, 1) = -(scale / frame[6]) * in_frame.segment(first, rows);
+  }
+  if (jac_point != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jp(jac_point);
+    jp.setZero();
+    jp.topRows(rows) = scale * rotation.Matrix().middleRows(first, rows);
+  }
+}
+
 // One solve. Every buffer is sized in the constructor; the iteration loop does not allocate.
 template <typename Model>
 class Solver {
@@ -97,14 +125,25 @@ class Solver {
     constant_parameters_ = constancy.constant_camera_parameters;
     nc_ = problem->num_cameras();
     np_ = problem->num_points();
-    no_ = static_cast<int>(problem->observations.size());
+    num_projections_ = static_cast<int>(problem->observations.size());
+    obs_ = &problem->observations;
+    if (!problem->point_anchors.empty()) {
+      // Each anchor joins the observations as two (its rows x, y and z), so that the Schur
+      // complement couples its frame with the cameras that see its point like any observer.
+      observations_with_anchors_ = problem->observations;
+      for (const PointAnchor& anchor : problem->point_anchors) {
+        for (int part = 0; part < 2; ++part) observations_with_anchors_.push_back({anchor.frame, anchor.point, 0.0, 0.0, 1.0});
+      }
+      obs_ = &observations_with_anchors_;
+    }
+    no_ = static_cast<int>(obs_->size());
     const auto nobs = static_cast<size_t>(no_);
     const_cam_.assign(static_cast<size_t>(nc_), 0);
     const_pt_.assign(static_cast<size_t>(np_), 0);
     if (!constancy.constant_cameras.empty()) const_cam_ = constancy.constant_cameras;
     if (!constancy.constant_points.empty()) const_pt_ = constancy.constant_points;
-    by_cam_.Build(nc_, problem->observations, true);
-    by_pt_.Build(np_, problem->observations, false);
+    by_cam_.Build(nc_, *obs_, true);
+    by_pt_.Build(np_, *obs_, false);
     residual_.resize(2 * nobs);
     rho_.resize(nobs);
     jc_.resize(nobs);
@@ -189,6 +228,20 @@ class Solver {
     return s;
   }
 
+  const PointAnchor& Anchor(int k) const {
+    return problem_->point_anchors[static_cast<size_t>((k - num_projections_) / 2)];
+  }
+  int AnchorPart(int k) const { return (k - num_projections_) % 2; }
+
+  void ZeroConstantColumns(const BalObservation& o, Mat29* jc, Mat23* jp) const {
+    if (const_cam_[static_cast<size_t>(o.camera)]) {
+      jc->setZero();
+    } else {
+      for (int m : constant_parameters_) jc->col(m).setZero();
+    }
+    if (const_pt_[static_cast<size_t>(o.point)]) jp->setZero();
+  }
+
   // Runs fn(begin, end) over [0, n) in chunks, on the pool when there is one. The job lives in
   // members so the std::function wrapper holds only `this` (no allocation).
   template <typename Fn>
@@ -211,13 +264,21 @@ class Solver {
 
   // Residuals, robust weights, Jacobians, cost, and the blocks of J^T J and J^T r.
   void BuildNormalEquations() {
-    const std::vector<BalObservation>& obs = problem_->observations;
+    const std::vector<BalObservation>& obs = *obs_;
     ParallelRange(no_, 512, [this, &obs](int begin, int end) {
       for (int k = begin; k < end; ++k) {
         const BalObservation& o = obs[static_cast<size_t>(k)];
         double* r = &residual_[2 * static_cast<size_t>(k)];
         Mat29& jc = jc_[static_cast<size_t>(k)];
         Mat23& jp = jp_[static_cast<size_t>(k)];
+        if (k >= num_projections_) {
+          AnchorResidual<kC>(Anchor(k), AnchorPart(k), problem_->camera(o.camera), problem_->point(o.point), r,
+                             jc.data(), jp.data());
+          rho_[static_cast<size_t>(k)] = r[0] * r[0] + r[1] * r[1];
+          ZeroConstantColumns(o, &jc, &jp);
+          w_[static_cast<size_t>(k)].noalias() = jc.transpose() * jp;
+          continue;
+        }
         if (!Model::Project(problem_->camera(o.camera), problem_->point(o.point), r, jc.data(),
                         jp.data())) {
           rho_[static_cast<size_t>(k)] = std::numeric_limits<double>::infinity();
@@ -235,12 +296,7 @@ class Solver {
           jc *= sw;
           jp *= sw;
         }
-        if (const_cam_[static_cast<size_t>(o.camera)]) {
-          jc.setZero();
-        } else {
-          for (int m : constant_parameters_) jc.col(m).setZero();
-        }
-        if (const_pt_[static_cast<size_t>(o.point)]) jp.setZero();
+        ZeroConstantColumns(o, &jc, &jp);
         w_[static_cast<size_t>(k)].noalias() = jc.transpose() * jp;
       }
     });
@@ -329,7 +385,7 @@ class Solver {
       if (g >= 0) step.template tail<kI>() = system_.Solution(GroupBlock(g));
     }
     if (!step_c_.allFinite()) return false;
-    const std::vector<BalObservation>& obs = problem_->observations;
+    const std::vector<BalObservation>& obs = *obs_;
     ParallelRange(np_, 256, [this, &obs](int begin, int end) {
       for (int j = begin; j < end; ++j) {
         Vec3 b = -gp_[static_cast<size_t>(j)];
@@ -349,7 +405,7 @@ class Solver {
   // written here is written by no other camera's task.
   template <int R>
   void AddCameraRows(int i, double lambda) {
-    const std::vector<BalObservation>& obs = problem_->observations;
+    const std::vector<BalObservation>& obs = *obs_;
     const int g = group_[static_cast<size_t>(i)];
     Mat99 sii = u_[static_cast<size_t>(i)];
     sii.diagonal() += lambda * dc_diag_[static_cast<size_t>(i)];
@@ -442,7 +498,7 @@ class Solver {
     const int first = point_groups_.offsets[j], last = point_groups_.offsets[j + 1];
     if (first == last) return;
     for (int e = first; e < last; ++e) z_[static_cast<size_t>(e)].setZero();
-    const std::vector<BalObservation>& obs = problem_->observations;
+    const std::vector<BalObservation>& obs = *obs_;
     for (int q = by_pt_.offsets[j]; q < by_pt_.offsets[j + 1]; ++q) {
       const auto k = static_cast<size_t>(by_pt_.items[static_cast<size_t>(q)]);
       const int g = group_[static_cast<size_t>(obs[k].camera)];
@@ -462,7 +518,7 @@ class Solver {
   // last. The pattern, where each block is stored, the observation pairs behind each camera pair
   // and the symbolic factorisation are all set up here, before the iterations.
   void BuildReducedSystem(const std::vector<int>& groups) {
-    const std::vector<BalObservation>& obs = problem_->observations;
+    const std::vector<BalObservation>& obs = *obs_;
     camera_block_.assign(static_cast<size_t>(nc_), -1);
     group_.assign(static_cast<size_t>(nc_), -1);
     own_size_.assign(static_cast<size_t>(nc_), kC);
@@ -599,13 +655,17 @@ class Solver {
   }
 
   double EvaluateCost(const std::vector<double>& cameras, const std::vector<double>& points) {
-    const std::vector<BalObservation>& obs = problem_->observations;
+    const std::vector<BalObservation>& obs = *obs_;
     ParallelRange(no_, 512, [this, &obs, &cameras, &points](int begin, int end) {
       for (int k = begin; k < end; ++k) {
         const BalObservation& o = obs[static_cast<size_t>(k)];
         double r[2];
         double rho = std::numeric_limits<double>::infinity(), drho;
-        if (Model::Project(cameras.data() + static_cast<size_t>(o.camera) * kC,
+        if (k >= num_projections_) {
+          AnchorResidual<kC>(Anchor(k), AnchorPart(k), cameras.data() + static_cast<size_t>(o.camera) * kC,
+                             points.data() + static_cast<size_t>(o.point) * kP, r, nullptr, nullptr);
+          rho = r[0] * r[0] + r[1] * r[1];
+        } else if (Model::Project(cameras.data() + static_cast<size_t>(o.camera) * kC,
                        points.data() + static_cast<size_t>(o.point) * kP, r, nullptr, nullptr)) {
           r[0] -= o.x;
           r[1] -= o.y;
@@ -623,6 +683,11 @@ class Solver {
   Problem* problem_;
   std::vector<int> constant_parameters_;  // indices within every camera block
   int nc_ = 0, np_ = 0, no_ = 0;
+  // The observations the solver works on: the problem's projections, then two per point anchor
+  // (copied with them only when there are anchors).
+  const std::vector<BalObservation>* obs_ = nullptr;
+  std::vector<BalObservation> observations_with_anchors_;
+  int num_projections_ = 0;
   std::vector<char> const_cam_, const_pt_;
   Grouping by_cam_, by_pt_;
   std::vector<double> residual_, rho_;
@@ -692,6 +757,14 @@ double CostImpl(const typename Model::Problem& problem, const RobustLoss& loss) 
     double rho, drho;
     loss.Evaluate(o.weight * o.weight * (r[0] * r[0] + r[1] * r[1]), &rho, &drho);
     cost += rho;
+  }
+  for (const PointAnchor& anchor : problem.point_anchors) {
+    for (int part = 0; part < 2; ++part) {
+      double r[2];
+      AnchorResidual<Model::Problem::kCameraSize>(anchor, part, problem.camera(anchor.frame), problem.point(anchor.point),
+                                                  r, nullptr, nullptr);
+      cost += r[0] * r[0] + r[1] * r[1];
+    }
   }
   return 0.5 * cost;
 }

@@ -18,6 +18,7 @@
 #include "core/io/image_io.h"
 #include "core/pipeline/matches_file.h"
 #include "core/pipeline/stage_record.h"
+#include "core/sfm/mapper_adjustment.h"
 #include "core/sfm/model_io.h"
 #include "core/sfm/tag_layout.h"
 
@@ -170,9 +171,11 @@ std::string SfmStageSettings(const SfmStageOptions& options) {
                              {"world_tag", options.tags.registration.world_tag},
                              {"tags_in_ba", options.tags.in_adjustment ? 1.0 : 0.0}});
   // Tag projects map differently since images register by their known tags and the world tag is
-  // fitted as a square (version 2): their recorded mapping is not reused. Others are unchanged.
+  // fitted as a square (version 2), and since the adjustments hold the scale tags to squares and
+  // only adjusted tags set the scale (version 3): their recorded mapping is not reused. Others are
+  // unchanged.
   if (with_tags) {
-    settings += " " + StageRecord::Settings({{"tag_mapping", 2.0}});
+    settings += " " + StageRecord::Settings({{"tag_mapping", 3.0}, {"tag_square_sigma", mapper.tag_square_sigma}});
     std::string ids;
     for (int id : options.tags.registration.scale_tags) ids += (ids.empty() ? "" : ",") + std::to_string(id);
     if (!ids.empty()) settings += " scale_tags=" + ids;
@@ -249,6 +252,9 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
     }
   }
   report.seconds_load = SecondsSince(start);
+  // The scale tags are the squares the adjustments hold (tag_squares.h); the others check them.
+  MapperOptions mapper_options = options.mapper;
+  mapper_options.square_tags = options.tags.registration.scale_tags;
 
   start = Clock::now();
   std::unique_ptr<Progress> progress;
@@ -263,12 +269,12 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   std::vector<Reconstruction> other_models;
   Result<Reconstruction> reconstruction = LiveModel(project, options, index_of, &report);
   if (reconstruction.ok()) {
-    reconstruction = ContinueFromLiveModel(*reconstruction, images, pairs, options.mapper, on_progress, &report);
+    reconstruction = ContinueFromLiveModel(*reconstruction, images, pairs, mapper_options, on_progress, &report);
   }
   if (!reconstruction.ok() || 2 * reconstruction->NumRegisteredImages() < static_cast<int>(images.size())) {
     MapperReport scratch_report;
     std::vector<Reconstruction> scratch_others;
-    auto scratch = RunIncrementalMapper(images, pairs, options.mapper, &scratch_report, on_progress, &scratch_others);
+    auto scratch = RunIncrementalMapper(images, pairs, mapper_options, &scratch_report, on_progress, &scratch_others);
     if (!reconstruction.ok() ||
         (scratch.ok() && scratch->NumRegisteredImages() > reconstruction->NumRegisteredImages())) {
       if (reconstruction.ok()) LiveModelNotUsed(&report, "the mapper from scratch registered more photos");
@@ -281,8 +287,10 @@ Result<SfmStageReport> RunSfmStage(const Project& project, const SfmStageOptions
   if (!reconstruction.ok()) return reconstruction.status();
   if (options.tags.enabled) {
     report.tags_used = true;
+    const std::vector<double> square_check = CrossCheckTagSquares(*reconstruction, images, mapper_options, &report.mapper);
     RECONAR_ASSIGN_OR_RETURN(report.tags, RegisterToTags(tag_observations, corner_keypoints,
                                                          options.tags.registration, &*reconstruction));
+    report.tags.square_check = square_check;
   }
   report.seconds_mapping = SecondsSince(start);
   FocalStatistics(*reconstruction, &report);

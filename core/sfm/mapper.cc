@@ -411,6 +411,8 @@ Status MapperOptions::Check() const {
   if (min_model_images < 2) return InvalidArgument("MapperOptions: min_model_images < 2");
   if (init_max_starts < 1) return InvalidArgument("MapperOptions: init_max_starts < 1");
   if (merge_min_shared_points < 3) return InvalidArgument("MapperOptions: merge_min_shared_points < 3");
+  if (!(tag_square_sigma >= 0.0 && std::isfinite(tag_square_sigma)))
+    return InvalidArgument("MapperOptions: tag_square_sigma must be finite and >= 0");
   if (registration_min_baseline_points < 0)
     return InvalidArgument("MapperOptions: registration_min_baseline_points < 0");
   if (registration_min_tag_point_inliers < 0)

@@ -151,6 +151,12 @@ struct MapperOptions {
   // untriangulable). Models of unrelated scenes share no point and stay apart.
   bool merge_models = true;
   int merge_min_shared_points = 12;
+  // Tags as rigid squares (tag_squares.h): every global adjustment holds the corners of square_tags
+  // (empty: every tag in MapperImage::tags) to the square of their mean edge that fits them best,
+  // each coordinate with this standard deviation relative to the edge; 0 turns it off. 0.003 is
+  // 0.4 mm on a 12.7 cm tag: a laser print's scale error and a sheet not quite flat.
+  double tag_square_sigma = 0.003;
+  std::vector<int> square_tags;
 
   Status Check() const;
 };

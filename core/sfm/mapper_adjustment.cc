@@ -1,11 +1,15 @@
 #include "core/sfm/mapper_adjustment.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 
 #include "core/math/rotation.h"
 #include "core/optim/bundle_adjuster.h"
 #include "core/optim/radial_camera_model.h"
+#include "core/sfm/tag_observations.h"
+#include "core/sfm/tag_squares.h"
 
 namespace reconar {
 namespace {
@@ -22,6 +26,48 @@ double ObservationWeight(const std::vector<MapperImage>& images, const TrackElem
   const std::vector<float>& scales = images[static_cast<size_t>(e.image_id)].keypoint_scales;
   if (scales.empty()) return 1.0;
   return ScaleWeight(scales[static_cast<size_t>(e.keypoint_id)], options);
+}
+
+// The square tags whose corners are all among the problem's points (tag_squares.h), each a frame
+// block after the cameras with its corners anchored to it; their edge is the frame blocks' shared
+// focal slot, in one intrinsics group after the cameras' (which `groups` gets when it had none).
+void AddTagSquares(const Reconstruction& rec, const std::vector<MapperImage>& images, const std::vector<int>& point_ids,
+                   const MapperOptions& options, RadialProblem* problem, std::vector<int>* groups) {
+  if (!(options.tag_square_sigma > 0.0)) return;
+  const TagSquares tags = FindTagSquares(rec, CornerKeypointsOfImages(images), options.square_tags);
+  if (tags.squares.empty() || !(tags.edge > 0.0)) return;
+  std::vector<int> index_of_point(rec.points.size(), -1);
+  for (size_t j = 0; j < point_ids.size(); ++j) index_of_point[static_cast<size_t>(point_ids[j])] = static_cast<int>(j);
+  const int num_cameras = problem->num_cameras();
+  int group = 0;
+  for (int g : *groups) group = std::max(group, g + 1);
+  for (const TagSquare& square : tags.squares) {
+    std::array<int, 4> points;
+    bool all_in = true;
+    for (size_t k = 0; k < 4; ++k) {
+      points[k] = index_of_point[static_cast<size_t>(square.points[k])];
+      all_in = all_in && points[k] >= 0;
+    }
+    if (!all_in) continue;
+    const Rigid3 tag_from_world = square.world_from_tag.Inverse();
+    const Eigen::Vector3d w = AngleAxisFromRotation(tag_from_world.rotation);
+    const Eigen::Vector3d& t = tag_from_world.translation;
+    const double block[12] = {w.x(), w.y(), w.z(), t.x(), t.y(), t.z(), tags.edge, 0.0, 0.0, 0.0, 0.0, 1.0};
+    const int frame = problem->num_cameras();
+    problem->cameras.insert(problem->cameras.end(), block, block + 12);
+    for (size_t k = 0; k < 4; ++k) {
+      PointAnchor anchor;
+      anchor.frame = frame;
+      anchor.point = points[k];
+      anchor.local[0] = kTagCornerUnits[k][0] / 2.0;
+      anchor.local[1] = kTagCornerUnits[k][1] / 2.0;
+      anchor.weight = 1.0 / options.tag_square_sigma;
+      problem->point_anchors.push_back(anchor);
+    }
+  }
+  if (problem->num_cameras() == num_cameras) return;
+  if (groups->empty()) groups->assign(static_cast<size_t>(num_cameras), -1);
+  groups->resize(static_cast<size_t>(problem->num_cameras()), group);
 }
 
 }  // namespace
@@ -94,6 +140,13 @@ Result<double> BundleAdjust(MapperModel* model, const std::vector<MapperImage>& 
     for (int image : image_of_slot)
       constancy.intrinsics_group.push_back(rec.images[static_cast<size_t>(image)].camera_id);
   }
+  // The squares are a constraint on the model's shape at the scale of the room, which a local
+  // adjustment (most cameras held) cannot correct; there a square's pull on newly triangulated
+  // corners pushed their observations past the outlier bound and split tags (the room's even half).
+  if (global) {
+    AddTagSquares(rec, images, point_ids, options, &problem, &constancy.intrinsics_group);
+    constancy.constant_cameras.resize(static_cast<size_t>(problem.num_cameras()), 0);
+  }
   const IntrinsicsChoice& free = adjustment.free;
   if (!options.refine_focal || !intrinsics) constancy.constant_camera_parameters.push_back(6);
   if (!free.distortion || !intrinsics) {
@@ -132,6 +185,41 @@ Result<double> BundleAdjust(MapperModel* model, const std::vector<MapperImage>& 
     rec.points[static_cast<size_t>(point_ids[j])].position = Eigen::Vector3d(problem.point(static_cast<int>(j)));
   }
   return summary->final_cost;
+}
+
+std::vector<double> CrossCheckTagSquares(const Reconstruction& rec, const std::vector<MapperImage>& images,
+                                         const MapperOptions& options, MapperReport* report) {
+  std::vector<double> errors;
+  if (!(options.tag_square_sigma > 0.0)) return errors;
+  const std::vector<TagCornerKeypoint> corner_keypoints = CornerKeypointsOfImages(images);
+  const TagSquares all = FindTagSquares(rec, corner_keypoints, options.square_tags);
+  if (all.squares.size() < 2) return errors;
+  static constexpr int kSegments[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
+  for (size_t fold = 0; fold < 2; ++fold) {
+    MapperOptions held = options;
+    held.square_tags.clear();
+    for (size_t t = 0; t < all.squares.size(); ++t) {
+      if (t % 2 != fold) held.square_tags.push_back(all.squares[t].tag_id);
+    }
+    MapperModel model;
+    model.rec = rec;
+    MapperAdjustment adjustment;
+    adjustment.iterations = options.final_ba_iterations;
+    adjustment.function_tolerance = options.final_ba_function_tolerance;
+    if (!BundleAdjust(&model, images, model.RegisteredImages(), adjustment, held, report).ok()) continue;
+    const TagSquares squares = FindTagSquares(model.rec, corner_keypoints, held.square_tags);
+    if (!(squares.edge > 0.0)) continue;
+    const auto position = [&model](int point) { return model.rec.points[static_cast<size_t>(point)].position; };
+    for (size_t t = fold; t < all.squares.size(); t += 2) {
+      const std::array<int, 4>& points = all.squares[t].points;
+      for (int s = 0; s < 6; ++s) {
+        const double length = (position(points[static_cast<size_t>(kSegments[s][1])]) -
+                               position(points[static_cast<size_t>(kSegments[s][0])])).norm();
+        errors.push_back(length / (s < 4 ? squares.edge : std::sqrt(2.0) * squares.edge) - 1.0);
+      }
+    }
+  }
+  return errors;
 }
 
 Status CountFailedAdjustment(const Status& status, MapperReport* report) {

@@ -50,6 +50,16 @@ void AppendCameraBlock(const SfmImage& image, const SfmCamera& camera, RadialPro
 // of its own (a tag corner: kTagCornerWeight) has that instead.
 double ScaleWeight(double keypoint_scale, const MapperOptions& options);
 
+// How well the tag squares (tag_squares.h) predict each other's size: the square tags in two folds
+// (alternate ids), the model adjusted globally once per fold with only the other fold's tags held
+// to squares (intrinsics held, the focal refined as options say), and each left-out tag's four
+// edges and two diagonals measured against the held tags' mean edge (times the root of two for a
+// diagonal). Returns those relative errors: the scale's variation across the model that a
+// measurement inherits, which the squares hide in the final model's own tags. Empty with fewer
+// than two square tags; `rec` is not changed.
+std::vector<double> CrossCheckTagSquares(const Reconstruction& rec, const std::vector<MapperImage>& images,
+                                         const MapperOptions& options, MapperReport* report);
+
 // Records a failed adjustment in `report` (num_failed_ba, first_ba_failure) and returns Ok, so
 // that the mapper carries on with the model as it was; InvalidArgument, a programming error, is
 // returned instead. Ok passes through uncounted.

@@ -105,6 +105,9 @@ struct TagRegistrationReport {
   // The same with each tag measured at a scale it did not help set: a scale tag at the scale of
   // the other scale tags, any other tag at the scale tags' (the mean above over the scale tags
   // equals the tag size by construction). Zero held_out_edges when no tag can be held out.
+  // The scale tags held as squares in the adjustment (mapper_adjustment.h, CrossCheckTagSquares):
+  // the relative errors of the tags a cross-check left out. Set by the caller; empty otherwise.
+  std::vector<double> square_check;
   int held_out_edges = 0;
   double held_out_edge_mean_m = 0.0, held_out_edge_std_m = 0.0, held_out_edge_max_abs_error_m = 0.0;
 };
@@ -120,7 +123,8 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
 // PROJECT/tags.json: {"metric", "reason", "family", "tag_size_m", "world_tag", "frame" ("world_tag" or
 // "layout"), with a layout "layout_tags": [ids], "layout_rms_m", "layout_max_m"; "tags_seen",
 // "metres_per_model_unit", "scale_tags": [ids], "edge_mean_m", "edge_std_m", "edge_max_abs_error_m", "held_out_edges", "held_out_edge_mean_m",
-// "held_out_edge_std_m", "held_out_edge_max_abs_error_m" (when an edge is held out), "tags": [{"id",
+// "held_out_edge_std_m", "held_out_edge_max_abs_error_m" (when an edge is held out), "square_check":
+// {"segments", "rms_relative_error", "max_abs_relative_error"} (when the scale tags were squares), "tags": [{"id",
 // "views", "adjusted", "corners": [[x, y, z] x 4] (metres, world frame), "edges_m": [4],
 // "rms_reprojection_px", "world_from_tag": {"R": [9, row-major], "t": [3]}}]}.
 std::string TagRegistrationJson(const TagRegistrationReport& report, const std::string& family, double tag_size_m);
