@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -381,6 +382,34 @@ struct ProjectMeasurer::State {
     return surface_status;
   }
 
+  // Where the dense stage missed a surface (a face every photo saw at a grazing angle), a picked
+  // pixel's ray passes through it and meets whatever lies behind. The photo's own model points
+  // round the pixel show it: a hit deeper than all of them by more than max_hit_behind is refused.
+  Status CheckHitDepth(const BalObservation& pick, const Eigen::Vector3d& hit, const std::string& what) const {
+    const SfmImage& image = image_of_camera(pick.camera);
+    const SfmCamera& intrinsics = camera_of(image);
+    const double radius = options.hit_check_radius * std::hypot(intrinsics.width, intrinsics.height);
+    const Eigen::Vector2d pixel(pick.x, pick.y);
+    double deepest = 0.0;
+    int near = 0;
+    for (size_t k = 0; k < image.keypoints.size() && k < image.point3d_ids.size(); ++k) {
+      const int id = image.point3d_ids[k];
+      if (id < 0 || (image.keypoints[k] - pixel).norm() > radius) continue;
+      const SfmPoint& point = model.model.points[static_cast<size_t>(id)];
+      if (point.deleted) continue;
+      deepest = std::max(deepest, (image.cam_from_world * point.position).z());
+      ++near;
+    }
+    const double depth = (image.cam_from_world * hit).z();
+    if (near < options.hit_check_min_points || depth <= (1.0 + options.max_hit_behind) * deepest) return Status::Ok();
+    char text[160];
+    std::snprintf(text, sizeof(text), "%.3g times as far as the deepest of the %d model points round the pixel", depth / deepest,
+                  near);
+    return FailedPrecondition(what + ": the mesh under the pixel lies " + text + " in " + image.name +
+                              ": its surface there is missing (picked through it); pick the point in a second photo too "
+                              "(PHOTO@X,Y+PHOTO2@X,Y)");
+  }
+
   // The surface point the ray meets, observed in the photos that see it (`pick`, when set, first:
   // the photo and pixel it was picked at), added to the covariance.
   Result<int> PlaceOnSurface(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
@@ -407,6 +436,7 @@ struct ProjectMeasurer::State {
       }
       from = hit.distance * (1.0 + 1e-9);
     }
+    if (pick != nullptr) RECONAR_RETURN_IF_ERROR(CheckHitDepth(*pick, hit.point, what));
     std::vector<std::pair<double, BalObservation>> seen_by;
     for (size_t i = 0; i < model.model.images.size(); ++i) {
       const int camera = model.problem_camera[i];

@@ -92,6 +92,12 @@ struct MeasureOptions {
   int max_support_radii = 16;
   double min_triangulation_angle_deg = 1.0;  // for pixels picked in several photos
   double max_pick_reprojection_px = 8.0;     // their rays must meet within this
+  // A pixel met with the mesh is refused when the hit lies more than max_hit_behind (relative) deeper
+  // than every model point its photo sees within hit_check_radius (of the image diagonal) of it,
+  // given at least hit_check_min_points of them: the mesh misses the surface the pixel shows.
+  double hit_check_radius = 0.02;
+  int hit_check_min_points = 3;
+  double max_hit_behind = 0.1;
 };
 
 struct MeasureSetup {  // what the ± rests on, for reports

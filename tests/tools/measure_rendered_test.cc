@@ -6,7 +6,10 @@
 // reconstruction's own), and each distance between two of them, brought to the truth's units by
 // the ratio of the sparse points' RMS spread in truth and in the model (the normalisation an
 // untagged project's σ is relative to; the true points triangulated from the same observations
-// with the true cameras), is checked against the true distance: at least 90 % within 2σ.
+// with the true cameras), is checked against the true distance: at least 90 % within 2σ. Each point
+// picked by one pixel alone, met with the mesh, either lands within 2σ of its triangulated pick or
+// is refused as a surface the mesh misses (the dense stage lost the box's top, which every camera
+// sees at 65° from its normal: the rays met the ground behind it): never a wrong point with a small σ.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -64,7 +67,7 @@ TEST(MeasureRendered, TheSigmaCoversExactDistancesOnTheTexturedBox) {
   }
   const std::string project = (root / "project").string();
   const CommandRun made = RunReconar("reconstruct " + (root / "images").string() + " " + project +
-                                     " --stages sparse --threads 2 --no-preview");
+                                     " --threads 2 --no-preview --formats ply");
   ASSERT_EQ(made.exit_code, 0) << made.output;
   auto model = ReadColmapTextModel(project + "/sparse");
   ASSERT_TRUE(model.ok()) << model.status().ToString();
@@ -171,6 +174,26 @@ TEST(MeasureRendered, TheSigmaCoversExactDistancesOnTheTexturedBox) {
               registered, truths.size(), picks.size(), within, 100 * share, 100 * relative_sigmas[relative_sigmas.size() / 2],
               100 * relative_errors[relative_errors.size() / 2]);
   EXPECT_GE(share, 0.90);
+
+  int agree = 0, refused = 0;
+  for (const std::string& pair : picks) {
+    const std::string single = pair.substr(0, pair.find('+'));
+    const CommandRun hit = RunReconar("measure " + project + " --distance " + single + " " + pair + " --pick-sigma 0.01 --json",
+                                      testing::StderrMode::kSeparate);
+    if (hit.exit_code != 0) {
+      EXPECT_NE(hit.error.find("its surface there is missing"), std::string::npos) << hit.error;
+      ++refused;
+      continue;
+    }
+    auto gap = ParseJson(hit.output, "measure --json");
+    ASSERT_TRUE(gap.ok()) << gap.status().ToString();
+    const JsonValue& item = (*gap->Find("items"))[0];
+    EXPECT_LE(item.Find("value")->number(), 2.0 * item.Find("sigma")->number()) << single;
+    agree += item.Find("value")->number() <= 2.0 * item.Find("sigma")->number() ? 1 : 0;
+  }
+  std::printf("one pixel met with the mesh: %d of %zu within 2 sigma of the triangulated pick, %d refused\n", agree,
+              picks.size(), refused);
+  EXPECT_GE(agree, 6) << "the box's sides and the ground";
   fs::remove_all(root);
 }
 
