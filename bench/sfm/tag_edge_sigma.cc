@@ -11,6 +11,7 @@
 
 #include "core/base/json_reader.h"
 #include "core/measure/measurement.h"
+#include "core/sfm/tag_observations.h"
 
 namespace reconar {
 namespace {
@@ -39,7 +40,6 @@ int Run(int argc, char** argv) {
               "from their %d segments; set up in %.3f s\n",
               setup.cameras, setup.points, setup.observations, setup.sigma0_px, scale.size(),
               100 * setup.scale_relative_sigma, setup.sigma_calibration, setup.scale_segments, setup.seconds_setup);
-  static constexpr int kSegments[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
   const JsonValue& list = *tags->Find("tags");
   int within = 0, total = 0;
   std::vector<double> sigmas, errors;
@@ -49,7 +49,7 @@ int Run(int argc, char** argv) {
     for (int s = 0; s < 6; ++s) {
       MeasureItem item;
       for (int end = 0; end < 2; ++end) {
-        item.points.push_back(*ParseMeasurePoint("tag:" + std::to_string(id) + ":c" + std::to_string(kSegments[s][end])));
+        item.points.push_back(*ParseMeasurePoint("tag:" + std::to_string(id) + ":c" + std::to_string(kTagSegments[s][end])));
       }
       Result<MeasuredItem> measured = measurer->Measure(item);
       if (!measured.ok()) {

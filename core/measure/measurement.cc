@@ -724,11 +724,10 @@ struct ProjectMeasurer::State {
     scale_relative_sigma = std::sqrt(spread) / mean / std::sqrt(static_cast<double>(edges.size()));
     setup->scale_relative_sigma = scale_relative_sigma;
 
-    static constexpr int kSegments[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
     const auto segment_of = [&](size_t t, int s) {
       std::vector<LocatedPoint> ends(2);
-      ends[0].terms = {{scale_corners[t + static_cast<size_t>(kSegments[s][0])], 1.0}};
-      ends[1].terms = {{scale_corners[t + static_cast<size_t>(kSegments[s][1])], 1.0}};
+      ends[0].terms = {{scale_corners[t + static_cast<size_t>(kTagSegments[s][0])], 1.0}};
+      ends[1].terms = {{scale_corners[t + static_cast<size_t>(kTagSegments[s][1])], 1.0}};
       return Evaluate(MeasureKind::kDistance, ends);
     };
     // The edges' relative spread beyond what the covariance and the scale's own term explain.

@@ -194,7 +194,6 @@ std::vector<double> CrossCheckTagSquares(const Reconstruction& rec, const std::v
   const std::vector<TagCornerKeypoint> corner_keypoints = CornerKeypointsOfImages(images);
   const TagSquares all = FindTagSquares(rec, corner_keypoints, options.square_tags);
   if (all.squares.size() < 2) return errors;
-  static constexpr int kSegments[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
   for (size_t fold = 0; fold < 2; ++fold) {
     MapperOptions held = options;
     held.square_tags.clear();
@@ -213,8 +212,8 @@ std::vector<double> CrossCheckTagSquares(const Reconstruction& rec, const std::v
     for (size_t t = fold; t < all.squares.size(); t += 2) {
       const std::array<int, 4>& points = all.squares[t].points;
       for (int s = 0; s < 6; ++s) {
-        const double length = (position(points[static_cast<size_t>(kSegments[s][1])]) -
-                               position(points[static_cast<size_t>(kSegments[s][0])])).norm();
+        const double length = (position(points[static_cast<size_t>(kTagSegments[s][1])]) -
+                               position(points[static_cast<size_t>(kTagSegments[s][0])])).norm();
         errors.push_back(length / (s < 4 ? squares.edge : std::sqrt(2.0) * squares.edge) - 1.0);
       }
     }

@@ -19,6 +19,8 @@
 namespace reconar {
 
 inline constexpr double kTagCornerUnits[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+// A tag's six corner-to-corner segments: its four edges (length = size), then its two diagonals.
+inline constexpr int kTagSegments[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
 
 struct TagObservation {
   int tag_id = -1;

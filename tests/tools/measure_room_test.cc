@@ -53,7 +53,6 @@ TEST(MeasureRoom, TheSigmaCoversTheTagsThatDidNotSetTheScale) {
   const std::set<int> scale_tags = {0, 1, 2, 3, 4, 5, 6, 7, 8, 11};
   auto tags = ReadJsonFile(project + "/tags.json");
   ASSERT_TRUE(tags.ok()) << tags.status().ToString();
-  static constexpr int kSegments[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
   std::string items;
   std::vector<double> truths;
   const JsonValue& list = *tags->Find("tags");
@@ -61,8 +60,8 @@ TEST(MeasureRoom, TheSigmaCoversTheTagsThatDidNotSetTheScale) {
     const int id = static_cast<int>(*list[t].Find("id")->AsInteger());
     if (scale_tags.count(id)) continue;
     for (int s = 0; s < 6; ++s) {
-      items += " --distance tag:" + std::to_string(id) + ":c" + std::to_string(kSegments[s][0]) + " tag:" +
-               std::to_string(id) + ":c" + std::to_string(kSegments[s][1]);
+      items += " --distance tag:" + std::to_string(id) + ":c" + std::to_string(kTagSegments[s][0]) + " tag:" +
+               std::to_string(id) + ":c" + std::to_string(kTagSegments[s][1]);
       truths.push_back(s < 4 ? kTagSize : kTagSize * std::sqrt(2.0));
     }
   }
