@@ -140,6 +140,22 @@ class Mapper {
       model_.failure[static_cast<size_t>(m.image_a)] = model_.failure[static_cast<size_t>(m.image_b)] = kNotConnected;
     }
     model_.SetTracks(BuildTracks(num_keypoints, matches));
+    model_.tag_corner_bounds.assign(static_cast<size_t>(n), {});
+    for (int i = 0; i < n; ++i) {
+      const MapperImage& in = images_[static_cast<size_t>(i)];
+      std::vector<MapperModel::TagCornerBound>& corners = model_.tag_corner_bounds[static_cast<size_t>(i)];
+      for (const MapperTag& tag : in.tags) {
+        if (tag.first_keypoint < 0 || static_cast<size_t>(tag.first_keypoint) + 4 > in.keypoints.size())
+          return InvalidArgument(in.name + ": a tag's corners index missing keypoints");
+        double edge = 0.0;
+        for (int k = 0; k < 4; ++k) {
+          edge += (in.keypoints[static_cast<size_t>(tag.first_keypoint + (k + 1) % 4)] -
+                   in.keypoints[static_cast<size_t>(tag.first_keypoint + k)]).norm() / 4.0;
+        }
+        for (int k = 0; k < 4; ++k) corners.push_back({tag.first_keypoint + k, edge});
+      }
+      std::sort(corners.begin(), corners.end());
+    }
     report_->num_tracks = static_cast<int>(model_.tracks.tracks.size());
     report_->num_conflicting_matches = model_.tracks.num_conflicting_matches;
     return Status::Ok();

@@ -1,6 +1,10 @@
 #include "core/sfm/mapper_model.h"
 
 #include <algorithm>
+
+#include "core/sfm/mapper.h"
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -11,6 +15,16 @@ void MapperModel::SetTracks(TrackSet track_set) {
   tracks = std::move(track_set);
   point_of_track.assign(tracks.tracks.size(), -1);
   track_of_point.clear();
+}
+
+double MapperModel::MaxSquaredError(int image, int kp, const MapperOptions& options) const {
+  double bound = options.max_reprojection_error_px;
+  if (static_cast<size_t>(image) < tag_corner_bounds.size()) {
+    const std::vector<TagCornerBound>& corners = tag_corner_bounds[static_cast<size_t>(image)];
+    const auto it = std::lower_bound(corners.begin(), corners.end(), TagCornerBound{kp, 0.0});
+    if (it != corners.end() && it->keypoint == kp) bound = std::max(bound, it->bound_px);
+  }
+  return bound * bound;
 }
 
 double MapperModel::SquaredError(const Eigen::Vector3d& position, int image, int kp) const {

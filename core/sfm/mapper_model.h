@@ -10,7 +10,10 @@
 #include "core/sfm/reconstruction.h"
 #include "core/sfm/tracks.h"
 
+
 namespace reconar {
+
+struct MapperOptions;
 
 struct MapperModel {
   Reconstruction rec;
@@ -22,6 +25,14 @@ struct MapperModel {
   std::vector<std::string> failure;    // per image: why it is not registered (yet)
   std::vector<int> tried_with;         // per image: visible points at the last failed attempt
   std::vector<int> neighbour_tried_with;  // the same for registration from a neighbour
+  // Per image: its tag corners' keypoints (sorted) and each one's error bound in pixels, the
+  // tag's mean edge there (MaxSquaredError).
+  struct TagCornerBound {
+    int keypoint = -1;
+    double bound_px = 0.0;
+    bool operator<(const TagCornerBound& other) const { return keypoint < other.keypoint; }
+  };
+  std::vector<std::vector<TagCornerBound>> tag_corner_bounds;
 
   // A model over `tracks` with no point yet: every track untriangulated.
   void SetTracks(TrackSet track_set);
@@ -29,6 +40,13 @@ struct MapperModel {
   // Squared reprojection error (pixels^2) of `position` in keypoint kp of `image`; infinity
   // behind the camera.
   double SquaredError(const Eigen::Vector3d& position, int image, int kp) const;
+  // The largest squared reprojection error (pixels^2) an observation of keypoint kp of `image`
+  // keeps: max_reprojection_error_px, or for a tag corner the tag's edge in that image when longer.
+  // A tag corner is identified by the decoded tag, not matched: far off, it says that the model
+  // drifted (the room's odd photos: the one view across the room saw three tags 7-16 px off their
+  // points and lost them, and with them the loop), while a corner still within the tag's own size
+  // is the same corner.
+  double MaxSquaredError(int image, int kp, const MapperOptions& options) const;
   // The largest angle (radians) between rays from the point to the centres of its first 30 views.
   double MaxTriangulationAngle(const SfmPoint& point) const;
   void AddObservation(int point_id, int image, int kp);

@@ -13,6 +13,7 @@
 #include "core/math/rigid3_json.h"
 #include "core/geometry/triangulation.h"
 #include "core/math/rotation.h"
+#include "core/sfm/tag_board.h"
 #include "core/sfm/tag_layout.h"
 #include "core/sfm/tag_squares.h"
 
@@ -338,10 +339,31 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
   }
   report.metres_per_model_unit = options.tag_size_m / mean_edge;
   if (options.layout.empty()) {
-    RECONAR_ASSIGN_OR_RETURN(report.world_from_model,
+    Sim3 world_tag_from_model;
+    RECONAR_ASSIGN_OR_RETURN(world_tag_from_model,
                              AlignSimilarity(AsVector(RigidTagCorners(*rec, seen.at(world->id), world->corners, mean_edge,
                                                                       options.max_reprojection_error_px)),
                                              AsVector(TagSquareCorners(options.tag_size_m)), report.metres_per_model_unit));
+    // The board: the world tag (its rigid square) and every other tag held by the adjustment (all,
+    // when none was), like the scale.
+    const bool any_tag_adjusted =
+        std::any_of(complete.begin(), complete.end(), [](const ModelTag& tag) { return tag.adjusted; });
+    std::vector<BoardTag> board = {{world->id, TagSquareCorners(options.tag_size_m)}};
+    for (const ModelTag& tag : complete) {
+      if (tag.id == world->id || (any_tag_adjusted && !tag.adjusted)) continue;
+      BoardTag placed{tag.id, {}};
+      for (size_t k = 0; k < 4; ++k) placed.corners[k] = world_tag_from_model.Apply(tag.corners[k]);
+      board.push_back(placed);
+    }
+    TagBoardFrame frame;
+    RECONAR_ASSIGN_OR_RETURN(frame, FitTagBoardFrame(board, world->id, options.tag_size_m));
+    report.world_from_model = world_tag_from_model;
+    report.world_from_model.rotation = frame.board_from_world_tag.rotation * world_tag_from_model.rotation;
+    report.world_from_model.translation =
+        frame.board_from_world_tag.rotation * world_tag_from_model.translation + frame.board_from_world_tag.translation;
+    report.board_plane_tags = frame.plane_tags;
+    report.board_up_tags = frame.up_tags;
+    report.board_turn_deg = frame.turn_deg;
   } else {
     // Every complete tag of the layout, its four corners onto their places there: the frame is
     // then as good as all those tags together, not one tag's corners.
@@ -432,7 +454,17 @@ std::string TagRegistrationJson(const TagRegistrationReport& report, const std::
   json.Key("family").String(family);
   json.Key("tag_size_m").Double(tag_size_m);
   json.Key("world_tag").Int(report.world_tag);
-  json.Key("frame").String(report.layout_tags.empty() ? "world_tag" : "layout");
+  const bool board = report.board_plane_tags.size() > 1 || report.board_up_tags.size() > 1;
+  json.Key("frame").String(!report.layout_tags.empty() ? "layout" : board ? "tag_board" : "world_tag");
+  if (report.layout_tags.empty() && report.metric) {
+    json.Key("plane_tags").BeginArray();
+    for (int id : report.board_plane_tags) json.Int(id);
+    json.EndArray();
+    json.Key("up_tags").BeginArray();
+    for (int id : report.board_up_tags) json.Int(id);
+    json.EndArray();
+    json.Key("board_turn_deg").Double(report.board_turn_deg);
+  }
   if (!report.layout_tags.empty()) {
     json.Key("layout_tags").BeginArray();
     for (int id : report.layout_tags) json.Int(id);

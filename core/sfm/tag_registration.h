@@ -64,7 +64,9 @@ std::vector<TagCornerKeypoint> AddTagCorrespondences(const std::vector<std::vect
 
 struct TagRegistrationOptions {
   double tag_size_m = 0.0;                 // edge of the black square (libapriltag's width_at_border), > 0
-  int world_tag = -1;                      // the tag whose frame becomes the world frame; -1: the lowest complete id
+  // The tag at the world frame's origin; -1: the lowest complete id. Without a layout the frame's
+  // axes are the tag board's (tag_board.h): the plane of the tags on its wall, the up they share.
+  int world_tag = -1;
   std::vector<int> scale_tags;             // the tags whose size sets the scale; empty: every complete tag
   // A layout the user declares (tag_layout.h, e.g. an earlier project's tags.layout or a survey):
   // when it holds any complete tag, the world frame is the layout's, fitted to every complete tag
@@ -92,6 +94,10 @@ struct TagRegistrationReport {
   bool metric = false;
   std::string reason;
   int world_tag = -1;
+  // Without a layout: the tags that fixed the frame with the world tag (tag_board.h; each list
+  // the world tag alone when it fixed the frame by itself) and the frame's turn from its own.
+  std::vector<int> board_plane_tags, board_up_tags;
+  double board_turn_deg = 0.0;
   // With a layout: the complete tags it holds, that fixed the frame, and the distances of their
   // corners from their places in the layout after the fit (metres).
   std::vector<int> layout_tags;
@@ -120,8 +126,9 @@ Result<TagRegistrationReport> RegisterToTags(const std::vector<std::vector<TagOb
                                              const std::vector<TagCornerKeypoint>& corner_keypoints,
                                              const TagRegistrationOptions& options, Reconstruction* rec);
 
-// PROJECT/tags.json: {"metric", "reason", "family", "tag_size_m", "world_tag", "frame" ("world_tag" or
-// "layout"), with a layout "layout_tags": [ids], "layout_rms_m", "layout_max_m"; "tags_seen",
+// PROJECT/tags.json: {"metric", "reason", "family", "tag_size_m", "world_tag", "frame" ("tag_board",
+// "world_tag" when no other tag shares its wall or up, or "layout"), without a layout "plane_tags",
+// "up_tags": [ids], "board_turn_deg", with one "layout_tags": [ids], "layout_rms_m", "layout_max_m"; "tags_seen",
 // "metres_per_model_unit", "scale_tags": [ids], "edge_mean_m", "edge_std_m", "edge_max_abs_error_m", "held_out_edges", "held_out_edge_mean_m",
 // "held_out_edge_std_m", "held_out_edge_max_abs_error_m" (when an edge is held out), "square_check":
 // {"segments", "rms_relative_error", "max_abs_relative_error"} (when the scale tags were squares), "tags": [{"id",

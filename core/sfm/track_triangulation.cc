@@ -72,7 +72,6 @@ bool TriangulateTrack(MapperModel* model, int track, const MapperOptions& option
 }
 
 void TriangulateImage(MapperModel* model, int image, const MapperOptions& options) {
-  const double max_error2 = options.max_reprojection_error_px * options.max_reprojection_error_px;
   SfmImage& img = model->rec.images[static_cast<size_t>(image)];
   const std::vector<int>& track_of = model->tracks.track_of[static_cast<size_t>(image)];
   for (size_t kp = 0; kp < track_of.size(); ++kp) {
@@ -82,7 +81,7 @@ void TriangulateImage(MapperModel* model, int image, const MapperOptions& option
     if (point_id < 0) {
       TriangulateTrack(model, t, options);
     } else if (model->SquaredError(model->rec.points[static_cast<size_t>(point_id)].position, image,
-                                   static_cast<int>(kp)) <= max_error2) {
+                                   static_cast<int>(kp)) <= model->MaxSquaredError(image, static_cast<int>(kp), options)) {
       model->AddObservation(point_id, image, static_cast<int>(kp));
     }
   }
@@ -92,14 +91,14 @@ void RetriangulateAll(MapperModel* model, const MapperOptions& options) {
   for (size_t t = 0; t < model->tracks.tracks.size(); ++t) {
     if (model->point_of_track[t] < 0) TriangulateTrack(model, static_cast<int>(t), options);
   }
-  const double max_error2 = options.max_reprojection_error_px * options.max_reprojection_error_px;
   for (size_t p = 0; p < model->rec.points.size(); ++p) {
     if (model->rec.points[p].deleted) continue;
     const int t = model->track_of_point[p];
     for (const TrackElement& e : model->tracks.tracks[static_cast<size_t>(t)]) {
       const SfmImage& img = model->rec.images[static_cast<size_t>(e.image_id)];
       if (!img.registered || img.point3d_ids[static_cast<size_t>(e.keypoint_id)] >= 0) continue;
-      if (model->SquaredError(model->rec.points[p].position, e.image_id, e.keypoint_id) <= max_error2) {
+      if (model->SquaredError(model->rec.points[p].position, e.image_id, e.keypoint_id) <=
+          model->MaxSquaredError(e.image_id, e.keypoint_id, options)) {
         model->AddObservation(static_cast<int>(p), e.image_id, e.keypoint_id);
       }
     }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "tests/core/sfm/synthetic_scene.h"
@@ -97,6 +98,40 @@ TEST(PointFilterTest, TooLittleParallaxDeletes) {
   EXPECT_EQ(model.rec.NumPoints(), 0);
   for (const SfmImage& image : model.rec.images) {
     for (int id : image.point3d_ids) EXPECT_EQ(id, -1);
+  }
+}
+
+}  // namespace
+}  // namespace reconar
+
+namespace reconar {
+namespace {
+
+// A tag corner is identified by its decoded tag: its observation stays while it is within the
+// tag's edge in that image (MapperModel::tag_corner_bounds), far beyond the 4 px of a match.
+TEST(PointFilterTest, ATagCornerStaysWithinItsTagsSize) {
+  MapperModel model = ExactTrueModel();
+  const int near = FirstPointWithTrackLength(model, 3, 100);
+  const int far = FirstPointWithTrackLength(model, 3, 100, near);
+  const int plain = FirstPointWithTrackLength(model, 3, 100, far);
+  ASSERT_GE(plain, 0);
+  const TrackElement near_view = model.rec.points[static_cast<size_t>(near)].track[1];
+  const TrackElement far_view = model.rec.points[static_cast<size_t>(far)].track[1];
+  const TrackElement plain_view = model.rec.points[static_cast<size_t>(plain)].track[1];
+  model.tag_corner_bounds.resize(model.rec.images.size());
+  for (const TrackElement& e : {near_view, far_view}) {
+    model.tag_corner_bounds[static_cast<size_t>(e.image_id)].push_back({e.keypoint_id, 25.0});  // a 25 px tag
+    std::sort(model.tag_corner_bounds[static_cast<size_t>(e.image_id)].begin(),
+              model.tag_corner_bounds[static_cast<size_t>(e.image_id)].end());
+  }
+  Shift(&model, near_view, Eigen::Vector2d(12.0, -9.0));  // 15 px: kept
+  Shift(&model, far_view, Eigen::Vector2d(24.0, 18.0));   // 30 px: more than the tag, dropped
+  Shift(&model, plain_view, Eigen::Vector2d(12.0, -9.0));  // 15 px, not a tag corner: dropped
+  const size_t track = model.rec.points[static_cast<size_t>(near)].track.size();
+  FilterPoints(&model, model.AllPoints(), MapperOptions());
+  EXPECT_EQ(model.rec.points[static_cast<size_t>(near)].track.size(), track);
+  for (const TrackElement& e : {far_view, plain_view}) {
+    EXPECT_EQ(model.rec.images[static_cast<size_t>(e.image_id)].point3d_ids[static_cast<size_t>(e.keypoint_id)], -1);
   }
 }
 
