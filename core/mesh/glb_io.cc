@@ -1,9 +1,14 @@
 #include "core/mesh/glb_io.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
+#include <map>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/base/atomic_file.h"
@@ -67,9 +72,22 @@ void WriteAccessor(JsonWriter* json, int buffer_view, int component_type, size_t
       .Key("type").String(type);
 }
 
-}  // namespace
+// One node of a scene to write; an empty name is left out.
+struct SceneElement {
+  std::string_view name;
+  const Mesh* mesh;
+};
 
-Result<std::string> EncodeGlb(const Mesh& mesh) {
+// What the JSON says about a mesh whose data is in the BIN chunk.
+struct MeshLayout {
+  Eigen::Vector3f min;  // of the positions
+  Eigen::Vector3f max;
+  bool short_indices;
+};
+
+// Appends the mesh's positions, normals, colours and indices to `bin`, one buffer view each, each
+// view 4-byte aligned.
+Result<MeshLayout> AppendMeshData(const Mesh& mesh, std::string* bin, std::vector<BufferViewSpec>* views) {
   RECONAR_RETURN_IF_ERROR(ValidateMesh(mesh));
   if (mesh.positions.empty()) return InvalidArgument("mesh: no vertices (glTF accessors need at least one)");
   RECONAR_RETURN_IF_ERROR(CheckFinite(mesh.positions, "position"));
@@ -80,86 +98,121 @@ Result<std::string> EncodeGlb(const Mesh& mesh) {
   if (num_vertices > std::numeric_limits<uint32_t>::max()) {
     return InvalidArgument("mesh: " + std::to_string(num_vertices) + " vertices exceed glTF's uint32 indices");
   }
-  const bool short_indices = num_vertices <= std::numeric_limits<uint16_t>::max();
+  MeshLayout layout{mesh.positions[0], mesh.positions[0], num_vertices <= std::numeric_limits<uint16_t>::max()};
 
-  // BIN chunk: positions, normals, colours, indices; each view 4-byte aligned.
-  std::string bin;
-  std::vector<BufferViewSpec> views;
-  const auto begin_view = [&] { return bin.size(); };
+  const auto begin_view = [&] { return bin->size(); };
   const auto end_view = [&](size_t offset, int target) {
-    views.push_back({offset, bin.size() - offset, target});
-    bin.resize(Align4(bin.size()), '\0');
+    views->push_back({offset, bin->size() - offset, target});
+    bin->resize(Align4(bin->size()), '\0');
   };
-  Eigen::Vector3f min = mesh.positions[0], max = mesh.positions[0];
   size_t offset = begin_view();
   for (const Eigen::Vector3f& p : mesh.positions) {
-    for (int axis = 0; axis < 3; ++axis) AppendLittleEndian(&bin, p[axis]);
-    min = min.cwiseMin(p);
-    max = max.cwiseMax(p);
+    for (int axis = 0; axis < 3; ++axis) AppendLittleEndian(bin, p[axis]);
+    layout.min = layout.min.cwiseMin(p);
+    layout.max = layout.max.cwiseMax(p);
   }
   end_view(offset, kTargetArrayBuffer);
   if (!mesh.normals.empty()) {
     offset = begin_view();
     for (const Eigen::Vector3f& n : mesh.normals) {
-      for (int axis = 0; axis < 3; ++axis) AppendLittleEndian(&bin, n[axis]);
+      for (int axis = 0; axis < 3; ++axis) AppendLittleEndian(bin, n[axis]);
     }
     end_view(offset, kTargetArrayBuffer);
   }
   if (!mesh.colors.empty()) {
     offset = begin_view();
-    for (const std::array<uint8_t, 4>& c : mesh.colors) bin.append(reinterpret_cast<const char*>(c.data()), 4);
+    for (const std::array<uint8_t, 4>& c : mesh.colors) bin->append(reinterpret_cast<const char*>(c.data()), 4);
     end_view(offset, kTargetArrayBuffer);
   }
   if (!mesh.triangles.empty()) {
     offset = begin_view();
     for (const std::array<uint32_t, 3>& triangle : mesh.triangles) {
       for (const uint32_t index : triangle) {
-        if (short_indices) {
-          AppendLittleEndian(&bin, static_cast<uint16_t>(index));
+        if (layout.short_indices) {
+          AppendLittleEndian(bin, static_cast<uint16_t>(index));
         } else {
-          AppendLittleEndian(&bin, index);
+          AppendLittleEndian(bin, index);
         }
       }
     }
     end_view(offset, kTargetElementArrayBuffer);
+  }
+  return layout;
+}
+
+// The mesh's one primitive; its accessors are numbered from *accessor on.
+void WriteMeshJson(JsonWriter* json, const Mesh& mesh, int* accessor) {
+  json->BeginObject().Key("primitives").BeginArray().BeginObject();
+  json->Key("attributes").BeginObject().Key("POSITION").Int((*accessor)++);
+  if (!mesh.normals.empty()) json->Key("NORMAL").Int((*accessor)++);
+  if (!mesh.colors.empty()) json->Key("COLOR_0").Int((*accessor)++);
+  json->EndObject();
+  if (!mesh.triangles.empty()) json->Key("indices").Int((*accessor)++);
+  json->Key("mode").Int(mesh.triangles.empty() ? kModePoints : kModeTriangles);
+  json->EndObject().EndArray().EndObject();
+}
+
+// The accessors of WriteMeshJson's primitive, on the buffer views numbered from *view on.
+void WriteAccessorsJson(JsonWriter* json, const Mesh& mesh, const MeshLayout& layout, int* view) {
+  const size_t num_vertices = mesh.positions.size();
+  WriteAccessor(json, (*view)++, kComponentFloat, num_vertices, "VEC3");
+  json->Key("min").BeginArray().Double(layout.min.x()).Double(layout.min.y()).Double(layout.min.z()).EndArray();
+  json->Key("max").BeginArray().Double(layout.max.x()).Double(layout.max.y()).Double(layout.max.z()).EndArray();
+  json->EndObject();
+  if (!mesh.normals.empty()) {
+    WriteAccessor(json, (*view)++, kComponentFloat, num_vertices, "VEC3");
+    json->EndObject();
+  }
+  if (!mesh.colors.empty()) {
+    WriteAccessor(json, (*view)++, kComponentUnsignedByte, num_vertices, "VEC4");
+    json->Key("normalized").Bool(true).EndObject();
+  }
+  if (!mesh.triangles.empty()) {
+    WriteAccessor(json, (*view)++, layout.short_indices ? kComponentUnsignedShort : kComponentUnsignedInt,
+                  3 * mesh.triangles.size(), "SCALAR");
+    json->EndObject();
+  }
+}
+
+Result<std::string> EncodeScene(const std::vector<SceneElement>& elements) {
+  if (elements.empty()) return InvalidArgument("glTF scene: no meshes to write");
+  // BIN chunk: each mesh's positions, normals, colours, indices.
+  std::string bin;
+  std::vector<BufferViewSpec> views;
+  std::vector<MeshLayout> layouts;
+  for (size_t i = 0; i < elements.size(); ++i) {
+    const std::string element = "element " + std::to_string(i) +
+                                (elements[i].name.empty() ? "" : " '" + std::string(elements[i].name) + "'");
+    // Our JSON reader, like the glTF specification, accepts UTF-8 strings only.
+    if (!ParseJson(JsonQuote(std::string(elements[i].name)), element).ok()) {
+      return InvalidArgument(element + ": the name is not valid UTF-8");
+    }
+    Result<MeshLayout> layout = AppendMeshData(*elements[i].mesh, &bin, &views);
+    if (!layout.ok()) return elements.size() == 1 ? layout.status() : layout.status().WithContext(element);
+    layouts.push_back(*layout);
   }
 
   JsonWriter json;
   json.BeginObject();
   json.Key("asset").BeginObject().Key("version").String("2.0").Key("generator").String("reconar").EndObject();
   json.Key("scene").Int(0);
-  json.Key("scenes").BeginArray().BeginObject().Key("nodes").BeginArray().Int(0).EndArray().EndObject().EndArray();
-  json.Key("nodes").BeginArray().BeginObject().Key("mesh").Int(0).EndObject().EndArray();
-
+  json.Key("scenes").BeginArray().BeginObject().Key("nodes").BeginArray();
+  for (size_t i = 0; i < elements.size(); ++i) json.Int(static_cast<long long>(i));
+  json.EndArray().EndObject().EndArray();
+  json.Key("nodes").BeginArray();
+  for (size_t i = 0; i < elements.size(); ++i) {
+    json.BeginObject();
+    if (!elements[i].name.empty()) json.Key("name").String(std::string(elements[i].name));
+    json.Key("mesh").Int(static_cast<long long>(i)).EndObject();
+  }
+  json.EndArray();
   int accessor = 0;
-  json.Key("meshes").BeginArray().BeginObject().Key("primitives").BeginArray().BeginObject();
-  json.Key("attributes").BeginObject().Key("POSITION").Int(accessor++);
-  if (!mesh.normals.empty()) json.Key("NORMAL").Int(accessor++);
-  if (!mesh.colors.empty()) json.Key("COLOR_0").Int(accessor++);
-  json.EndObject();
-  if (!mesh.triangles.empty()) json.Key("indices").Int(accessor++);
-  json.Key("mode").Int(mesh.triangles.empty() ? kModePoints : kModeTriangles);
-  json.EndObject().EndArray().EndObject().EndArray();
-
+  json.Key("meshes").BeginArray();
+  for (const SceneElement& element : elements) WriteMeshJson(&json, *element.mesh, &accessor);
+  json.EndArray();
   int view = 0;
   json.Key("accessors").BeginArray();
-  WriteAccessor(&json, view++, kComponentFloat, num_vertices, "VEC3");
-  json.Key("min").BeginArray().Double(min.x()).Double(min.y()).Double(min.z()).EndArray();
-  json.Key("max").BeginArray().Double(max.x()).Double(max.y()).Double(max.z()).EndArray();
-  json.EndObject();
-  if (!mesh.normals.empty()) {
-    WriteAccessor(&json, view++, kComponentFloat, num_vertices, "VEC3");
-    json.EndObject();
-  }
-  if (!mesh.colors.empty()) {
-    WriteAccessor(&json, view++, kComponentUnsignedByte, num_vertices, "VEC4");
-    json.Key("normalized").Bool(true).EndObject();
-  }
-  if (!mesh.triangles.empty()) {
-    WriteAccessor(&json, view++, short_indices ? kComponentUnsignedShort : kComponentUnsignedInt,
-                  3 * mesh.triangles.size(), "SCALAR");
-    json.EndObject();
-  }
+  for (size_t i = 0; i < elements.size(); ++i) WriteAccessorsJson(&json, *elements[i].mesh, layouts[i], &view);
   json.EndArray();
 
   json.Key("bufferViews").BeginArray();
@@ -196,10 +249,26 @@ Result<std::string> EncodeGlb(const Mesh& mesh) {
   return glb;
 }
 
-Status WriteGlb(const std::string& path, const Mesh& mesh) {
-  Result<std::string> glb = EncodeGlb(mesh);
+Status WriteEncodedGlb(const std::string& path, const Result<std::string>& glb) {
   if (!glb.ok()) return glb.status().WithContext(path);
   return WriteFileAtomically(path, *glb);
+}
+
+}  // namespace
+
+Result<std::string> EncodeGlb(const Mesh& mesh) { return EncodeScene({{std::string_view(), &mesh}}); }
+
+Status WriteGlb(const std::string& path, const Mesh& mesh) { return WriteEncodedGlb(path, EncodeGlb(mesh)); }
+
+Result<std::string> EncodeGlbScene(const std::vector<NamedMesh>& meshes) {
+  std::vector<SceneElement> elements;
+  elements.reserve(meshes.size());
+  for (const NamedMesh& named : meshes) elements.push_back({named.name, &named.mesh});
+  return EncodeScene(elements);
+}
+
+Status WriteGlbScene(const std::string& path, const std::vector<NamedMesh>& meshes) {
+  return WriteEncodedGlb(path, EncodeGlbScene(meshes));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -207,16 +276,98 @@ Status WriteGlb(const std::string& path, const Mesh& mesh) {
 
 namespace {
 
+constexpr int kMaxNodeDepth = 64;
+constexpr size_t kMaxSceneVertices = size_t{1} << 28;
+
+// The 6-bit value of a base64 character (RFC 4648, section 4), -1 for any other character.
+int Base64Value(char c) {
+  if (c >= 'A' && c <= 'Z') return c - 'A';
+  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+  if (c >= '0' && c <= '9') return c - '0' + 52;
+  if (c == '+') return 62;
+  if (c == '/') return 63;
+  return -1;
+}
+
+// RFC 4648 base64 with its padding; nullopt for a length that is not a multiple of 4, a character
+// outside the alphabet (white space included) or a '=' anywhere but in the last two places.
+std::optional<std::string> DecodeBase64(std::string_view text) {
+  if (text.size() % 4 != 0) return std::nullopt;
+  std::string bytes;
+  bytes.reserve(text.size() / 4 * 3);
+  for (size_t group = 0; group < text.size(); group += 4) {
+    const bool last = group + 4 == text.size();
+    const int padding = !last ? 0 : text[group + 3] != '=' ? 0 : text[group + 2] != '=' ? 1 : 2;
+    uint32_t bits = 0;
+    for (int i = 0; i < 4; ++i) {
+      const int value = i >= 4 - padding ? 0 : Base64Value(text[group + i]);
+      if (value < 0) return std::nullopt;
+      bits = (bits << 6) | static_cast<uint32_t>(value);
+    }
+    bytes.push_back(static_cast<char>(bits >> 16));
+    if (padding < 2) bytes.push_back(static_cast<char>((bits >> 8) & 0xFF));
+    if (padding < 1) bytes.push_back(static_cast<char>(bits & 0xFF));
+  }
+  return bytes;
+}
+
+int HexValue(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+// A URI's "%XX" escapes decoded (RFC 3986, section 2.1); nullopt for a malformed escape.
+std::optional<std::string> PercentDecode(std::string_view text) {
+  std::string decoded;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '%') {
+      decoded.push_back(text[i]);
+      continue;
+    }
+    const int high = i + 2 < text.size() ? HexValue(text[i + 1]) : -1;
+    const int low = i + 2 < text.size() ? HexValue(text[i + 2]) : -1;
+    if (high < 0 || low < 0) return std::nullopt;
+    decoded.push_back(static_cast<char>(high * 16 + low));
+    i += 2;
+  }
+  return decoded;
+}
+
 class GlbDecoder {
  public:
-  GlbDecoder(std::string_view bytes, const std::string& name) : bytes_(bytes), name_(name) {}
+  // `base_directory`: where the files that buffers' uris name are read from; without one, a
+  // buffer with a uri is kUnsupported.
+  GlbDecoder(std::string_view bytes, const std::string& name, std::optional<std::string> base_directory = {})
+      : bytes_(bytes), name_(name), base_directory_(std::move(base_directory)) {}
 
   Result<Mesh> Decode() {
     RECONAR_RETURN_IF_ERROR(ReadContainer());
     RECONAR_RETURN_IF_ERROR(CheckAssetAndExtensions());
     const JsonValue* primitive = nullptr;
     RECONAR_RETURN_IF_ERROR(FindFirstPrimitive(&primitive));
-    return ReadPrimitive(*primitive);
+    return ReadPrimitive(*primitive, "meshes[0].primitives[0]");
+  }
+
+  // A .glb, or a .gltf JSON text.
+  Result<std::vector<NamedMesh>> DecodeScene() {
+    if (bytes_.size() >= 4 && LoadLittleEndian<uint32_t>(bytes_.data()) == kGlbMagic) {
+      RECONAR_RETURN_IF_ERROR(ReadContainer());
+    } else {
+      RECONAR_RETURN_IF_ERROR(ParseGltfJson(bytes_, name_, "the glTF JSON"));
+    }
+    RECONAR_RETURN_IF_ERROR(CheckAssetAndExtensions());
+    std::vector<int64_t> parents;
+    RECONAR_RETURN_IF_ERROR(ReadNodeHierarchy(&parents));
+    std::vector<size_t> roots;
+    RECONAR_RETURN_IF_ERROR(GetSceneRoots(parents, &roots));
+    std::vector<NamedMesh> meshes;
+    for (const size_t root : roots) {
+      RECONAR_RETURN_IF_ERROR(AddNodeMeshes(root, Eigen::Affine3d::Identity(), &meshes));
+    }
+    if (meshes.empty()) return Corrupt("no triangle mesh in the scene");
+    return meshes;
   }
 
  private:
@@ -248,10 +399,7 @@ class GlbDecoder {
       const std::string_view data = bytes_.substr(position, chunk_length);
       if (first && chunk_type != kChunkJson) return Corrupt("the first chunk is not JSON");
       if (first) {
-        Result<JsonValue> json = ParseJson(data, name_ + " (JSON chunk)");
-        if (!json.ok()) return json.status();
-        json_ = std::move(json).value();
-        if (!json_.is_object()) return Corrupt("the JSON chunk is not an object");
+        RECONAR_RETURN_IF_ERROR(ParseGltfJson(data, name_ + " (JSON chunk)", "the JSON chunk"));
       } else if (chunk_type == kChunkBin && !has_bin_) {
         bin_ = data;
         has_bin_ = true;
@@ -260,6 +408,15 @@ class GlbDecoder {
       position = std::min<size_t>(Align4(position + chunk_length), length);
     }
     if (first) return Corrupt("no JSON chunk");
+    return Status::Ok();
+  }
+
+  // `json_name` prefixes the parser's messages; `what` names the JSON in ours.
+  Status ParseGltfJson(std::string_view text, const std::string& json_name, const std::string& what) {
+    Result<JsonValue> json = ParseJson(text, json_name);
+    if (!json.ok()) return json.status();
+    json_ = std::move(json).value();
+    if (!json_.is_object()) return Corrupt(what + " is not an object");
     return Status::Ok();
   }
 
@@ -418,16 +575,78 @@ class GlbDecoder {
     const std::string where = "buffers[" + std::to_string(index) + "]";
     if (buffers == nullptr || index >= static_cast<int64_t>(buffers->size())) return Corrupt(where + " missing");
     const JsonValue& entry = (*buffers)[static_cast<size_t>(index)];
-    if (entry.Find("uri") != nullptr) return Unsupported(where + " has a uri (external or data: URI buffers)");
-    if (index != 0) return Corrupt(where + " has no uri, but only buffers[0] can be the GLB's BIN chunk");
-    if (!has_bin_) return Corrupt("buffers[0] refers to the BIN chunk, but the file has none");
+    std::string_view data = bin_;
+    const char* source = "the BIN chunk";
+    if (const JsonValue* uri = entry.Find("uri")) {
+      if (!base_directory_.has_value()) return Unsupported(where + " has a uri (external or data: URI buffers)");
+      RECONAR_RETURN_IF_ERROR(LoadUriBuffer(static_cast<size_t>(index), *uri, where + ".uri", &data));
+      source = "the data of its uri";
+    } else {
+      if (index != 0) return Corrupt(where + " has no uri, but only buffers[0] can be the GLB's BIN chunk");
+      if (!has_bin_) return Corrupt("buffers[0] refers to the BIN chunk, but the file has none");
+    }
     int64_t length = 0;
     RECONAR_RETURN_IF_ERROR(GetIndex(entry, "byteLength", where, &length));
-    if (static_cast<uint64_t>(length) > bin_.size()) {
-      return Corrupt(where + ".byteLength " + std::to_string(length) + " exceeds the BIN chunk (" +
-                     std::to_string(bin_.size()) + " bytes)");
+    if (static_cast<uint64_t>(length) > data.size()) {
+      return Corrupt(where + ".byteLength " + std::to_string(length) + " exceeds " + source + " (" +
+                     std::to_string(data.size()) + " bytes)");
     }
-    *buffer = bin_.substr(0, static_cast<size_t>(length));
+    *buffer = data.substr(0, static_cast<size_t>(length));
+    return Status::Ok();
+  }
+
+  // The bytes of a base64 data: URI or of the file a relative URI names; each buffer is loaded once.
+  Status LoadUriBuffer(size_t index, const JsonValue& uri, const std::string& where, std::string_view* data) const {
+    if (const auto loaded = uri_buffers_.find(index); loaded != uri_buffers_.end()) {
+      *data = loaded->second;
+      return Status::Ok();
+    }
+    if (!uri.is_string()) return Corrupt(where + " is not a string");
+    const std::string& text = uri.string();
+    std::string bytes;
+    if (text.rfind("data:", 0) == 0) {
+      const size_t comma = text.find(',');
+      const std::string_view base64 = ";base64";
+      if (comma == std::string::npos || comma < 5 + base64.size() ||
+          std::string_view(text).substr(comma - base64.size(), base64.size()) != base64) {
+        return Unsupported(where + " is a data: URI without base64");
+      }
+      std::optional<std::string> decoded = DecodeBase64(std::string_view(text).substr(comma + 1));
+      if (!decoded.has_value()) return Corrupt(where + " is a data: URI with invalid base64");
+      bytes = std::move(*decoded);
+    } else {
+      std::string relative_path;
+      RECONAR_RETURN_IF_ERROR(RelativePathOfUri(text, where, &relative_path));
+      const std::string path = base_directory_->empty() ? relative_path : *base_directory_ + "/" + relative_path;
+      Result<std::string> file = ReadFileToString(path);
+      if (!file.ok()) return file.status().WithContext(name_ + ": " + where);
+      bytes = std::move(file).value();
+    }
+    *data = uri_buffers_.emplace(index, std::move(bytes)).first->second;
+    return Status::Ok();
+  }
+
+  // The file a URI names, relative to the base directory: no scheme, not absolute, no "..".
+  Status RelativePathOfUri(const std::string& uri, const std::string& where, std::string* relative_path) const {
+    const std::string quoted = where + " \"" + uri + "\"";
+    const size_t colon = uri.find(':');
+    if (colon != std::string::npos && colon < uri.find('/')) {
+      return Unsupported(quoted + ": only data: URIs and relative file names are read");
+    }
+    std::optional<std::string> decoded = PercentDecode(uri);
+    if (!decoded.has_value()) return Corrupt(quoted + " has a malformed percent escape");
+    if (decoded->empty() || decoded->find('\0') != std::string::npos) return Corrupt(quoted + " does not name a file");
+    if (decoded->front() == '/' || decoded->front() == '\\') return Corrupt(quoted + " is an absolute path");
+    size_t segment_start = 0;
+    while (segment_start <= decoded->size()) {
+      size_t segment_end = decoded->find_first_of("/\\", segment_start);
+      if (segment_end == std::string::npos) segment_end = decoded->size();
+      if (decoded->compare(segment_start, segment_end - segment_start, "..") == 0) {
+        return Corrupt(quoted + " leaves the directory of the file (\"..\")");
+      }
+      segment_start = segment_end + 1;
+    }
+    *relative_path = std::move(*decoded);
     return Status::Ok();
   }
 
@@ -489,36 +708,37 @@ class GlbDecoder {
     return Status::Ok();
   }
 
-  Result<Mesh> ReadPrimitive(const JsonValue& primitive) const {
+  // `where` names the primitive ("meshes[0].primitives[0]").
+  Result<Mesh> ReadPrimitive(const JsonValue& primitive, const std::string& where) const {
     if (const JsonValue* extensions = primitive.Find("extensions")) {
       if (extensions->Find("KHR_draco_mesh_compression") != nullptr) {
-        return Unsupported("meshes[0].primitives[0] is draco-compressed (KHR_draco_mesh_compression)");
+        return Unsupported(where + " is draco-compressed (KHR_draco_mesh_compression)");
       }
     }
     int64_t mode = kModeTriangles;
-    RECONAR_RETURN_IF_ERROR(GetIndex(primitive, "mode", "meshes[0].primitives[0]", &mode, kModeTriangles));
+    RECONAR_RETURN_IF_ERROR(GetIndex(primitive, "mode", where, &mode, kModeTriangles));
     if (mode != kModeTriangles && mode != kModePoints) {
       return Unsupported("primitive mode " + std::to_string(mode) + " (only TRIANGLES and POINTS are read)");
     }
     const JsonValue* attributes = primitive.Find("attributes");
-    if (attributes == nullptr || !attributes->is_object()) return Corrupt("meshes[0].primitives[0].attributes missing");
+    const std::string attributes_where = where + ".attributes";
+    if (attributes == nullptr || !attributes->is_object()) return Corrupt(attributes_where + " missing");
 
     Mesh mesh;
-    const std::string where = "meshes[0].primitives[0].attributes";
     int64_t index = 0;
-    RECONAR_RETURN_IF_ERROR(GetIndex(*attributes, "POSITION", where, &index));
+    RECONAR_RETURN_IF_ERROR(GetIndex(*attributes, "POSITION", attributes_where, &index));
     AccessorView view;
     RECONAR_RETURN_IF_ERROR(GetAccessor(index, &view));
     RECONAR_RETURN_IF_ERROR(ReadVectors(view, &mesh.positions));
     const size_t num_vertices = mesh.positions.size();
     if (attributes->Find("NORMAL") != nullptr) {
-      RECONAR_RETURN_IF_ERROR(GetIndex(*attributes, "NORMAL", where, &index));
+      RECONAR_RETURN_IF_ERROR(GetIndex(*attributes, "NORMAL", attributes_where, &index));
       RECONAR_RETURN_IF_ERROR(GetAccessor(index, &view));
       if (view.count != num_vertices) return Corrupt(view.where + ": NORMAL count differs from POSITION count");
       RECONAR_RETURN_IF_ERROR(ReadVectors(view, &mesh.normals));
     }
     if (attributes->Find("COLOR_0") != nullptr) {
-      RECONAR_RETURN_IF_ERROR(GetIndex(*attributes, "COLOR_0", where, &index));
+      RECONAR_RETURN_IF_ERROR(GetIndex(*attributes, "COLOR_0", attributes_where, &index));
       RECONAR_RETURN_IF_ERROR(GetAccessor(index, &view));
       if (view.count != num_vertices) return Corrupt(view.where + ": COLOR_0 count differs from POSITION count");
       RECONAR_RETURN_IF_ERROR(ReadColors(view, &mesh.colors));
@@ -534,7 +754,7 @@ class GlbDecoder {
       for (uint32_t i = 0; i < num_vertices; i += 3) mesh.triangles.push_back({i, i + 1, i + 2});
       return mesh;
     }
-    RECONAR_RETURN_IF_ERROR(GetIndex(primitive, "indices", "meshes[0].primitives[0]", &index));
+    RECONAR_RETURN_IF_ERROR(GetIndex(primitive, "indices", where, &index));
     RECONAR_RETURN_IF_ERROR(GetAccessor(index, &view));
     if (view.components != 1 || view.normalized ||
         (view.component_type != kComponentUnsignedByte && view.component_type != kComponentUnsignedShort &&
@@ -565,11 +785,242 @@ class GlbDecoder {
     }
   }
 
+  // Reads every node's children into node_children_ and checks that the nodes form trees: one
+  // parent per node, no cycle, at most kMaxNodeDepth levels. `parents[n]` is -1 for a root.
+  Status ReadNodeHierarchy(std::vector<int64_t>* parents) {
+    const JsonValue* nodes = RootArray("nodes");
+    const size_t num_nodes = nodes == nullptr ? 0 : nodes->size();
+    node_children_.assign(num_nodes, {});
+    parents->assign(num_nodes, -1);
+    for (size_t n = 0; n < num_nodes; ++n) {
+      const std::string where = "nodes[" + std::to_string(n) + "]";
+      if (!(*nodes)[n].is_object()) return Corrupt(where + " is not an object");
+      const JsonValue* children = (*nodes)[n].Find("children");
+      if (children == nullptr) continue;
+      if (!children->is_array()) return Corrupt(where + ".children is not an array");
+      for (size_t i = 0; i < children->size(); ++i) {
+        const std::string entry = where + ".children[" + std::to_string(i) + "]";
+        size_t child = 0;
+        RECONAR_RETURN_IF_ERROR(GetNodeIndex((*children)[i], entry, num_nodes, &child));
+        if ((*parents)[child] >= 0) {
+          return Corrupt(entry + ": nodes[" + std::to_string(child) + "] is already a child of nodes[" +
+                         std::to_string((*parents)[child]) + "]");
+        }
+        (*parents)[child] = static_cast<int64_t>(n);
+        node_children_[n].push_back(child);
+      }
+    }
+    std::vector<bool> reached(num_nodes, false);
+    for (size_t n = 0; n < num_nodes; ++n) {
+      if ((*parents)[n] < 0) RECONAR_RETURN_IF_ERROR(MarkSubtree(n, 1, &reached));
+    }
+    for (size_t n = 0; n < num_nodes; ++n) {
+      if (reached[n]) continue;
+      // With one parent per node, a node that no root reaches hangs from a cycle: climbing
+      // num_nodes parents from it ends on the cycle.
+      int64_t on_cycle = static_cast<int64_t>(n);
+      for (size_t step = 0; step < num_nodes; ++step) on_cycle = (*parents)[static_cast<size_t>(on_cycle)];
+      return Corrupt("nodes[" + std::to_string(on_cycle) + "] is its own ancestor (a cycle of children)");
+    }
+    return Status::Ok();
+  }
+
+  Status MarkSubtree(size_t node, int depth, std::vector<bool>* reached) const {
+    if (depth > kMaxNodeDepth) {
+      return Corrupt("nodes[" + std::to_string(node) + "] lies deeper than " + std::to_string(kMaxNodeDepth) +
+                     " levels in the node hierarchy");
+    }
+    (*reached)[node] = true;
+    for (const size_t child : node_children_[node]) RECONAR_RETURN_IF_ERROR(MarkSubtree(child, depth + 1, reached));
+    return Status::Ok();
+  }
+
+  Status GetNodeIndex(const JsonValue& value, const std::string& where, size_t num_nodes, size_t* node) const {
+    const std::optional<int64_t> index = value.AsInteger();
+    if (!index.has_value() || *index < 0 || static_cast<uint64_t>(*index) >= num_nodes) {
+      return Corrupt(where + " is not the index of a node");
+    }
+    *node = static_cast<size_t>(*index);
+    return Status::Ok();
+  }
+
+  // The root nodes of the scene `scene` (else of scenes[0]), or every root node when the file has
+  // neither `scene` nor `scenes`.
+  Status GetSceneRoots(const std::vector<int64_t>& parents, std::vector<size_t>* roots) const {
+    const JsonValue* scenes = RootArray("scenes");
+    const JsonValue* default_scene = json_.Find("scene");
+    if (default_scene == nullptr && scenes == nullptr) {
+      for (size_t n = 0; n < parents.size(); ++n) {
+        if (parents[n] < 0) roots->push_back(n);
+      }
+      return Status::Ok();
+    }
+    int64_t scene = 0;
+    if (default_scene != nullptr) {
+      const std::optional<int64_t> index = default_scene->AsInteger();
+      if (!index.has_value() || *index < 0) return Corrupt("scene is not a non-negative integer");
+      scene = *index;
+    }
+    const std::string where = "scenes[" + std::to_string(scene) + "]";
+    if (scenes == nullptr || scene >= static_cast<int64_t>(scenes->size())) return Corrupt(where + " missing");
+    const JsonValue* nodes = (*scenes)[static_cast<size_t>(scene)].Find("nodes");
+    if (nodes == nullptr) return Status::Ok();
+    if (!nodes->is_array()) return Corrupt(where + ".nodes is not an array");
+    std::vector<bool> listed(parents.size(), false);
+    for (size_t i = 0; i < nodes->size(); ++i) {
+      const std::string entry = where + ".nodes[" + std::to_string(i) + "]";
+      size_t node = 0;
+      RECONAR_RETURN_IF_ERROR(GetNodeIndex((*nodes)[i], entry, parents.size(), &node));
+      const std::string node_where = "nodes[" + std::to_string(node) + "]";
+      if (parents[node] >= 0) return Corrupt(entry + ": " + node_where + " is not a root node");
+      if (listed[node]) return Corrupt(entry + ": " + node_where + " is listed twice");
+      listed[node] = true;
+      roots->push_back(node);
+    }
+    return Status::Ok();
+  }
+
+  // `count` numbers of the array member `key`; `out` is left as it is when the member is absent.
+  Status GetNumbers(const JsonValue& object, const char* key, const std::string& where, size_t count,
+                    double* out) const {
+    const JsonValue* value = object.Find(key);
+    if (value == nullptr) return Status::Ok();
+    const std::string message = where + "." + key + " is not an array of " + std::to_string(count) + " numbers";
+    if (!value->is_array() || value->size() != count) return Corrupt(message);
+    for (size_t i = 0; i < count; ++i) {
+      if (!(*value)[i].is_number()) return Corrupt(message);
+      out[i] = (*value)[i].number();
+    }
+    return Status::Ok();
+  }
+
+  // The node's transform from its frame to its parent's.
+  Status GetLocalTransform(const JsonValue& node, const std::string& where, Eigen::Affine3d* local) const {
+    *local = Eigen::Affine3d::Identity();
+    if (node.Find("matrix") != nullptr) {
+      Eigen::Matrix4d matrix;
+      RECONAR_RETURN_IF_ERROR(GetNumbers(node, "matrix", where, 16, matrix.data()));  // both column-major
+      if (matrix.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) {
+        return Corrupt(where + ".matrix is not affine (its last row must be 0 0 0 1)");
+      }
+      local->matrix() = matrix;
+      return Status::Ok();
+    }
+    Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+    Eigen::Vector4d rotation(0, 0, 0, 1);  // x y z w
+    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+    RECONAR_RETURN_IF_ERROR(GetNumbers(node, "translation", where, 3, translation.data()));
+    RECONAR_RETURN_IF_ERROR(GetNumbers(node, "rotation", where, 4, rotation.data()));
+    RECONAR_RETURN_IF_ERROR(GetNumbers(node, "scale", where, 3, scale.data()));
+    const Eigen::Quaterniond quaternion(rotation[3], rotation[0], rotation[1], rotation[2]);
+    if (!std::isnormal(quaternion.norm())) return Corrupt(where + ".rotation is not a rotation quaternion");
+    local->linear() = quaternion.normalized().toRotationMatrix() * scale.asDiagonal();
+    local->translation() = translation;
+    return Status::Ok();
+  }
+
+  // Appends the meshes of nodes[node] and its descendants; `parent_transform` takes the parent's
+  // frame to the scene's.
+  Status AddNodeMeshes(size_t node, const Eigen::Affine3d& parent_transform, std::vector<NamedMesh>* meshes) {
+    const JsonValue& json_node = (*RootArray("nodes"))[node];
+    const std::string where = "nodes[" + std::to_string(node) + "]";
+    Eigen::Affine3d local;
+    RECONAR_RETURN_IF_ERROR(GetLocalTransform(json_node, where, &local));
+    const Eigen::Affine3d transform = parent_transform * local;
+    if (json_node.Find("mesh") != nullptr) {
+      int64_t mesh_index = 0;
+      RECONAR_RETURN_IF_ERROR(GetIndex(json_node, "mesh", where, &mesh_index));
+      const JsonValue* json_meshes = RootArray("meshes");
+      if (json_meshes == nullptr || mesh_index >= static_cast<int64_t>(json_meshes->size())) {
+        return Corrupt(where + ".mesh: meshes[" + std::to_string(mesh_index) + "] missing");
+      }
+      const JsonValue& json_mesh = (*json_meshes)[static_cast<size_t>(mesh_index)];
+      NamedMesh named;
+      RECONAR_RETURN_IF_ERROR(ReadTriangleMesh(json_mesh, "meshes[" + std::to_string(mesh_index) + "]", &named.mesh));
+      if (!named.mesh.triangles.empty()) {
+        RECONAR_RETURN_IF_ERROR(TransformToScene(transform, where, &named.mesh));
+        named.name = StringMember(json_node, "name");
+        if (named.name.empty()) named.name = StringMember(json_mesh, "name");
+        if (named.name.empty()) named.name = "node " + std::to_string(node);
+        meshes->push_back(std::move(named));
+      }
+    }
+    for (const size_t child : node_children_[node]) RECONAR_RETURN_IF_ERROR(AddNodeMeshes(child, transform, meshes));
+    return Status::Ok();
+  }
+
+  static std::string StringMember(const JsonValue& object, const char* key) {
+    const JsonValue* value = object.Find(key);
+    return value != nullptr && value->is_string() ? value->string() : std::string();
+  }
+
+  // The mesh's TRIANGLES primitives as one mesh in its own frame; no triangles when it has none.
+  Status ReadTriangleMesh(const JsonValue& json_mesh, const std::string& where, Mesh* mesh) {
+    const JsonValue* primitives = json_mesh.Find("primitives");
+    if (primitives == nullptr || !primitives->is_array()) return Corrupt(where + ".primitives missing");
+    bool every_primitive_has_normals = true, every_primitive_has_colors = true;
+    for (size_t p = 0; p < primitives->size(); ++p) {
+      const JsonValue& primitive = (*primitives)[p];
+      const std::string primitive_where = where + ".primitives[" + std::to_string(p) + "]";
+      if (!primitive.is_object()) return Corrupt(primitive_where + " is not an object");
+      int64_t mode = kModeTriangles;
+      RECONAR_RETURN_IF_ERROR(GetIndex(primitive, "mode", primitive_where, &mode, kModeTriangles));
+      if (mode != kModeTriangles) continue;
+      RECONAR_ASSIGN_OR_RETURN(const Mesh part, ReadPrimitive(primitive, primitive_where));
+      if (part.positions.size() > kMaxSceneVertices - scene_vertices_) {
+        return FileError(StatusCode::kResourceExhausted, name_,
+                         "more than " + std::to_string(kMaxSceneVertices) + " vertices in the scene");
+      }
+      scene_vertices_ += part.positions.size();
+      every_primitive_has_normals = every_primitive_has_normals && !part.normals.empty();
+      every_primitive_has_colors = every_primitive_has_colors && !part.colors.empty();
+      const uint32_t first_vertex = static_cast<uint32_t>(mesh->positions.size());
+      mesh->positions.insert(mesh->positions.end(), part.positions.begin(), part.positions.end());
+      mesh->normals.insert(mesh->normals.end(), part.normals.begin(), part.normals.end());
+      mesh->colors.insert(mesh->colors.end(), part.colors.begin(), part.colors.end());
+      for (const std::array<uint32_t, 3>& triangle : part.triangles) {
+        mesh->triangles.push_back({triangle[0] + first_vertex, triangle[1] + first_vertex, triangle[2] + first_vertex});
+      }
+    }
+    if (!every_primitive_has_normals) mesh->normals.clear();
+    if (!every_primitive_has_colors) mesh->colors.clear();
+    return Status::Ok();
+  }
+
+  // Positions by `transform`, normals by its inverse transpose (dropped when it is singular, as a
+  // zero scale makes it), the winding reversed when it mirrors.
+  Status TransformToScene(const Eigen::Affine3d& transform, const std::string& where, Mesh* mesh) const {
+    // Leaves the floats of an untransformed mesh as they are (-0 stays -0).
+    const bool identity = transform.matrix() == Eigen::Matrix4d::Identity();
+    for (size_t i = 0; i < mesh->positions.size(); ++i) {
+      const Eigen::Vector3d position = transform * mesh->positions[i].cast<double>();
+      // Also keeps the conversion to float defined.
+      if (!(position.array().abs() <= static_cast<double>(std::numeric_limits<float>::max())).all()) {
+        return Corrupt(where + ": vertex " + std::to_string(i) + " is not a finite float in the scene's frame");
+      }
+      if (!identity) mesh->positions[i] = position.cast<float>();
+    }
+    if (identity) return Status::Ok();
+    const Eigen::Matrix3d normal_transform = transform.linear().inverse().transpose();
+    if (!normal_transform.allFinite()) mesh->normals.clear();
+    for (Eigen::Vector3f& normal : mesh->normals) {
+      normal = (normal_transform * normal.cast<double>()).normalized().cast<float>();
+    }
+    if (transform.linear().determinant() < 0) {
+      for (std::array<uint32_t, 3>& triangle : mesh->triangles) std::swap(triangle[1], triangle[2]);
+    }
+    return Status::Ok();
+  }
+
   std::string_view bytes_;
   const std::string& name_;
+  const std::optional<std::string> base_directory_;
   JsonValue json_;
   std::string_view bin_;
   bool has_bin_ = false;
+  mutable std::map<size_t, std::string> uri_buffers_;  // the data of buffers with a uri, by buffer index
+  std::vector<std::vector<size_t>> node_children_;
+  size_t scene_vertices_ = 0;
 };
 
 }  // namespace
@@ -581,6 +1032,16 @@ Result<Mesh> DecodeGlb(std::string_view bytes, const std::string& name_for_error
 Result<Mesh> ReadGlb(const std::string& path) {
   RECONAR_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
   return DecodeGlb(bytes, path);
+}
+
+Result<std::vector<NamedMesh>> DecodeGltfScene(std::string_view bytes, const std::string& name_for_errors,
+                                               const std::string& base_directory) {
+  return GlbDecoder(bytes, name_for_errors, base_directory).DecodeScene();
+}
+
+Result<std::vector<NamedMesh>> ReadGltfScene(const std::string& path) {
+  RECONAR_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
+  return DecodeGltfScene(bytes, path, std::filesystem::path(path).parent_path().string());
 }
 
 }  // namespace reconar

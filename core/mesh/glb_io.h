@@ -20,8 +20,15 @@
 // draco-compressed primitive, sparse accessors, buffers with a URI (external file or data: URI),
 // other primitive modes, indexed POINTS. kCorruptData naming the file and the JSON path (e.g.
 // "accessors[3].count") for anything that does not parse or lies outside its buffer.
+//
+// The scene functions read and write a design model: several named elements, one node each.
+// WriteGlbScene writes one scene of one node per element (named, unless the name is empty), each
+// with its own mesh of one primitive laid out as WriteGlb lays out its mesh; WriteGlb is the scene
+// of one unnamed element. ReadGltfScene reads what WriteGlbScene writes and the scenes of other
+// tools, .glb or .gltf (see DecodeGltfScene).
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/base/status.h"
 #include "core/mesh/mesh.h"
@@ -36,5 +43,32 @@ Status WriteGlb(const std::string& path, const Mesh& mesh);
 // `name_for_errors` prefixes every message.
 Result<Mesh> DecodeGlb(std::string_view bytes, const std::string& name_for_errors);
 Result<Mesh> ReadGlb(const std::string& path);
+
+// The .glb bytes of one scene with one node per element, in order. kInvalidArgument as EncodeGlb
+// (naming the element when there are several), for no element, or for a name that is not UTF-8.
+Result<std::string> EncodeGlbScene(const std::vector<NamedMesh>& meshes);
+Status WriteGlbScene(const std::string& path, const std::vector<NamedMesh>& meshes);
+
+// Every node of the scene that has a mesh with triangles, as one NamedMesh each, in depth-first
+// order from the scene's root nodes: the scene's root nodes are those of `scene` (else scenes[0]),
+// or every node without a parent when the file has neither `scene` nor `scenes`. Positions and
+// normals are in the scene's frame: each node's `matrix` (column-major, affine) or translation *
+// rotation * scale, composed from the root down; normals by the inverse transpose (dropped when
+// that is singular), the winding reversed when the transform mirrors. All TRIANGLES primitives of
+// the node's mesh concatenated (other modes skipped); NORMAL and COLOR_0 kept only when every one
+// of them has it. The name is the node's `name`, else its mesh's, else "node N" (N its index).
+//
+// `bytes` is a .glb file or a .gltf JSON text. A buffer with a `uri` is a base64 `data:` URI or a
+// file relative to `base_directory` (empty: the working directory); the uri must be a relative
+// file name (percent-encoded as URIs are) without "..": kCorruptData otherwise, kUnsupported for
+// another scheme (http:, ...). Errors as DecodeGlb's, naming `name_for_errors` and the JSON path,
+// and kCorruptData for a node with two parents, a cycle of children, a hierarchy deeper than 64
+// levels, a scene root that is some node's child, a vertex that is not finite in the scene's frame
+// or a scene without any triangle ("no triangle mesh in the scene"); kResourceExhausted beyond
+// 2^28 vertices in all (nodes can instance a mesh many times).
+Result<std::vector<NamedMesh>> DecodeGltfScene(std::string_view bytes, const std::string& name_for_errors,
+                                               const std::string& base_directory);
+// .glb or .gltf; a .gltf's external buffers are read from its directory.
+Result<std::vector<NamedMesh>> ReadGltfScene(const std::string& path);
 
 }  // namespace reconar

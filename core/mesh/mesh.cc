@@ -1,5 +1,7 @@
 #include "core/mesh/mesh.h"
 
+#include <unordered_map>
+
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -41,6 +43,26 @@ void ComputeVertexNormals(Mesh* mesh) {
     const float length = normal.norm();
     normal = length > 1e-30f && std::isfinite(length) ? Eigen::Vector3f(normal / length) : Eigen::Vector3f::UnitZ();
   }
+}
+
+Mesh SubMesh(const Mesh& mesh, const std::vector<size_t>& triangles) {
+  Mesh part;
+  std::unordered_map<uint32_t, uint32_t> new_index;
+  part.triangles.reserve(triangles.size());
+  for (size_t t : triangles) {
+    std::array<uint32_t, 3> triangle = mesh.triangles[t];
+    for (uint32_t& vertex : triangle) {
+      const auto [it, added] = new_index.emplace(vertex, static_cast<uint32_t>(part.positions.size()));
+      if (added) {
+        part.positions.push_back(mesh.positions[vertex]);
+        if (!mesh.normals.empty()) part.normals.push_back(mesh.normals[vertex]);
+        if (!mesh.colors.empty()) part.colors.push_back(mesh.colors[vertex]);
+      }
+      vertex = it->second;
+    }
+    part.triangles.push_back(triangle);
+  }
+  return part;
 }
 
 }  // namespace reconar

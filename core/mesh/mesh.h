@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/base/status.h"
@@ -19,6 +20,12 @@ struct Mesh {
   bool is_point_cloud() const { return triangles.empty(); }
 };
 
+// A mesh with a name: an element of a design (a glTF node, an OBJ group).
+struct NamedMesh {
+  std::string name;
+  Mesh mesh;
+};
+
 // Ok when `normals` and `colors` are empty or hold one entry per position and every triangle index
 // is below positions.size(); otherwise kInvalidArgument naming the first problem. The writers
 // (core/mesh/mesh_io.h, glb_io.h) check this before writing anything.
@@ -28,5 +35,9 @@ Status ValidateMesh(const Mesh& mesh);
 // by the counter-clockwise winding. Vertices without a non-degenerate triangle get (0, 0, 1) so
 // that every normal is unit length (glTF requires it). The mesh must pass ValidateMesh.
 void ComputeVertexNormals(Mesh* mesh);
+
+// The given triangles of `mesh` (indices into mesh.triangles, each at most once, all valid) with
+// only the vertices they use, in their first-use order, and those vertices' normals and colours.
+Mesh SubMesh(const Mesh& mesh, const std::vector<size_t>& triangles);
 
 }  // namespace reconar

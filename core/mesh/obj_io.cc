@@ -1,5 +1,7 @@
 #include "core/mesh/obj_io.h"
 
+#include <algorithm>
+
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -100,6 +102,10 @@ class ObjParser {
  public:
   explicit ObjParser(const std::string& path) : path_(path) {}
 
+  // Per triangle of the parsed mesh, its group; the groups' names.
+  const std::vector<int>& triangle_groups() const { return triangle_group_; }
+  const std::vector<std::string>& group_names() const { return group_names_; }
+
   Result<Mesh> Parse(std::string_view text) {
     size_t position = 0;
     while (position < text.size()) {
@@ -129,6 +135,20 @@ class ObjParser {
     if (fields[0] == "v") return ParseVertex(fields);
     if (fields[0] == "vn") return ParseNormal(fields);
     if (fields[0] == "f") return ParseFace(fields);
+    if (fields[0] == "g" || fields[0] == "o") return ParseGroup(line, fields);
+    return Status::Ok();
+  }
+
+  Status ParseGroup(std::string_view line, const std::vector<std::string_view>& fields) {
+    std::string name = "default";
+    if (fields.size() > 1) {
+      const size_t begin = static_cast<size_t>(fields[1].data() - line.data());
+      const size_t end = static_cast<size_t>(fields.back().data() + fields.back().size() - line.data());
+      name = std::string(line.substr(begin, end - begin));
+    }
+    const auto known = std::find(group_names_.begin(), group_names_.end(), name);
+    group_ = static_cast<int>(known - group_names_.begin());
+    if (known == group_names_.end()) group_names_.push_back(name);
     return Status::Ok();
   }
 
@@ -197,6 +217,7 @@ class ObjParser {
       corners_.push_back(parsed);
     }
     faces_.push_back({first_corner, corners_.size()});
+    face_group_.push_back(group_);
     return Status::Ok();
   }
 
@@ -217,11 +238,13 @@ class ObjParser {
                              "]");
       }
     }
-    for (const auto& [begin, end] : faces_) {
+    for (size_t f = 0; f < faces_.size(); ++f) {
+      const auto& [begin, end] = faces_[f];
       for (size_t k = begin + 2; k < end; ++k) {
         mesh_.triangles.push_back({static_cast<uint32_t>(corners_[begin].vertex),
                                    static_cast<uint32_t>(corners_[k - 1].vertex),
                                    static_cast<uint32_t>(corners_[k].vertex)});
+        triangle_group_.push_back(face_group_[f]);
       }
     }
     return Status::Ok();
@@ -251,6 +274,10 @@ class ObjParser {
   const std::string& path_;
   int line_ = 0;
   Mesh mesh_;
+  std::vector<std::string> group_names_ = {"default"};
+  int group_ = 0;                    // index into group_names_ of the faces now read
+  std::vector<int> face_group_;      // per face
+  std::vector<int> triangle_group_;  // per triangle of mesh_
   size_t num_coloured_ = 0;
   std::vector<Eigen::Vector3f> file_normals_;
   std::vector<Corner> corners_;
@@ -269,6 +296,24 @@ Status WriteObj(const std::string& path, const Mesh& mesh) {
 Result<Mesh> ReadObj(const std::string& path) {
   RECONAR_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
   return ObjParser(path).Parse(text);
+}
+
+Result<std::vector<NamedMesh>> ReadObjGroups(const std::string& path) {
+  RECONAR_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  ObjParser parser(path);
+  RECONAR_ASSIGN_OR_RETURN(const Mesh mesh, parser.Parse(text));
+  if (mesh.triangles.empty()) return FileError(StatusCode::kCorruptData, path, "no faces ('f' lines)");
+  const std::vector<std::string>& names = parser.group_names();
+  std::vector<std::vector<size_t>> triangles_of(names.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    triangles_of[static_cast<size_t>(parser.triangle_groups()[t])].push_back(t);
+  }
+  std::vector<NamedMesh> groups;
+  for (size_t g = 0; g < names.size(); ++g) {
+    if (triangles_of[g].empty()) continue;
+    groups.push_back({names[g], SubMesh(mesh, triangles_of[g])});
+  }
+  return groups;
 }
 
 }  // namespace reconar

@@ -21,7 +21,13 @@
 // vertex has them (alpha 255). Errors: kNotFound for a missing file; kCorruptData naming the file
 // and line for a malformed number, a bad corner or an index out of range, and for a file without
 // any vertex.
+//
+// ReadObjGroups reads the same, and splits the triangles by the group their face was in ("g NAME"
+// or "o NAME", the latest of either; faces before any are the group "default"): one NamedMesh per
+// group with faces, in the order the groups first appear, each with only the vertices its
+// triangles use (their normals and colours with them). A file without faces is kCorruptData.
 #include <string>
+#include <vector>
 
 #include "core/base/status.h"
 #include "core/mesh/mesh.h"
@@ -30,5 +36,6 @@ namespace reconar {
 
 Status WriteObj(const std::string& path, const Mesh& mesh);
 Result<Mesh> ReadObj(const std::string& path);
+Result<std::vector<NamedMesh>> ReadObjGroups(const std::string& path);
 
 }  // namespace reconar

@@ -73,7 +73,97 @@ double BoxEntry(const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max, 
   return near;
 }
 
+// Squared distance from the point to the box (0 inside).
+double BoxDistanceSquared(const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max, const Eigen::Vector3d& p) {
+  double sum = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double below = box_min[a] - p[a], above = p[a] - box_max[a];
+    const double d = std::max({below, above, 0.0});
+    sum += d * d;
+  }
+  return sum;
+}
+
+Eigen::Vector3d ClosestPointOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double length_squared = ab.squaredNorm();
+  if (length_squared <= 0.0) return a;
+  return a + std::clamp((p - a).dot(ab) / length_squared, 0.0, 1.0) * ab;
+}
+
+// The point of triangle abc nearest to p (Ericson, "Real-Time Collision Detection" 5.1.5: the
+// Voronoi regions of the corners, then the edges, then the face, where *interior is set).
+// Triangles of (numerically) zero area take the nearest of their edges: a point (p, p, p) is p.
+Eigen::Vector3d ClosestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& c, bool* interior) {
+  *interior = false;
+  const Eigen::Vector3d ab = b - a, ac = c - a;
+  if (ab.cross(ac).squaredNorm() <= 1e-24 * ab.squaredNorm() * ac.squaredNorm()) {
+    Eigen::Vector3d best = ClosestPointOnSegment(p, a, b);
+    for (const Eigen::Vector3d& candidate : {ClosestPointOnSegment(p, a, c), ClosestPointOnSegment(p, b, c)}) {
+      if ((candidate - p).squaredNorm() < (best - p).squaredNorm()) best = candidate;
+    }
+    return best;
+  }
+  const Eigen::Vector3d ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + d1 / (d1 - d3) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + d2 / (d2 - d6) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+  *interior = true;
+  const double inverse = 1.0 / (va + vb + vc);
+  return a + ab * (vb * inverse) + ac * (vc * inverse);
+}
+
 }  // namespace
+
+NearestSurfacePoint TriangleBvh::Nearest(const Eigen::Vector3d& query, double max_distance) const {
+  NearestSurfacePoint nearest;
+  if (nodes_.empty()) return nearest;
+  double best2 = max_distance < 1e150 ? max_distance * max_distance : INFINITY;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[static_cast<size_t>(stack[--top])];
+    if (!(BoxDistanceSquared(node.box_min, node.box_max, query) <= best2)) continue;
+    if (node.count > 0) {
+      for (int k = node.first; k < node.first + node.count; ++k) {
+        const int t = order_[static_cast<size_t>(k)];
+        const std::array<Eigen::Vector3f, 3>& c = corners_[static_cast<size_t>(t)];
+        bool interior = false;
+        const Eigen::Vector3d point =
+            ClosestOnTriangle(query, c[0].cast<double>(), c[1].cast<double>(), c[2].cast<double>(), &interior);
+        const double d2 = (point - query).squaredNorm();
+        if (d2 <= best2) {
+          best2 = d2;
+          nearest = {t, std::sqrt(d2), point, interior};
+        }
+      }
+      continue;
+    }
+    if (top + 2 > static_cast<int>(sizeof(stack) / sizeof(stack[0]))) continue;
+    const int first = static_cast<int>(&node - nodes_.data()) + 1, second = node.first;
+    const Node& a = nodes_[static_cast<size_t>(first)];
+    const Node& b = nodes_[static_cast<size_t>(second)];
+    // The nearer child is searched first: pushed last.
+    const bool first_nearer =
+        BoxDistanceSquared(a.box_min, a.box_max, query) <= BoxDistanceSquared(b.box_min, b.box_max, query);
+    stack[top++] = first_nearer ? second : first;
+    stack[top++] = first_nearer ? first : second;
+  }
+  return nearest;
+}
 
 RayHit TriangleBvh::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double min_distance,
                               double max_distance) const {

@@ -5,7 +5,9 @@
 //
 // Binary tree of axis-aligned boxes; a node splits its triangles at the median of their centroids
 // along the longest axis of the centroids' box, down to leaves of at most kLeafSize triangles.
-// Rays are met with triangles by Moller & Trumbore (1997), both faces counted.
+// Rays are met with triangles by Moller & Trumbore (1997), both faces counted; the nearest point of
+// the surface to a point is found depth first, nearer box first, pruned by the best so far
+// (closest point on a triangle after Ericson, Real-Time Collision Detection, 5.1.5).
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -22,6 +24,13 @@ struct RayHit {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
 };
 
+struct NearestSurfacePoint {
+  int triangle = -1;       // index into the mesh's triangles; -1: none within the bound
+  double distance = 0.0;   // from the query point
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  bool interior = false;   // the nearest point lies inside the triangle, not on an edge or corner
+};
+
 class TriangleBvh {
  public:
   static constexpr int kLeafSize = 4;
@@ -31,6 +40,9 @@ class TriangleBvh {
   // The nearest triangle the ray origin + t direction meets for min_distance < t < max_distance.
   RayHit Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double min_distance = 0.0,
                    double max_distance = 1e300) const;
+
+  // The surface point nearest to `query` no farther than max_distance.
+  NearestSurfacePoint Nearest(const Eigen::Vector3d& query, double max_distance = 1e300) const;
 
   int num_triangles() const { return static_cast<int>(order_.size()); }  // the usable ones
 

@@ -14,70 +14,10 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr uint32_t kLeafSize = 4;
-// Median splits halve every node, so the depth stays below 33 for 2^32 primitives; nearest-first
-// traversal keeps at most one pending sibling per level.
-constexpr int kMaxStack = 64;
 
 // A uniform double in [0, 1) from 53 random bits: the same sequence on every platform, unlike
 // std::uniform_real_distribution.
 double Uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-Eigen::Vector3d ClosestPointOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const Eigen::Vector3d ab = b - a;
-  const double length_squared = ab.squaredNorm();
-  if (length_squared <= 0.0) return a;
-  const double t = std::clamp((p - a).dot(ab) / length_squared, 0.0, 1.0);
-  return a + t * ab;
-}
-
-// Ericson, "Real-Time Collision Detection" (2005), 5.1.5: Voronoi regions of the vertices, then
-// the edges, then the face. Triangles of (numerically) zero area take the nearest of their edges.
-Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                       const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a;
-  const Eigen::Vector3d ac = c - a;
-  if (ab.cross(ac).squaredNorm() <= 1e-24 * ab.squaredNorm() * ac.squaredNorm()) {
-    Eigen::Vector3d best = ClosestPointOnSegment(p, a, b);
-    for (const Eigen::Vector3d& candidate : {ClosestPointOnSegment(p, a, c), ClosestPointOnSegment(p, b, c)}) {
-      if ((candidate - p).squaredNorm() < (best - p).squaredNorm()) best = candidate;
-    }
-    return best;
-  }
-  const Eigen::Vector3d ap = p - a;
-  const double d1 = ab.dot(ap);
-  const double d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return a;
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp);
-  const double d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + (d1 / (d1 - d3)) * ab;
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp);
-  const double d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + (d2 / (d2 - d6)) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
-    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  }
-  const double inverse = 1.0 / (va + vb + vc);
-  return a + ab * (vb * inverse) + ac * (vc * inverse);
-}
-
-double BoxDistanceSquared(const Eigen::Vector3f& p, const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max) {
-  double sum = 0.0;
-  for (int axis = 0; axis < 3; ++axis) {
-    const double below = static_cast<double>(box_min[axis]) - p[axis];
-    const double above = static_cast<double>(p[axis]) - box_max[axis];
-    const double gap = std::max({below, above, 0.0});
-    sum += gap * gap;
-  }
-  return sum;
-}
 
 double Mean(const std::vector<double>& values) {
   double sum = 0.0;
@@ -207,104 +147,29 @@ std::vector<Eigen::Vector3f> SampleSurface(const Mesh& mesh, size_t count, uint6
   return samples;
 }
 
-MeshDistanceField::MeshDistanceField(const Mesh& mesh) {
-  std::vector<std::array<Eigen::Vector3f, 3>> corners;
-  if (mesh.triangles.empty()) {
-    corners.reserve(mesh.positions.size());
-    for (const Eigen::Vector3f& p : mesh.positions) corners.push_back({p, p, p});
-  } else {
-    corners.reserve(mesh.triangles.size());
-    for (const std::array<uint32_t, 3>& t : mesh.triangles) {
-      corners.push_back({mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]});
-    }
-  }
-  if (corners.empty()) return;
-  std::vector<uint32_t> order(corners.size());
-  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-  nodes_.reserve(2 * corners.size() / kLeafSize + 1);
-  Build(order, 0, static_cast<uint32_t>(order.size()), corners);
-  corners_.reserve(corners.size());
-  for (const uint32_t id : order) corners_.push_back(corners[id]);
-  primitive_ids_ = std::move(order);
+namespace {
+
+// A point cloud as triangles (p, p, p): the nearest triangle is then the nearest point.
+Mesh AsTriangles(const Mesh& mesh) {
+  if (!mesh.triangles.empty()) return mesh;
+  Mesh points;
+  points.positions = mesh.positions;
+  for (uint32_t i = 0; i < mesh.positions.size(); ++i) points.triangles.push_back({i, i, i});
+  return points;
 }
 
-uint32_t MeshDistanceField::Build(std::vector<uint32_t>& order, uint32_t begin, uint32_t end,
-                                  const std::vector<std::array<Eigen::Vector3f, 3>>& corners) {
-  const uint32_t index = static_cast<uint32_t>(nodes_.size());
-  nodes_.emplace_back();
-  Eigen::Vector3f box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
-  Eigen::Vector3f box_max = -box_min;
-  Eigen::Vector3f centre_min = box_min;
-  Eigen::Vector3f centre_max = box_max;
-  for (uint32_t i = begin; i < end; ++i) {
-    const std::array<Eigen::Vector3f, 3>& c = corners[order[i]];
-    for (const Eigen::Vector3f& corner : c) {
-      box_min = box_min.cwiseMin(corner);
-      box_max = box_max.cwiseMax(corner);
-    }
-    const Eigen::Vector3f centre = (c[0] + c[1] + c[2]) / 3.0f;
-    centre_min = centre_min.cwiseMin(centre);
-    centre_max = centre_max.cwiseMax(centre);
-  }
-  nodes_[index].box_min = box_min;
-  nodes_[index].box_max = box_max;
-  if (end - begin <= kLeafSize) {
-    nodes_[index].first = begin;
-    nodes_[index].count = end - begin;
-    return index;
-  }
-  int axis = 0;
-  (centre_max - centre_min).maxCoeff(&axis);
-  const uint32_t middle = begin + (end - begin) / 2;
-  auto centre_on_axis = [&](uint32_t id) { return corners[id][0][axis] + corners[id][1][axis] + corners[id][2][axis]; };
-  std::nth_element(order.begin() + begin, order.begin() + middle, order.begin() + end,
-                   [&](uint32_t l, uint32_t r) { return centre_on_axis(l) < centre_on_axis(r); });
-  Build(order, begin, middle, corners);
-  const uint32_t second = Build(order, middle, end, corners);
-  nodes_[index].first = second;
-  nodes_[index].count = 0;
-  return index;
-}
+}  // namespace
+
+MeshDistanceField::MeshDistanceField(const Mesh& mesh) : bvh_(AsTriangles(mesh)) {}
 
 ClosestSurfacePoint MeshDistanceField::Closest(const Eigen::Vector3f& point) const {
   ClosestSurfacePoint result;
   result.distance = kInfinity;
-  if (nodes_.empty()) return result;
-  const Eigen::Vector3d p = point.cast<double>();
-  double best_squared = kInfinity;
-  uint32_t stack[kMaxStack];
-  int size = 0;
-  stack[size++] = 0;
-  while (size > 0) {
-    const Node& node = nodes_[stack[--size]];
-    if (BoxDistanceSquared(point, node.box_min, node.box_max) >= best_squared) continue;
-    if (node.count > 0) {
-      for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-        const std::array<Eigen::Vector3f, 3>& c = corners_[i];
-        const Eigen::Vector3d closest =
-            ClosestPointOnTriangle(p, c[0].cast<double>(), c[1].cast<double>(), c[2].cast<double>());
-        const double squared = (closest - p).squaredNorm();
-        if (squared < best_squared) {
-          best_squared = squared;
-          result.point = closest;
-          result.primitive = primitive_ids_[i];
-        }
-      }
-      continue;
-    }
-    const uint32_t first_child = static_cast<uint32_t>(&node - nodes_.data()) + 1;
-    const uint32_t second_child = node.first;
-    const double first_distance = BoxDistanceSquared(point, nodes_[first_child].box_min, nodes_[first_child].box_max);
-    const double second_distance =
-        BoxDistanceSquared(point, nodes_[second_child].box_min, nodes_[second_child].box_max);
-    // The nearer child goes on top of the stack, so it is searched first.
-    const bool first_is_nearer = first_distance <= second_distance;
-    const uint32_t nearer = first_is_nearer ? first_child : second_child;
-    const uint32_t farther = first_is_nearer ? second_child : first_child;
-    if (std::max(first_distance, second_distance) < best_squared) stack[size++] = farther;
-    if (std::min(first_distance, second_distance) < best_squared) stack[size++] = nearer;
-  }
-  result.distance = std::sqrt(best_squared);
+  const NearestSurfacePoint nearest = bvh_.Nearest(point.cast<double>());
+  if (nearest.triangle < 0) return result;
+  result.distance = nearest.distance;
+  result.point = nearest.point;
+  result.primitive = static_cast<uint32_t>(nearest.triangle);
   return result;
 }
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/mesh/mesh.h"
+#include "core/mesh/triangle_bvh.h"
 
 namespace reconar::testing {
 
@@ -28,11 +29,9 @@ struct ClosestSurfacePoint {
 };
 
 // Exact Euclidean distance from a point to the nearest triangle of a mesh (to the nearest vertex
-// when the mesh is a point cloud). A bounding-volume hierarchy (median splits on the longest
-// axis, leaves of up to 4 triangles) is searched nearest box first; the distance to each
-// candidate triangle is computed in double (Ericson, "Real-Time Collision Detection", 5.1.5;
-// zero-area triangles fall back to their edges). Queries are const and thread-safe. The field
-// copies what it needs: the mesh may be destroyed after construction.
+// when the mesh is a point cloud): core/mesh/triangle_bvh.h's nearest-point query, a point cloud
+// taken as triangles (p, p, p). Queries are const and thread-safe. The field copies what it
+// needs: the mesh may be destroyed after construction.
 class MeshDistanceField {
  public:
   explicit MeshDistanceField(const Mesh& mesh);
@@ -42,22 +41,10 @@ class MeshDistanceField {
   // distance +infinity (and primitive 0) when the mesh is empty.
   ClosestSurfacePoint Closest(const Eigen::Vector3f& point) const;
 
-  size_t num_primitives() const { return corners_.size(); }
+  size_t num_primitives() const { return static_cast<size_t>(bvh_.num_triangles()); }
 
  private:
-  struct Node {
-    Eigen::Vector3f box_min;
-    Eigen::Vector3f box_max;
-    uint32_t first = 0;  // leaf: first primitive in corners_; inner: index of the second child
-    uint32_t count = 0;  // primitives in a leaf; 0 for an inner node (first child = this + 1)
-  };
-
-  uint32_t Build(std::vector<uint32_t>& order, uint32_t begin, uint32_t end,
-                 const std::vector<std::array<Eigen::Vector3f, 3>>& corners);
-
-  std::vector<Node> nodes_;
-  std::vector<std::array<Eigen::Vector3f, 3>> corners_;  // in leaf order; a point is (p, p, p)
-  std::vector<uint32_t> primitive_ids_;                  // leaf order -> index in the mesh
+  TriangleBvh bvh_;
 };
 
 // Distances between the surfaces of two triangle meshes, both ways: `samples` area-uniform points

@@ -115,6 +115,12 @@ TEST_F(GlbDataTest, KhronosValidatorAcceptsOurFiles) {
   ASSERT_TRUE(WriteMeshFile(dispatched, bunny).ok());
   files += " " + dispatched;
   meshes.emplace_back("bunny_mesh_file.GLB", Mesh());
+  // A design of named elements, one node each: a mesh with uint16 indices, one with uint32, a
+  // point cloud, and an unnamed element.
+  const std::string scene = (dir_ / "design_scene.glb").string();
+  ASSERT_TRUE(WriteGlbScene(scene, {{"bunny", bunny}, {"floor \"A\"", grid}, {"points", *scan}, {"", bunny}}).ok());
+  files += " " + scene;
+  meshes.emplace_back("design_scene.glb", Mesh());
   const testing::CommandRun run = testing::RunCommand("node " + std::string(RECONAR_SOURCE_DIR) +
                                                       "/tests/core/mesh/validate_glb.js " + validator_dir + files,
                                                       testing::StderrMode::kSeparate);

@@ -185,5 +185,39 @@ TEST_F(ObjTest, RefusesInconsistentOrNonFiniteMeshesAndWritesNothing) {
   EXPECT_FALSE(ReadFileToString(path).ok());
 }
 
+// A design's elements: faces split by their group ("g" or "o", the latest), each group with only
+// its own vertices; a group named again continues; faces before any group are "default".
+TEST_F(ObjTest, GroupsSplitIntoNamedMeshes) {
+  const std::string path = Write("design.obj",
+                                 "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nv 6 5 5\nv 6 6 5\n"
+                                 "f 1 2 3\n"
+                                 "g wall north  # a comment\n"
+                                 "f 1 3 4\n"
+                                 "o door\n"
+                                 "f 5 6 7\n"
+                                 "g wall north\n"
+                                 "f 2 3 4\n");
+  const Result<std::vector<NamedMesh>> groups = ReadObjGroups(path);
+  ASSERT_TRUE(groups.ok()) << groups.status().message();
+  ASSERT_EQ(groups->size(), 3u);
+  EXPECT_EQ((*groups)[0].name, "default");
+  EXPECT_EQ((*groups)[1].name, "wall north");
+  EXPECT_EQ((*groups)[2].name, "door");
+  EXPECT_EQ((*groups)[0].mesh.triangles.size(), 1u);
+  EXPECT_EQ((*groups)[1].mesh.triangles.size(), 2u);
+  EXPECT_EQ((*groups)[1].mesh.positions.size(), 4u);  // vertices 1..4, nothing of the door
+  const Mesh& door = (*groups)[2].mesh;
+  ASSERT_EQ(door.positions.size(), 3u);
+  EXPECT_EQ(door.positions[door.triangles[0][1]], Eigen::Vector3f(6, 5, 5));
+  EXPECT_TRUE(ValidateMesh(door).ok());
+}
+
+TEST_F(ObjTest, GroupsOfAFileWithoutFacesIsAnError) {
+  const std::string path = Write("points.obj", "v 0 0 0\nv 1 0 0\ng a\n");
+  const Result<std::vector<NamedMesh>> groups = ReadObjGroups(path);
+  ASSERT_FALSE(groups.ok());
+  EXPECT_NE(groups.status().message().find("points.obj"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace reconar

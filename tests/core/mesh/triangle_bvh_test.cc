@@ -62,6 +62,53 @@ TEST(TriangleBvhTest, FindsTheNearestTriangleAsTestingEveryOneDoes) {
 TEST(TriangleBvhTest, AnEmptyMeshMeetsNothing) {
   const TriangleBvh bvh{Mesh()};
   EXPECT_EQ(bvh.Intersect(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()).triangle, -1);
+  EXPECT_EQ(bvh.Nearest(Eigen::Vector3d::Zero()).triangle, -1);
+}
+
+// The distance from p to triangle abc the long way: to its plane when the foot falls inside (by
+// the signs of the three edge normals), else to the nearest of its edges as segments.
+double DistanceToTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                          const Eigen::Vector3d& c) {
+  const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
+  const Eigen::Vector3d foot = p - (p - a).dot(normal) * normal;
+  const bool inside = ((b - a).cross(foot - a)).dot(normal) >= 0 && ((c - b).cross(foot - b)).dot(normal) >= 0 &&
+                      ((a - c).cross(foot - c)).dot(normal) >= 0;
+  if (inside) return (p - foot).norm();
+  const auto segment = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    const double t = std::clamp((p - u).dot(v - u) / (v - u).squaredNorm(), 0.0, 1.0);
+    return (p - (u + t * (v - u))).norm();
+  };
+  return std::min({segment(a, b), segment(b, c), segment(c, a)});
+}
+
+TEST(TriangleBvhTest, FindsTheNearestSurfacePointAsTestingEveryTriangleDoes) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  Mesh mesh;
+  for (int t = 0; t < 1500; ++t) {
+    const Eigen::Vector3d centre(coordinate(random), coordinate(random), coordinate(random));
+    for (int k = 0; k < 3; ++k) {
+      mesh.positions.push_back(
+          (centre + 0.1 * Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random))).cast<float>());
+    }
+    mesh.triangles.push_back({uint32_t(3 * t), uint32_t(3 * t + 1), uint32_t(3 * t + 2)});
+  }
+  const TriangleBvh bvh(mesh);
+  for (int q = 0; q < 400; ++q) {
+    const Eigen::Vector3d query = 1.5 * Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random));
+    double expected = INFINITY;
+    for (const auto& t : mesh.triangles) {
+      expected = std::min(expected, DistanceToTriangle(query, mesh.positions[t[0]].cast<double>(),
+                                                       mesh.positions[t[1]].cast<double>(),
+                                                       mesh.positions[t[2]].cast<double>()));
+    }
+    const NearestSurfacePoint nearest = bvh.Nearest(query);
+    ASSERT_GE(nearest.triangle, 0);
+    EXPECT_NEAR(nearest.distance, expected, 1e-9) << "query " << q;
+    EXPECT_NEAR((nearest.point - query).norm(), nearest.distance, 1e-12);
+    // Bounded below the distance, nothing is found.
+    EXPECT_EQ(bvh.Nearest(query, 0.999 * expected).triangle, -1);
+  }
 }
 
 }  // namespace
