@@ -19,6 +19,7 @@ int RunMap(int argc, char** argv, int first);
 int RunLocalize(int argc, char** argv, int first);
 int RunCapture(int argc, char** argv, int first);
 int RunMeasure(int argc, char** argv, int first);
+int RunCompare(int argc, char** argv, int first);
 // reconstruct and sfm (sparse_only: the sparse stages, no preview): tools/reconstruct_command.cc.
 int RunReconstructCommand(int argc, char** argv, int first, const char* help, bool sparse_only);
 

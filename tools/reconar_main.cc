@@ -24,6 +24,7 @@ constexpr char kUsage[] =
     "  map PROJECT_DIR                                     localisation map for markerless AR (rebuild)\n"
     "  localize PROJECT_DIR IMAGE|DIR... [--json]          camera poses of photos against the map\n"
     "  measure PROJECT_DIR --distance A B [--json]        distances, areas, heights with their +- (sigma)\n"
+    "  compare PROJECT_DIR DESIGN [--control FILE]         as built against its design, element by element\n"
     "  dense PROJECT_DIR                                   dense oriented points (multi-view stereo)\n"
     "  mesh POINTS.ply OUT.{ply,obj,glb,wrl} [--depth N]   Poisson surface from oriented points\n"
     "  export IN.{ply,glb,obj} OUT.{ply,obj,glb,wrl}       convert a mesh or point cloud between formats\n"
@@ -72,6 +73,7 @@ int main(int argc, char** argv) {
   if (command == "export") return reconar::tools::RunExport(argc, argv, 2);
   if (command == "mesh") return reconar::tools::RunMesh(argc, argv, 2);
   if (command == "measure") return reconar::tools::RunMeasure(argc, argv, 2);
+  if (command == "compare") return reconar::tools::RunCompare(argc, argv, 2);
   if (command == "dense") return reconar::tools::RunDense(argc, argv, 2);
   if (command == "reconstruct") return reconar::tools::RunReconstruct(argc, argv, 2);
   if (command == "map") return reconar::tools::RunMap(argc, argv, 2);

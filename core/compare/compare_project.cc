@@ -1,0 +1,181 @@
+#include "core/compare/compare_project.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <set>
+
+#include "core/base/atomic_file.h"
+#include "core/base/json_reader.h"
+#include "core/base/json_writer.h"
+#include "core/mesh/glb_io.h"
+#include "core/mesh/mesh_file.h"
+#include "core/mesh/mesh_io.h"
+#include "core/sfm/model_io.h"
+#include "core/sfm/tag_layout.h"
+#include "core/sfm/tag_squares.h"
+
+namespace reconar {
+namespace {
+
+// Diverging colours: blue below the design, white on it, red above, saturated at `full`.
+std::array<uint8_t, 4> DeviationColour(double signed_m, double full) {
+  const double t = std::clamp(signed_m / full, -1.0, 1.0);
+  const auto fade = [](double x) { return static_cast<uint8_t>(std::lround(255.0 * (1.0 - x))); };
+  if (t >= 0.0) return {255, fade(t), fade(t), 255};
+  return {fade(-t), fade(-t), 255, 255};
+}
+
+Result<std::vector<ControlPair>> ControlPairs(const Project& project, const std::string& control_path) {
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<ControlTag> tags, ReadControlFile(control_path));
+  std::error_code error;
+  if (!std::filesystem::exists(project.TagLayoutPath(), error)) {
+    return FailedPrecondition(project.root() + " has no registered tags (" + project.TagLayoutPath() +
+                              " is missing: reconstruct with --tag-size) for the control in " + control_path);
+  }
+  RECONAR_ASSIGN_OR_RETURN(const TagLayout layout, ReadTagLayout(project.TagLayoutPath()));
+  std::vector<ControlPair> pairs;
+  for (const ControlTag& tag : tags) {
+    const LayoutTag* placed = layout.Find(tag.id);
+    if (placed == nullptr) {
+      return FileError(StatusCode::kInvalidArgument, control_path,
+                       "line " + std::to_string(tag.line) + ": tag " + std::to_string(tag.id) +
+                           " is not among the project's reconstructed tags (" + project.TagLayoutPath() + ")");
+    }
+    if (tag.design_points.size() == 1) {
+      pairs.push_back({tag.id, tag.design_points[0], placed->layout_from_tag.translation});
+    } else {
+      const std::array<Eigen::Vector3d, 4> corners = TagSquareCorners(placed->size);
+      for (size_t k = 0; k < 4; ++k) pairs.push_back({tag.id, tag.design_points[k], placed->layout_from_tag * corners[k]});
+    }
+  }
+  return pairs;
+}
+
+}  // namespace
+
+Result<CompareReport> CompareWithDesign(const Project& project, const std::string& design_path,
+                                        const CompareOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CompareReport report;
+  report.design_path = design_path;
+  RECONAR_ASSIGN_OR_RETURN(const Design design, ReadDesign(design_path));
+
+  std::error_code error;
+  if (std::filesystem::exists(project.TagsJsonPath(), error)) {
+    RECONAR_ASSIGN_OR_RETURN(const JsonValue tags, ReadJsonFile(project.TagsJsonPath()));
+    const JsonValue* metric = tags.Find("metric");
+    report.metric = metric != nullptr && metric->is_bool() && metric->bool_value();
+  }
+  std::vector<ControlPair> control;
+  if (!options.control_path.empty()) {
+    RECONAR_ASSIGN_OR_RETURN(control, ControlPairs(project, options.control_path));
+  }
+  std::set<int> control_tags;
+  for (const ControlPair& pair : control) control_tags.insert(pair.tag);
+  report.control_tags = static_cast<int>(control_tags.size());
+
+  // The as-built points: the dense points (with their normals), else the mesh's vertices.
+  std::string source = project.DensePointsPath();
+  if (!std::filesystem::exists(source, error)) source = project.MeshDir() + "/mesh.ply";
+  if (!std::filesystem::exists(source, error)) {
+    return FailedPrecondition(project.root() + " has no dense points (" + project.DensePointsPath() +
+                              ") nor mesh to compare with the design: run `reconar reconstruct` through its dense stage");
+  }
+  RECONAR_ASSIGN_OR_RETURN(const Mesh cloud, ReadMeshFile(source));
+  if (cloud.positions.empty()) return FileError(StatusCode::kCorruptData, source, "no points");
+  report.as_built_source = source;
+  report.as_built_points = static_cast<int>(cloud.positions.size());
+  std::vector<Eigen::Vector3d> points, normals;
+  points.reserve(cloud.positions.size());
+  for (const Eigen::Vector3f& p : cloud.positions) points.push_back(p.cast<double>());
+  for (const Eigen::Vector3f& n : cloud.normals) normals.push_back(n.cast<double>());
+
+  Result<Reconstruction> views = ReadColmapTextModel(project.SparseDir());
+  DesignRegistrationOptions registration_options = options.registration;
+  if (!report.metric && !control.empty()) registration_options.similarity = true;  // no metres to keep
+  RECONAR_ASSIGN_OR_RETURN(report.registration, RegisterDesign(design, control, points, registration_options));
+  RECONAR_ASSIGN_OR_RETURN(report.deviation,
+                           ComputeDeviation(design, report.registration.world_from_design, points, normals,
+                                            views.ok() ? &*views : nullptr, options.deviation));
+
+  report.out_dir = project.root() + "/compare";
+  std::filesystem::create_directories(report.out_dir, error);
+  if (error) return IoError(report.out_dir + ": " + error.message());
+  Mesh coloured;
+  coloured.positions = cloud.positions;
+  coloured.colors.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    coloured.colors.push_back(report.deviation.element_of_point[i] < 0
+                                  ? std::array<uint8_t, 4>{128, 128, 128, 255}
+                                  : DeviationColour(report.deviation.signed_distance_m[i], 3.0 * options.deviation.tolerance));
+  }
+  RECONAR_RETURN_IF_ERROR(WritePly(report.out_dir + "/deviation.ply", coloured));
+  std::vector<NamedMesh> placed;
+  for (const NamedMesh& element : design.elements) {
+    NamedMesh moved{element.name, Mesh()};
+    for (const Eigen::Vector3f& p : element.mesh.positions) {
+      moved.mesh.positions.push_back(report.registration.world_from_design.Apply(p.cast<double>()).cast<float>());
+    }
+    moved.mesh.triangles = element.mesh.triangles;
+    ComputeVertexNormals(&moved.mesh);
+    placed.push_back(std::move(moved));
+  }
+  RECONAR_RETURN_IF_ERROR(WriteGlbScene(report.out_dir + "/design_registered.glb", placed));
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.out_dir + "/report.json", CompareReportJson(report, options)));
+  return report;
+}
+
+std::string CompareReportJson(const CompareReport& report, const CompareOptions& options) {
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("design").String(report.design_path);
+  json.Key("as_built").BeginObject().Key("source").String(report.as_built_source).Key("points").Int(report.as_built_points).EndObject();
+  json.Key("metric").Bool(report.metric);
+  json.Key("tolerance_m").Double(options.deviation.tolerance);
+  const DesignRegistration& r = report.registration;
+  json.Key("registration").BeginObject();
+  json.Key("world_from_design").BeginArray();
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() = r.world_from_design.scale * r.world_from_design.rotation;
+  m.topRightCorner<3, 1>() = r.world_from_design.translation;
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col) json.Double(m(row, col));
+  json.EndArray();
+  json.Key("scale").Double(r.world_from_design.scale);
+  json.Key("units").String(r.units);
+  json.Key("control_tags").Int(report.control_tags);
+  json.Key("control_rms_m").Double(r.control_rms_m);
+  json.Key("control_residuals_m").BeginArray();
+  for (double residual : r.control_residuals_m) json.Double(residual);
+  json.EndArray();
+  json.Key("refined").Bool(r.refined);
+  json.Key("icp_rms_m").Double(r.icp_rms_m);
+  json.Key("points_used").Int(r.points_used);
+  json.Key("overlap").Double(r.overlap);
+  json.Key("icp_iterations").Int(r.icp_iterations);
+  json.Key("icp_turn_deg").Double(r.icp_turn_deg);
+  json.Key("icp_shift_m").Double(r.icp_shift_m);
+  json.Key("free_directions").Int(r.free_directions);
+  json.EndObject();
+  json.Key("density_per_m2").Double(report.deviation.density_per_m2);
+  json.Key("elements").BeginArray();
+  for (const ElementDeviation& e : report.deviation.elements) {
+    json.BeginObject();
+    json.Key("name").String(e.name).Key("points").Int(e.points);
+    json.Key("area_m2").Double(e.area_m2).Key("seen_area_m2").Double(e.seen_area_m2);
+    json.Key("mean_m").Double(e.mean_m).Key("rms_m").Double(e.rms_m).Key("p95_m").Double(e.p95_m);
+    json.Key("within_tolerance").Double(e.within_tolerance);
+    json.Key("shift_m").BeginArray().Double(e.shift_m.x()).Double(e.shift_m.y()).Double(e.shift_m.z()).EndArray();
+    json.Key("turn_deg").Double(e.turn_deg).Key("largest_move_m").Double(e.largest_move_m);
+    json.Key("verdict").String(e.verdict);
+    json.EndObject();
+  }
+  json.EndArray();
+  json.Key("seconds").Double(report.seconds);
+  json.EndObject();
+  return json.str() + "\n";
+}
+
+}  // namespace reconar
