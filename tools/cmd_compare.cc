@@ -60,6 +60,7 @@ int RunCompare(int argc, char** argv, int first) {
   const DesignRegistration& r = report->registration;
   std::printf("design %s: %zu elements, units %s; %d control tags, control RMS %.1f mm\n", report->design_path.c_str(),
               report->deviation.elements.size(), r.units.c_str(), report->control_tags, 1000.0 * r.control_rms_m);
+  if (!r.icp_rejected.empty()) std::printf("ICP not taken: %s; the control's placement kept\n", r.icp_rejected.c_str());
   if (r.refined) {
     std::printf("ICP: %d of the as-built points used (overlap %.0f %%), RMS %.1f mm, moved %.2f deg and %.1f mm from the "
                 "control's placement\n",

@@ -151,6 +151,7 @@ std::string CompareReportJson(const CompareReport& report, const CompareOptions&
   for (double residual : r.control_residuals_m) json.Double(residual);
   json.EndArray();
   json.Key("refined").Bool(r.refined);
+  if (!r.icp_rejected.empty()) json.Key("icp_rejected").String(r.icp_rejected);
   json.Key("icp_rms_m").Double(r.icp_rms_m);
   json.Key("points_used").Int(r.points_used);
   json.Key("overlap").Double(r.overlap);

@@ -22,6 +22,17 @@ double RotationAngleDeg(const Eigen::Matrix3d& rotation) {
   return std::acos(std::clamp((rotation.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
 }
 
+// How far the ICP may take the control points beyond twice their own RMS: a design drawn to the
+// millimetre, tags placed to a few.
+constexpr double kControlSlack = 0.005;
+
+double ControlRms(const std::vector<ControlPair>& control, const Sim3& world_from_design) {
+  if (control.empty()) return 0.0;
+  double squares = 0.0;
+  for (const ControlPair& pair : control) squares += (world_from_design.Apply(pair.design) - pair.world).squaredNorm();
+  return std::sqrt(squares / static_cast<double>(control.size()));
+}
+
 }  // namespace
 
 DesignSurface PlaceDesign(const Design& design, const Sim3& world_from_design) {
@@ -107,22 +118,29 @@ Result<DesignRegistration> RegisterDesign(const Design& design, const std::vecto
     // built a few centimetres off (a column moved 4 cm) cannot pull the whole design half way
     // toward itself before the bound tightens.
     icp.max_distance = options.max_distance;
+    const double control_rms = ControlRms(control, registration.world_from_design);
     if (!control.empty()) {
-      double squares = 0.0;
-      for (const ControlPair& pair : control) {
-        squares += (registration.world_from_design.Apply(pair.design) - pair.world).squaredNorm();
-      }
-      const double control_rms = std::sqrt(squares / static_cast<double>(control.size()));
       icp.max_distance = std::clamp(3.0 * control_rms, std::min(0.01, options.max_distance), options.max_distance);
     }
     icp.max_iterations = options.max_iterations;
     const PointToPlaneReport fit = AlignPointsToSurface(points, bvh, surface.face_normals, icp);
-    if (fit.inliers >= 6) {
-      // The points moved onto the design: the design moves by the inverse onto the points.
-      const Rigid3 world_from_placed = fit.surface_from_points.Inverse();
-      Sim3& pose = registration.world_from_design;
-      pose.rotation = world_from_placed.rotation * pose.rotation;
-      pose.translation = world_from_placed.rotation * pose.translation + world_from_placed.translation;
+    // The points moved onto the design: the design moves by the inverse onto the points.
+    const Rigid3 world_from_placed = fit.surface_from_points.Inverse();
+    Sim3 refined = registration.world_from_design;
+    refined.rotation = world_from_placed.rotation * refined.rotation;
+    refined.translation = world_from_placed.rotation * refined.translation + world_from_placed.translation;
+    // Accepted only when it keeps to the control: surfaces that leave a motion weakly held (walls
+    // alone, with a few points near their top and bottom faces) let the ICP slide the design along
+    // them (the room's four walls: 155 mm, the control then 158 mm off).
+    const double refined_control_rms = ControlRms(control, refined);
+    if (fit.inliers >= 6 && refined_control_rms > 2.0 * control_rms + kControlSlack) {
+      char reason[160];
+      std::snprintf(reason, sizeof(reason),
+                    "the ICP's placement put the control points %.1f mm RMS off (%.1f mm from the control alone)",
+                    1000.0 * refined_control_rms, 1000.0 * control_rms);
+      registration.icp_rejected = reason;
+    } else if (fit.inliers >= 6) {
+      registration.world_from_design = refined;
       registration.refined = true;
       registration.icp_rms_m = fit.rms;
       registration.points_used = fit.inliers;

@@ -37,6 +37,9 @@ struct DesignRegistration {
   std::vector<double> control_residuals_m;  // per control pair, after the final registration
   double control_rms_m = 0.0;
   bool refined = false;
+  // Why the ICP's placement was not taken (empty when it was, or did not run): it moved the control
+  // points more than twice their RMS plus 5 mm.
+  std::string icp_rejected;
   double icp_rms_m = 0.0;
   int points_used = 0;       // as-built points within the ICP's final bound of the design
   double overlap = 0.0;      // the share of the points the ICP looked at within max_distance of it

@@ -152,6 +152,33 @@ TEST(CompareTest, ControlInMillimetresIsRecognisedAndAStrangeScaleRefused) {
   EXPECT_FALSE(RegisterDesign(design, control, {}, options).ok());
 }
 
+// Points that the control contradicts (the whole scan 5 cm off what the tags say) do not move the
+// design: the ICP's placement would take the control points 5 cm off, and is not taken.
+TEST(CompareTest, TheIcpMayNotLeaveTheControl) {
+  Design design;
+  design.elements.push_back({"box", BoxMesh({0, 0, 0}, {1, 1, 1})});
+  std::mt19937 random(9);
+  std::vector<Eigen::Vector3d> points, normals;
+  Sample(MovedMesh(design.elements[0].mesh, Rigid3{Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.05, 0, 0)}), 0.02,
+         &random, &points, &normals);
+  std::vector<ControlPair> control;
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 1)}) {
+    control.push_back({static_cast<int>(control.size()), p, p});
+  }
+  DesignRegistrationOptions options;
+  options.max_distance = 0.1;
+  Result<DesignRegistration> registration = RegisterDesign(design, control, points, options);
+  ASSERT_TRUE(registration.ok());
+  EXPECT_FALSE(registration->refined);
+  EXPECT_NE(registration->icp_rejected.find("control points"), std::string::npos) << registration->icp_rejected;
+  EXPECT_LT(registration->control_rms_m, 1e-9);
+  // Without control the ICP is free to follow the points.
+  registration = RegisterDesign(design, {}, points, options);
+  ASSERT_TRUE(registration.ok());
+  EXPECT_TRUE(registration->refined);
+  EXPECT_NEAR(registration->world_from_design.translation.x(), 0.05, 0.002);
+}
+
 TEST(CompareTest, ControlFileLinesAreCheckedAndNamed) {
   const Result<std::vector<ControlTag>> tags =
       ParseControl("# tags on the north wall\n3 1.0 2.0 0.5\n7 0 0 0  1 0 0  1 1 0  0 1 0  # corners\n", "c.txt");
