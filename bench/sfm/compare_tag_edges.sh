@@ -12,22 +12,8 @@
 # (default 2), COLMAP (default colmap; installed with apt-get by compare_colmap.sh if missing).
 set -euo pipefail
 
-if [[ $# -lt 2 || $# -gt 3 || $1 == -h || $1 == --help ]]; then
-  sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'
-  [[ $# -ge 1 && ($1 == -h || $1 == --help) ]] && exit 0
-  exit 2
-fi
-repo=$(cd "$(dirname "$0")/../.." && pwd)
-dataset=$(realpath "$1")
-tag_size=$2
-work=${3:-$(mktemp -d /tmp/compare_tag_edges.XXXXXX)}
-mkdir -p "$work"
-work=$(realpath "$work")
-build=${BUILD_DIR:-$repo/build}
-reconar=$build/bin/reconar
-evaluate=$build/bin/evaluate_tags
-threads=${THREADS:-2}
-[[ -x $evaluate ]] || { echo "evaluate_tags not found at $evaluate (build with -DRECONAR_BUILD_BENCH=ON)" >&2; exit 2; }
+# shellcheck source=bench/sfm/tag_bench_args.sh
+source "$(dirname "$0")/tag_bench_args.sh"
 
 # The photos of the top folder only, as reconar reads them (COLMAP would also take sub-folders,
 # e.g. a calibration/ folder of checkerboards).
