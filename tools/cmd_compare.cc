@@ -12,7 +12,7 @@ namespace {
 
 constexpr char kHelp[] =
     "usage: reconar compare PROJECT DESIGN [--control FILE] [--tolerance M] [--max-distance M]\n"
-    "                       [--similarity] [--no-icp] [--json]\n"
+    "                       [--similarity] [--no-icp] [--threads N] [--json]\n"
     "\n"
     "Compares what a reconstructed project shows with its design (as planned), element by element.\n"
     "DESIGN: glTF 2.0 (.glb, .gltf: each node with a mesh is an element, by its name), OBJ (each\n"
@@ -30,6 +30,7 @@ constexpr char kHelp[] =
     "  --max-distance M    points farther than M from every design surface belong to none (default 0.1)\n"
     "  --similarity        fit the design's scale instead of recognising its unit\n"
     "  --no-icp            keep the control's placement\n"
+    "  --threads N         worker threads (default: one per core)\n"
     "  --json              print compare/report.json on stdout\n"
     "Writes PROJECT/compare/report.json, deviation.ply (the points coloured: blue inside, white on,\n"
     "red outside the design, saturated at 3 x the tolerance; grey on no element) and\n"
@@ -38,7 +39,7 @@ constexpr char kHelp[] =
 }  // namespace
 
 int RunCompare(int argc, char** argv, int first) {
-  Args args({"control", "tolerance", "max-distance"}, {"similarity", "no-icp", "json"});
+  Args args({"control", "tolerance", "max-distance", "threads"}, {"similarity", "no-icp", "json"});
   if (const auto exit_code = ParseCommand(&args, argc, argv, first, kHelp, 2, 2)) return *exit_code;
   CompareOptions options;
   options.control_path = args.Get("control");
@@ -51,6 +52,10 @@ int RunCompare(int argc, char** argv, int first) {
   options.registration.max_distance = *max_distance;
   options.registration.similarity = args.Has("similarity");
   options.registration.refine = !args.Has("no-icp");
+  Result<int> threads = args.GetThreads();
+  if (!threads.ok()) return Fail(threads.status());
+  options.registration.num_threads = *threads;
+  options.deviation.num_threads = *threads;
   Result<CompareReport> report = CompareWithDesign(Project(args.positionals()[0]), args.positionals()[1], options);
   if (!report.ok()) return Fail(report.status());
   if (args.Has("json")) {

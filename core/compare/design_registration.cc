@@ -26,11 +26,21 @@ double RotationAngleDeg(const Eigen::Matrix3d& rotation) {
 // millimetre, tags placed to a few.
 constexpr double kControlSlack = 0.005;
 
-double ControlRms(const std::vector<ControlPair>& control, const Sim3& world_from_design) {
-  if (control.empty()) return 0.0;
+std::vector<double> ControlResiduals(const std::vector<ControlPair>& control, const Sim3& world_from_design) {
+  std::vector<double> residuals;
+  for (const ControlPair& pair : control) residuals.push_back((world_from_design.Apply(pair.design) - pair.world).norm());
+  return residuals;
+}
+
+double Rms(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
   double squares = 0.0;
-  for (const ControlPair& pair : control) squares += (world_from_design.Apply(pair.design) - pair.world).squaredNorm();
-  return std::sqrt(squares / static_cast<double>(control.size()));
+  for (const double value : values) squares += value * value;
+  return std::sqrt(squares / static_cast<double>(values.size()));
+}
+
+double ControlRms(const std::vector<ControlPair>& control, const Sim3& world_from_design) {
+  return Rms(ControlResiduals(control, world_from_design));
 }
 
 }  // namespace
@@ -123,7 +133,8 @@ Result<DesignRegistration> RegisterDesign(const Design& design, const std::vecto
       icp.max_distance = std::clamp(3.0 * control_rms, std::min(0.01, options.max_distance), options.max_distance);
     }
     icp.max_iterations = options.max_iterations;
-    const PointToPlaneReport fit = AlignPointsToSurface(points, bvh, surface.face_normals, icp);
+    ThreadPool pool(ThreadPool::ResolveThreadCount(options.num_threads));
+    const PointToPlaneReport fit = AlignPointsToSurface(points, bvh, surface.face_normals, icp, Rigid3(), &pool);
     // The points moved onto the design: the design moves by the inverse onto the points.
     const Rigid3 world_from_placed = fit.surface_from_points.Inverse();
     Sim3 refined = registration.world_from_design;
@@ -157,13 +168,8 @@ Result<DesignRegistration> RegisterDesign(const Design& design, const std::vecto
       registration.icp_shift_m = (world_from_placed * centre - centre).norm();
     }
   }
-  double squares = 0.0;
-  for (const ControlPair& pair : control) {
-    const double residual = (registration.world_from_design.Apply(pair.design) - pair.world).norm();
-    registration.control_residuals_m.push_back(residual);
-    squares += residual * residual;
-  }
-  if (!control.empty()) registration.control_rms_m = std::sqrt(squares / static_cast<double>(control.size()));
+  registration.control_residuals_m = ControlResiduals(control, registration.world_from_design);
+  registration.control_rms_m = Rms(registration.control_residuals_m);
   return registration;
 }
 

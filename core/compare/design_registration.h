@@ -27,6 +27,7 @@ struct DesignRegistrationOptions {
   double max_distance = 0.1;      // metres: as-built points farther from the design take no part
   int max_points = 200000;        // as-built points used by the ICP (evenly thinned)
   int max_iterations = 40;
+  int num_threads = 0;            // 0: one per core
 };
 
 struct DesignRegistration {

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "core/base/thread_pool.h"
 #include "core/compare/design_registration.h"
 #include "core/compare/point_to_plane.h"
 #include "core/mesh/triangle_bvh.h"
@@ -27,6 +28,37 @@ int FacingViews(const Reconstruction& views, const Eigen::Vector3d& point, const
     ++count;
   }
   return count;
+}
+
+// The points' indices along a Morton (Z-order) curve over their bounding box, 2^10 cells a side:
+// nearby queries one after another keep the tree's nodes in cache and the previous answer near.
+std::vector<uint32_t> SpatialOrder(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& p : points) {
+    if (p.allFinite()) box.extend(p);
+  }
+  const Eigen::Vector3d scale = 1023.0 * (box.sizes().array().max(1e-12)).inverse();
+  const auto spread = [](uint64_t v) {  // 10 bits to every third of 30
+    v = (v | (v << 16)) & 0x030000FFull;
+    v = (v | (v << 8)) & 0x0300F00Full;
+    v = (v | (v << 4)) & 0x030C30C3ull;
+    v = (v | (v << 2)) & 0x09249249ull;
+    return v;
+  };
+  std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    uint64_t key = 0;
+    if (points[i].allFinite()) {
+      const Eigen::Vector3d cell = ((points[i] - box.min()).array() * scale.array()).max(0.0).min(1023.0);
+      key = spread(static_cast<uint64_t>(cell.x())) | (spread(static_cast<uint64_t>(cell.y())) << 1) |
+            (spread(static_cast<uint64_t>(cell.z())) << 2);
+    }
+    keyed[i] = {key, static_cast<uint32_t>(i)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<uint32_t> order(points.size());
+  for (size_t i = 0; i < points.size(); ++i) order[i] = keyed[i].second;
+  return order;
 }
 
 double Percentile(std::vector<double> values, double fraction) {
@@ -54,20 +86,34 @@ Result<DeviationReport> ComputeDeviation(const Design& design, const Sim3& world
   report.element_of_point.assign(as_built.size(), -1);
   report.signed_distance_m.assign(as_built.size(), 0.0);
   const size_t num_elements = design.elements.size();
+  std::vector<std::vector<size_t>> triangles_of(num_elements);
+  for (size_t t = 0; t < surface.element_of_triangle.size(); ++t) {
+    triangles_of[static_cast<size_t>(surface.element_of_triangle[t])].push_back(t);
+  }
+  ThreadPool pool(ThreadPool::ResolveThreadCount(options.num_threads));
+  const std::vector<uint32_t> order = SpatialOrder(as_built);
+  constexpr size_t kChunkPoints = 4096;
+  pool.ParallelFor(0, (as_built.size() + kChunkPoints - 1) / kChunkPoints, [&](size_t chunk, int) {
+    const size_t end = std::min(as_built.size(), (chunk + 1) * kChunkPoints);
+    int previous = -1;
+    for (size_t k = chunk * kChunkPoints; k < end; ++k) {
+      const size_t i = order[k];
+      const NearestSurfacePoint nearest = bvh.Nearest(as_built[i], options.max_distance, previous);
+      if (nearest.triangle < 0) continue;
+      previous = nearest.triangle;
+      const Eigen::Vector3d& normal = surface.face_normals[static_cast<size_t>(nearest.triangle)];
+      if (!as_built_normals.empty() && as_built_normals[i].norm() > 0.0 &&
+          as_built_normals[i].normalized().dot(normal) < min_cos) {
+        continue;
+      }
+      report.element_of_point[i] = surface.element_of_triangle[static_cast<size_t>(nearest.triangle)];
+      const double side = normal.dot(as_built[i] - nearest.point);
+      report.signed_distance_m[i] = side >= 0.0 ? nearest.distance : -nearest.distance;
+    }
+  });
   std::vector<std::vector<size_t>> points_of(num_elements);
   for (size_t i = 0; i < as_built.size(); ++i) {
-    NearestSurfacePoint nearest = bvh.Nearest(as_built[i], options.max_distance);
-    if (nearest.triangle < 0) continue;
-    const Eigen::Vector3d& normal = surface.face_normals[static_cast<size_t>(nearest.triangle)];
-    if (!as_built_normals.empty() && as_built_normals[i].norm() > 0.0 &&
-        as_built_normals[i].normalized().dot(normal) < min_cos) {
-      continue;
-    }
-    const int element = surface.element_of_triangle[static_cast<size_t>(nearest.triangle)];
-    report.element_of_point[i] = element;
-    const double side = normal.dot(as_built[i] - nearest.point);
-    report.signed_distance_m[i] = side >= 0.0 ? nearest.distance : -nearest.distance;
-    points_of[static_cast<size_t>(element)].push_back(i);
+    if (report.element_of_point[i] >= 0) points_of[static_cast<size_t>(report.element_of_point[i])].push_back(i);
   }
 
   // Areas, and the areas two registered photos face (sampled at each triangle's centroid).
@@ -110,19 +156,18 @@ Result<DeviationReport> ComputeDeviation(const Design& design, const Sim3& world
     if (element.seen_area_m2 > 0.0) densities.push_back(n / element.seen_area_m2);
     if (element.points < options.min_points) continue;
     // The element's own fit: its points onto its surface alone.
-    Design alone;
-    alone.elements.push_back(design.elements[e]);
-    const DesignSurface own = PlaceDesign(alone, world_from_design);
-    const TriangleBvh own_bvh(own.mesh);
+    const TriangleBvh own_bvh(SubMesh(surface.mesh, triangles_of[e]));
+    std::vector<Eigen::Vector3d> own_normals;
+    for (size_t t : triangles_of[e]) own_normals.push_back(surface.face_normals[t]);
     std::vector<Eigen::Vector3d> points;
+    const size_t stride = std::max<size_t>(1, mine.size() / static_cast<size_t>(std::max(1, options.max_fit_points)));
+    for (size_t k = 0; k < mine.size(); k += stride) points.push_back(as_built[mine[k]]);
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (size_t i : mine) {
-      points.push_back(as_built[i]);
-      centre += as_built[i] / n;
-    }
+    for (const Eigen::Vector3d& p : points) centre += p / static_cast<double>(points.size());
     PointToPlaneOptions fit_options;
     fit_options.max_distance = options.max_distance;
-    const PointToPlaneReport fit = AlignPointsToSurface(points, own_bvh, own.face_normals, fit_options);
+    const PointToPlaneReport fit =
+        AlignPointsToSurface(points, own_bvh, own_normals, fit_options, Rigid3(), &pool);
     const Rigid3 element_move = fit.surface_from_points.Inverse();  // the design element onto its points
     element.shift_m = element_move * centre - centre;
     element.turn_deg = std::acos(std::clamp((element_move.rotation.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;

@@ -25,6 +25,8 @@ struct DeviationOptions {
   // area should (at the median density of the elements) is missing.
   double missing_fraction = 0.1;
   int min_points = 30;         // fewer: no fit of its own, no deviates verdict from statistics alone
+  int max_fit_points = 20000;  // an element's own fit uses at most this many of its points (evenly thinned)
+  int num_threads = 0;         // 0: one per core
 };
 
 struct ElementDeviation {

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "core/base/thread_pool.h"
 #include "core/math/rigid3.h"
 #include "core/mesh/triangle_bvh.h"
 
@@ -30,9 +31,11 @@ struct PointToPlaneReport {
   int free_directions = 0;     // of the 6, those the correspondences left unconstrained
 };
 
-// `face_normals[t]`: unit normal of triangle t of the surface the BVH was built on.
+// `face_normals[t]`: unit normal of triangle t of the surface the BVH was built on. The nearest
+// points are found on `pool` when given; the result does not depend on its size.
 PointToPlaneReport AlignPointsToSurface(const std::vector<Eigen::Vector3d>& points, const TriangleBvh& surface,
                                         const std::vector<Eigen::Vector3d>& face_normals,
-                                        const PointToPlaneOptions& options, const Rigid3& start = Rigid3());
+                                        const PointToPlaneOptions& options, const Rigid3& start = Rigid3(),
+                                        ThreadPool* pool = nullptr);
 
 }  // namespace reconar

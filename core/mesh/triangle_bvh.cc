@@ -20,6 +20,18 @@ TriangleBvh::TriangleBvh(const Mesh& mesh) {
   }
   nodes_.reserve(2 * (order_.size() / kLeafSize + 1));
   if (!order_.empty()) Build(0, static_cast<int>(order_.size()), &centroids);
+  // The corners (and boxes) stored in leaf order: a leaf's triangles side by side in memory.
+  std::vector<std::array<Eigen::Vector3f, 3>> by_triangle;
+  by_triangle.swap(corners_);
+  corners_.reserve(order_.size());
+  boxes_.reserve(order_.size());
+  position_of_.assign(mesh.triangles.size(), -1);
+  for (size_t k = 0; k < order_.size(); ++k) {
+    const std::array<Eigen::Vector3f, 3>& c = by_triangle[static_cast<size_t>(order_[k])];
+    corners_.push_back(c);
+    boxes_.push_back({c[0].cwiseMin(c[1]).cwiseMin(c[2]), c[0].cwiseMax(c[1]).cwiseMax(c[2])});
+    position_of_[static_cast<size_t>(order_[k])] = static_cast<int>(k);
+  }
 }
 
 int TriangleBvh::Build(int begin, int end, std::vector<Eigen::Vector3f>* centroids) {
@@ -73,15 +85,11 @@ double BoxEntry(const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max, 
   return near;
 }
 
-// Squared distance from the point to the box (0 inside).
-double BoxDistanceSquared(const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max, const Eigen::Vector3d& p) {
-  double sum = 0.0;
-  for (int a = 0; a < 3; ++a) {
-    const double below = box_min[a] - p[a], above = p[a] - box_max[a];
-    const double d = std::max({below, above, 0.0});
-    sum += d * d;
-  }
-  return sum;
+// Squared distance from the point to the box (0 inside), in single precision as the boxes are: a
+// lower bound for pruning, compared with a margin for rounding.
+float BoxDistanceSquared(const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max, const Eigen::Vector3f& p) {
+  const Eigen::Vector3f outside = (box_min - p).cwiseMax(p - box_max).cwiseMax(0.0f);
+  return outside.squaredNorm();
 }
 
 Eigen::Vector3d ClosestPointOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -127,40 +135,61 @@ Eigen::Vector3d ClosestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3
 
 }  // namespace
 
-NearestSurfacePoint TriangleBvh::Nearest(const Eigen::Vector3d& query, double max_distance) const {
+NearestSurfacePoint TriangleBvh::Nearest(const Eigen::Vector3d& query, double max_distance, int hint) const {
   NearestSurfacePoint nearest;
   if (nodes_.empty()) return nearest;
   double best2 = max_distance < 1e150 ? max_distance * max_distance : INFINITY;
-  int stack[128];
+  const Eigen::Vector3f query_f = query.cast<float>();
+  // Single-precision box distances may come out a little long: pruned only beyond a margin.
+  float prune2 = static_cast<float>(best2 * (1.0 + 1e-5) + 1e-12);
+  const auto try_triangle = [&](int k) {
+    // The triangle's box bounds its distance from below: most triangles of a leaf end there.
+    const std::array<Eigen::Vector3f, 2>& box = boxes_[static_cast<size_t>(k)];
+    if (!(BoxDistanceSquared(box[0], box[1], query_f) <= prune2)) return;
+    const std::array<Eigen::Vector3f, 3>& c = corners_[static_cast<size_t>(k)];
+    bool interior = false;
+    const Eigen::Vector3d point =
+        ClosestOnTriangle(query, c[0].cast<double>(), c[1].cast<double>(), c[2].cast<double>(), &interior);
+    const double d2 = (point - query).squaredNorm();
+    if (d2 <= best2) {
+      best2 = d2;
+      prune2 = static_cast<float>(best2 * (1.0 + 1e-5) + 1e-12);
+      nearest = {order_[static_cast<size_t>(k)], std::sqrt(d2), point, interior};
+    }
+  };
+  // A usable triangle near the query (the previous query's, for points in order) bounds the search.
+  if (hint >= 0 && static_cast<size_t>(hint) < position_of_.size() && position_of_[static_cast<size_t>(hint)] >= 0) {
+    try_triangle(position_of_[static_cast<size_t>(hint)]);
+  }
+  struct Entry {
+    int node;
+    float distance2;  // from the query to the node's box
+  };
+  Entry stack[128];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = {0, BoxDistanceSquared(nodes_[0].box_min, nodes_[0].box_max, query_f)};
   while (top > 0) {
-    const Node& node = nodes_[static_cast<size_t>(stack[--top])];
-    if (!(BoxDistanceSquared(node.box_min, node.box_max, query) <= best2)) continue;
+    const Entry entry = stack[--top];
+    if (!(entry.distance2 <= prune2)) continue;
+    const Node& node = nodes_[static_cast<size_t>(entry.node)];
     if (node.count > 0) {
-      for (int k = node.first; k < node.first + node.count; ++k) {
-        const int t = order_[static_cast<size_t>(k)];
-        const std::array<Eigen::Vector3f, 3>& c = corners_[static_cast<size_t>(t)];
-        bool interior = false;
-        const Eigen::Vector3d point =
-            ClosestOnTriangle(query, c[0].cast<double>(), c[1].cast<double>(), c[2].cast<double>(), &interior);
-        const double d2 = (point - query).squaredNorm();
-        if (d2 <= best2) {
-          best2 = d2;
-          nearest = {t, std::sqrt(d2), point, interior};
-        }
-      }
+      for (int k = node.first; k < node.first + node.count; ++k) try_triangle(k);
       continue;
     }
     if (top + 2 > static_cast<int>(sizeof(stack) / sizeof(stack[0]))) continue;
-    const int first = static_cast<int>(&node - nodes_.data()) + 1, second = node.first;
+    const int first = entry.node + 1, second = node.first;
     const Node& a = nodes_[static_cast<size_t>(first)];
     const Node& b = nodes_[static_cast<size_t>(second)];
+    const float to_a = BoxDistanceSquared(a.box_min, a.box_max, query_f);
+    const float to_b = BoxDistanceSquared(b.box_min, b.box_max, query_f);
     // The nearer child is searched first: pushed last.
-    const bool first_nearer =
-        BoxDistanceSquared(a.box_min, a.box_max, query) <= BoxDistanceSquared(b.box_min, b.box_max, query);
-    stack[top++] = first_nearer ? second : first;
-    stack[top++] = first_nearer ? first : second;
+    if (to_a <= to_b) {
+      if (to_b <= prune2) stack[top++] = {second, to_b};
+      if (to_a <= prune2) stack[top++] = {first, to_a};
+    } else {
+      if (to_a <= prune2) stack[top++] = {first, to_a};
+      if (to_b <= prune2) stack[top++] = {second, to_b};
+    }
   }
   return nearest;
 }
@@ -179,8 +208,7 @@ RayHit TriangleBvh::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector
     if (!(BoxEntry(node.box_min, node.box_max, origin, inverse, min_distance, best) < INFINITY)) continue;
     if (node.count > 0) {
       for (int k = node.first; k < node.first + node.count; ++k) {
-        const int t = order_[static_cast<size_t>(k)];
-        const std::array<Eigen::Vector3f, 3>& c = corners_[static_cast<size_t>(t)];
+        const std::array<Eigen::Vector3f, 3>& c = corners_[static_cast<size_t>(k)];
         const Eigen::Vector3d a = c[0].cast<double>();
         const Eigen::Vector3d e1 = c[1].cast<double>() - a, e2 = c[2].cast<double>() - a;
         const Eigen::Vector3d p = direction.cross(e2);
@@ -195,7 +223,7 @@ RayHit TriangleBvh::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector
         const double distance = e2.dot(q) / determinant;
         if (distance > min_distance && distance < best) {
           best = distance;
-          hit.triangle = t;
+          hit.triangle = order_[static_cast<size_t>(k)];
           hit.distance = distance;
         }
       }

@@ -41,8 +41,10 @@ class TriangleBvh {
   RayHit Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double min_distance = 0.0,
                    double max_distance = 1e300) const;
 
-  // The surface point nearest to `query` no farther than max_distance.
-  NearestSurfacePoint Nearest(const Eigen::Vector3d& query, double max_distance = 1e300) const;
+  // The surface point nearest to `query` no farther than max_distance. `hint`: a triangle likely
+  // near the query (the previous query's answer when the queries come in spatial order), tried
+  // first so that its distance prunes the search; any value is safe.
+  NearestSurfacePoint Nearest(const Eigen::Vector3d& query, double max_distance = 1e300, int hint = -1) const;
 
   int num_triangles() const { return static_cast<int>(order_.size()); }  // the usable ones
 
@@ -54,8 +56,11 @@ class TriangleBvh {
   };
   int Build(int begin, int end, std::vector<Eigen::Vector3f>* centroids);
 
-  std::vector<std::array<Eigen::Vector3f, 3>> corners_;  // per mesh triangle
   std::vector<int> order_;  // the usable triangles (indices in range, finite corners) in leaf order
+  // Per position in order_ (per mesh triangle while building): the corners, and their min and max.
+  std::vector<std::array<Eigen::Vector3f, 3>> corners_;
+  std::vector<std::array<Eigen::Vector3f, 2>> boxes_;
+  std::vector<int> position_of_;  // per mesh triangle: its position in order_, -1 when not usable
   std::vector<Node> nodes_;
 };
 

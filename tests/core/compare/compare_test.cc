@@ -124,6 +124,19 @@ TEST(CompareTest, RegistrationRecoversTheDesignFrameAndEveryChangeIsFound) {
   EXPECT_NEAR(e[3].turn_deg, 2.0, 0.2);
   EXPECT_EQ(e[4].verdict, "as_designed") << "d rms " << e[4].rms_m << " move " << e[4].largest_move_m;
   EXPECT_LT(e[4].largest_move_m, 0.005);
+
+  // The same numbers on one thread as on several.
+  options.num_threads = 1;
+  deviation_options.num_threads = 1;
+  const Result<DesignRegistration> one_thread = RegisterDesign(design, control, points, options);
+  ASSERT_TRUE(one_thread.ok());
+  EXPECT_EQ(one_thread->world_from_design.rotation, fitted.rotation);
+  EXPECT_EQ(one_thread->world_from_design.translation, fitted.translation);
+  const Result<DeviationReport> one_thread_deviation =
+      ComputeDeviation(design, fitted, points, normals, nullptr, deviation_options);
+  ASSERT_TRUE(one_thread_deviation.ok());
+  EXPECT_EQ(one_thread_deviation->signed_distance_m, deviation->signed_distance_m);
+  for (size_t k = 0; k < e.size(); ++k) EXPECT_EQ(one_thread_deviation->elements[k].shift_m, e[k].shift_m);
 }
 
 TEST(CompareTest, ControlInMillimetresIsRecognisedAndAStrangeScaleRefused) {

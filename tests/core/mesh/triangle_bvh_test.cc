@@ -108,6 +108,25 @@ TEST(TriangleBvhTest, FindsTheNearestSurfacePointAsTestingEveryTriangleDoes) {
     EXPECT_NEAR((nearest.point - query).norm(), nearest.distance, 1e-12);
     // Bounded below the distance, nothing is found.
     EXPECT_EQ(bvh.Nearest(query, 0.999 * expected).triangle, -1);
+    // A hint changes nothing but the work: any triangle, one out of range, the answer itself.
+    for (const int hint : {static_cast<int>(q) % 1500, -7, 1500, 1 << 30, nearest.triangle}) {
+      const NearestSurfacePoint hinted = bvh.Nearest(query, 1e300, hint);
+      EXPECT_NEAR(hinted.distance, expected, 1e-9) << "query " << q << " hint " << hint;
+      EXPECT_EQ(bvh.Nearest(query, 0.999 * expected, hint).triangle, -1) << "query " << q << " hint " << hint;
+    }
+  }
+}
+
+TEST(TriangleBvhTest, NearestSkipsUnusableTrianglesEvenAsHints) {
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {NAN, 0, 0}, {0, 0, 5}, {1, 0, 5}, {0, 1, 5}};
+  mesh.triangles = {{0, 1, 2}, {3, 1, 2}, {0, 1, 99}, {4, 5, 6}};
+  const TriangleBvh bvh(mesh);
+  EXPECT_EQ(bvh.num_triangles(), 2);
+  for (const int hint : {-1, 0, 1, 2, 3, 4}) {
+    const NearestSurfacePoint nearest = bvh.Nearest({0.2, 0.2, 4.0}, 1e300, hint);
+    EXPECT_EQ(nearest.triangle, 3) << "hint " << hint;
+    EXPECT_NEAR(nearest.distance, 1.0, 1e-12) << "hint " << hint;
   }
 }
 
