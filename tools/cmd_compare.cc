@@ -24,11 +24,15 @@ constexpr char kHelp[] =
     "missing (photos looked at it, nothing was built) or not_seen.\n"
     "  --control FILE      the design coordinates of some of the project's tags, one line per tag:\n"
     "                      'ID X Y Z' (its centre) or 'ID' and its 4 corners' X Y Z (libapriltag's\n"
-    "                      order), '#' comments. The design's units (m, cm, mm, in, ft) are told from\n"
-    "                      their scale. Without it the design is taken as drawn in the world frame.\n"
+    "                      order); or of picked points: 'point X Y Z WX WY WZ' (design, then world\n"
+    "                      coordinates, e.g. from `reconar measure`); '#' comments. The design's units\n"
+    "                      (m, cm, mm, in, ft) are told from the tags' scale; a project without tags\n"
+    "                      takes its metres from the design, read as metres. Without control the design\n"
+    "                      is taken as drawn in the world frame.\n"
     "  --tolerance M       as designed within M metres (default 0.01)\n"
     "  --max-distance M    points farther than M from every design surface belong to none (default 0.1)\n"
-    "  --similarity        fit the design's scale instead of recognising its unit\n"
+    "  --similarity        fit the design's scale instead of recognising its unit (lengths are then\n"
+    "                      in the world's units)\n"
     "  --no-icp            keep the control's placement\n"
     "  --threads N         worker threads (default: one per core)\n"
     "  --json              print compare/report.json on stdout\n"
@@ -63,8 +67,14 @@ int RunCompare(int argc, char** argv, int first) {
     return 0;
   }
   const DesignRegistration& r = report->registration;
-  std::printf("design %s: %zu elements, units %s; %d control tags, control RMS %.1f mm\n", report->design_path.c_str(),
-              report->deviation.elements.size(), r.units.c_str(), report->control_tags, 1000.0 * r.control_rms_m);
+  std::printf("design %s: %zu elements, units %s; control: %d tags, %d picked points, RMS %.1f mm\n",
+              report->design_path.c_str(), report->deviation.elements.size(), r.units.c_str(), report->control_tags,
+              report->control_points, 1000.0 * r.control_rms_m);
+  if (report->units_assumed) {
+    std::printf("the project has no metric scale (no tags): the design is taken as drawn in metres, 1 m = %.4g of "
+                "the model's units\n",
+                report->world_units_per_metre);
+  }
   if (!r.icp_rejected.empty()) std::printf("ICP not taken: %s; the control's placement kept\n", r.icp_rejected.c_str());
   if (r.refined) {
     std::printf("ICP: %d of the as-built points used (overlap %.0f %%), RMS %.1f mm, moved %.2f deg and %.1f mm from the "

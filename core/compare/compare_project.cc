@@ -28,14 +28,21 @@ std::array<uint8_t, 4> DeviationColour(double signed_m, double full) {
 
 Result<std::vector<ControlPair>> ControlPairs(const Project& project, const std::string& control_path) {
   RECONAR_ASSIGN_OR_RETURN(const std::vector<ControlTag> tags, ReadControlFile(control_path));
+  std::vector<ControlPair> pairs;
+  bool any_tag = false;
+  for (const ControlTag& tag : tags) {
+    if (tag.id < 0) pairs.push_back({-1, tag.design_points[0], tag.world_point});
+    any_tag = any_tag || tag.id >= 0;
+  }
+  if (!any_tag) return pairs;
   std::error_code error;
   if (!std::filesystem::exists(project.TagLayoutPath(), error)) {
     return FailedPrecondition(project.root() + " has no registered tags (" + project.TagLayoutPath() +
                               " is missing: reconstruct with --tag-size) for the control in " + control_path);
   }
   RECONAR_ASSIGN_OR_RETURN(const TagLayout layout, ReadTagLayout(project.TagLayoutPath()));
-  std::vector<ControlPair> pairs;
   for (const ControlTag& tag : tags) {
+    if (tag.id < 0) continue;
     const LayoutTag* placed = layout.Find(tag.id);
     if (placed == nullptr) {
       return FileError(StatusCode::kInvalidArgument, control_path,
@@ -72,8 +79,12 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
     RECONAR_ASSIGN_OR_RETURN(control, ControlPairs(project, options.control_path));
   }
   std::set<int> control_tags;
-  for (const ControlPair& pair : control) control_tags.insert(pair.tag);
+  for (const ControlPair& pair : control) {
+    if (pair.tag >= 0) control_tags.insert(pair.tag);
+  }
   report.control_tags = static_cast<int>(control_tags.size());
+  report.control_points = static_cast<int>(std::count_if(control.begin(), control.end(),
+                                                          [](const ControlPair& pair) { return pair.tag < 0; }));
 
   // The as-built points: the dense points (with their normals), else the mesh's vertices.
   std::string source = project.DensePointsPath();
@@ -92,12 +103,32 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
   for (const Eigen::Vector3f& n : cloud.normals) normals.push_back(n.cast<double>());
 
   Result<Reconstruction> views = ReadColmapTextModel(project.SparseDir());
-  DesignRegistrationOptions registration_options = options.registration;
-  if (!report.metric && !control.empty()) registration_options.similarity = true;  // no metres to keep
-  RECONAR_ASSIGN_OR_RETURN(report.registration, RegisterDesign(design, control, points, registration_options));
+  // A project without metres takes them from the design (drawn in metres unless the control's
+  // scale is fitted on request): its scale fitted to the control, everything is measured in a
+  // metric copy of the world, so that tolerances, distances and sizes are metres.
+  if (!report.metric && !control.empty() && !options.registration.similarity) {
+    DesignRegistrationOptions scale_only = options.registration;
+    scale_only.similarity = true;
+    scale_only.refine = false;
+    RECONAR_ASSIGN_OR_RETURN(const DesignRegistration scaled, RegisterDesign(design, control, {}, scale_only));
+    report.world_units_per_metre = scaled.world_from_design.scale;
+    report.units_assumed = true;
+  }
+  const double metres_per_world_unit = 1.0 / report.world_units_per_metre;
+  std::vector<Eigen::Vector3d> metric_points = points;
+  for (Eigen::Vector3d& p : metric_points) p *= metres_per_world_unit;
+  for (ControlPair& pair : control) pair.world *= metres_per_world_unit;
+  if (views.ok()) {
+    for (SfmImage& image : views->images) image.cam_from_world.translation *= metres_per_world_unit;
+  }
+  RECONAR_ASSIGN_OR_RETURN(report.registration, RegisterDesign(design, control, metric_points, options.registration));
   RECONAR_ASSIGN_OR_RETURN(report.deviation,
-                           ComputeDeviation(design, report.registration.world_from_design, points, normals,
+                           ComputeDeviation(design, report.registration.world_from_design, metric_points, normals,
                                             views.ok() ? &*views : nullptr, options.deviation));
+  // Back to the world frame: world_from_design = world_from_metric * metric_from_design.
+  Sim3& world_from_design = report.registration.world_from_design;
+  world_from_design.scale *= report.world_units_per_metre;
+  world_from_design.translation *= report.world_units_per_metre;
 
   report.out_dir = project.root() + "/compare";
   std::filesystem::create_directories(report.out_dir, error);
@@ -145,7 +176,10 @@ std::string CompareReportJson(const CompareReport& report, const CompareOptions&
   json.EndArray();
   json.Key("scale").Double(r.world_from_design.scale);
   json.Key("units").String(r.units);
+  json.Key("units_assumed").Bool(report.units_assumed);
+  json.Key("world_units_per_metre").Double(report.world_units_per_metre);
   json.Key("control_tags").Int(report.control_tags);
+  json.Key("control_points").Int(report.control_points);
   json.Key("control_rms_m").Double(r.control_rms_m);
   json.Key("control_residuals_m").BeginArray();
   for (double residual : r.control_residuals_m) json.Double(residual);

@@ -24,7 +24,12 @@ struct CompareReport {
   int as_built_points = 0;
   bool metric = false;          // the project is in metres (tags.json)
   int control_tags = 0;
-  DesignRegistration registration;
+  int control_points = 0;       // picked points in the control
+  // A project without metres (no tags) gets them from the design, taken as drawn in metres: its
+  // world units per metre from the control's fitted scale (1 for a metric project).
+  double world_units_per_metre = 1.0;
+  bool units_assumed = false;
+  DesignRegistration registration;  // world_from_design in the world frame; lengths in metres
   DeviationReport deviation;
   std::string out_dir;
   double seconds = 0.0;
@@ -36,7 +41,8 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
                                         const CompareOptions& options);
 
 // compare/report.json: {"design", "as_built": {"source", "points"}, "metric", "tolerance_m",
-// "registration": {"world_from_design": 4x4 row-major, "scale", "units", "control_tags",
+// "registration": {"world_from_design": 4x4 row-major, "scale", "units", "units_assumed",
+// "world_units_per_metre", "control_tags", "control_points",
 // "control_rms_m", "control_residuals_m", "refined", "icp_rms_m", "points_used", "overlap",
 // "icp_iterations", "icp_turn_deg", "icp_shift_m", "free_directions"}, "density_per_m2",
 // "elements": [{"name", "points", "area_m2", "seen_area_m2", "mean_m", "rms_m", "p95_m",

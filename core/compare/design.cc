@@ -51,17 +51,24 @@ Result<std::vector<ControlTag>> ParseControl(const std::string& text, const std:
     const auto error = [&](const std::string& reason) {
       return FileError(StatusCode::kCorruptData, name_for_errors, "line " + std::to_string(number) + ": " + reason);
     };
-    if (words.size() != 4 && words.size() != 13) {
-      return error("expected 'ID X Y Z' (the tag's centre) or 'ID' and its 4 corners' 12 coordinates, got " +
-                   std::to_string(words.size()) + " fields");
+    const bool picked = words[0] == "point";
+    if (picked ? words.size() != 7 : words.size() != 4 && words.size() != 13) {
+      return error(picked ? "expected 'point' and 6 coordinates (design X Y Z, then world X Y Z), got " +
+                                std::to_string(words.size() - 1)
+                          : "expected 'ID X Y Z' (the tag's centre), 'ID' and its 4 corners' 12 coordinates, or "
+                            "'point' and a picked point's design and world coordinates, got " +
+                                std::to_string(words.size()) + " fields");
     }
     ControlTag tag;
     tag.line = number;
     char* end = nullptr;
-    const long id = std::strtol(words[0].c_str(), &end, 10);
-    if (*end != '\0' || id < 0 || id > 1000000) return error("bad tag id '" + words[0] + "'");
-    tag.id = static_cast<int>(id);
-    if (!ids.insert(tag.id).second) return error("tag " + words[0] + " given twice");
+    if (!picked) {
+      const long id = std::strtol(words[0].c_str(), &end, 10);
+      if (*end != '\0' || id < 0 || id > 1000000) return error("bad tag id '" + words[0] + "'");
+      tag.id = static_cast<int>(id);
+      if (!ids.insert(tag.id).second) return error("tag " + words[0] + " given twice");
+    }
+    std::vector<Eigen::Vector3d> points;
     for (size_t k = 1; k + 2 < words.size(); k += 3) {
       Eigen::Vector3d point;
       for (int c = 0; c < 3; ++c) {
@@ -69,11 +76,17 @@ Result<std::vector<ControlTag>> ParseControl(const std::string& text, const std:
         point[c] = std::strtod(word.c_str(), &end);
         if (*end != '\0' || !std::isfinite(point[c])) return error("bad coordinate '" + word + "'");
       }
-      tag.design_points.push_back(point);
+      points.push_back(point);
+    }
+    if (picked) {
+      tag.design_points = {points[0]};
+      tag.world_point = points[1];
+    } else {
+      tag.design_points = points;
     }
     tags.push_back(tag);
   }
-  if (tags.empty()) return FileError(StatusCode::kCorruptData, name_for_errors, "no control tag");
+  if (tags.empty()) return FileError(StatusCode::kCorruptData, name_for_errors, "no control tag or point");
   return tags;
 }
 
