@@ -8,6 +8,8 @@
 #include "core/base/atomic_file.h"
 #include "core/base/json_reader.h"
 #include "core/base/json_writer.h"
+#include "core/compare/report_picture.h"
+#include "core/io/image_write.h"
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_file.h"
 #include "core/mesh/mesh_io.h"
@@ -17,14 +19,6 @@
 
 namespace reconar {
 namespace {
-
-// Diverging colours: blue below the design, white on it, red above, saturated at `full`.
-std::array<uint8_t, 4> DeviationColour(double signed_m, double full) {
-  const double t = std::clamp(signed_m / full, -1.0, 1.0);
-  const auto fade = [](double x) { return static_cast<uint8_t>(std::lround(255.0 * (1.0 - x))); };
-  if (t >= 0.0) return {255, fade(t), fade(t), 255};
-  return {fade(-t), fade(-t), 255, 255};
-}
 
 Result<std::vector<ControlPair>> ControlPairs(const Project& project, const std::string& control_path) {
   RECONAR_ASSIGN_OR_RETURN(const std::vector<ControlTag> tags, ReadControlFile(control_path));
@@ -153,6 +147,18 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
     placed.push_back(std::move(moved));
   }
   RECONAR_RETURN_IF_ERROR(WriteGlbScene(report.out_dir + "/design_registered.glb", placed));
+  // The top view looks down the world's up: the tag board's y for a project registered by tags,
+  // else the points' thinnest direction (the floor's normal for a room, a wall's for a facade).
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  if (!report.metric) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& p : metric_points) mean += p / static_cast<double>(metric_points.size());
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const Eigen::Vector3d& p : metric_points) scatter += (p - mean) * (p - mean).transpose();
+    up = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+  }
+  const Image<uint8_t> picture = DrawCompareReport(report, options, metric_points, up);
+  RECONAR_RETURN_IF_ERROR(WritePng(report.out_dir + "/report.png", picture.view(), 3));
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.out_dir + "/report.json", CompareReportJson(report, options)));
   return report;

@@ -9,7 +9,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/median.h"
 #include "core/io/image_write.h"
-#include "render/ar/bitmap_text.h"
+#include "core/base/bitmap_text.h"
 
 namespace reconar {
 namespace {

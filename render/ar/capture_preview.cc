@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "render/ar/bitmap_text.h"
+#include "core/base/bitmap_text.h"
 
 namespace reconar {
 namespace {

@@ -1,4 +1,4 @@
-// The capture's preview words (render/ar/bitmap_text.h, render/ar/capture_preview.h): the built-in
+// The capture's preview words (core/base/bitmap_text.h, render/ar/capture_preview.h): the built-in
 // font holds every advice the gate gives, its glyphs tell apart, and the words land where drawn.
 #include "render/ar/capture_preview.h"
 
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "render/ar/bitmap_text.h"
+#include "core/base/bitmap_text.h"
 #include "tracker/keyframe_gate.h"
 
 namespace reconar {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/base/json_reader.h"
+#include "core/io/image_io.h"
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_io.h"
 #include "core/sfm/tag_layout.h"
@@ -113,9 +114,23 @@ TEST_F(CompareCliTest, FindsTheMovedColumnInADesignDrawnInMillimetres) {
   EXPECT_EQ(verdicts["wall"], "as_designed");
   EXPECT_EQ(verdicts["plinth"], "as_designed");
   EXPECT_EQ(verdicts["ground"], "as_designed");
-  for (const char* output : {"report.json", "deviation.ply", "design_registered.glb"}) {
+  for (const char* output : {"report.json", "deviation.ply", "design_registered.glb", "report.png"}) {
     EXPECT_TRUE(std::filesystem::exists(project_ + "/compare/" + output)) << output;
   }
+  // The picture's table says the verdicts in their colours: red for the column, green for the rest.
+  const Result<DecodedImage> picture = ReadImage(project_ + "/compare/report.png");
+  ASSERT_TRUE(picture.ok()) << picture.status().message();
+  EXPECT_EQ(picture->rgb.width(), 1280);
+  int red = 0, green = 0;
+  for (int y = 600; y < picture->rgb.height(); ++y) {
+    for (int x = 0; x < picture->rgb.width(); ++x) {
+      const uint8_t* p = picture->rgb.row(y) + 3 * x;
+      red += p[0] == 200 && p[1] == 40 && p[2] == 30;
+      green += p[0] == 30 && p[1] == 140 && p[2] == 60;
+    }
+  }
+  EXPECT_GT(red, 100);
+  EXPECT_GT(green, 3 * 100);  // three elements as designed
   // The registered design lands on the world frame: its wall where the world design has it.
   const Result<std::vector<NamedMesh>> placed = ReadGltfScene(project_ + "/compare/design_registered.glb");
   ASSERT_TRUE(placed.ok()) << placed.status().message();

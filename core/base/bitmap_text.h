@@ -1,8 +1,9 @@
 #pragma once
-// Words on the capture's preview and the view's measurements without a font library: a built-in
-// 5 x 7 pixel font (a cell of 6 x 8 with the spacing), drawn on the CPU at an integer scale. It
-// holds what they say: lower-case letters, digits, space and : , . % / - + ( ) '. Any other character is drawn as a
-// hollow box, so that a missing glyph shows instead of vanishing.
+// Words on the capture's preview, the view's measurements and compare's report picture without a
+// font library: a built-in 5 x 7 pixel font (a cell of 6 x 8 with the spacing), drawn on the CPU
+// at an integer scale. It holds what they say: lower-case letters, digits, space and
+// : , . % / - + ( ) ' _ = < >. Any other character is drawn as a hollow box, so that a missing
+// glyph shows instead of vanishing.
 #include <array>
 #include <cstdint>
 #include <string>
