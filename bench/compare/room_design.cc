@@ -1,12 +1,15 @@
 // room_design PROJECT OUT_DIR: a design of the room a tagged project shows, made from its tags:
 // one wall per group of tags facing the same way within 0.2 m of one plane, each a box 5 cm thick
 // behind the upright plane fitted to its tags' corners, as long as its tags reach plus half a metre each
-// way and from 1 m below the lowest tag to 1 m above the highest (the world frame's y is up: the
-// tag board's). Written as OUT_DIR/room_design.glb in millimetres, in a frame of its own (z up,
+// way and from the floor to the ceiling (the world frame's y is up: the tag board's); a floor and a
+// ceiling slab, 5 cm thick, at the heights of the lowest and highest dense points (no tag is on
+// them), over the tags' extent plus half a metre. Written as OUT_DIR/room_design.glb in millimetres, in a frame of its own (z up,
 // the origin 10 m east and 20 m north of the world's), with OUT_DIR/room_control.txt giving every
 // tag's centre in that frame, so that `reconar compare PROJECT OUT_DIR/room_design.glb --control
 // OUT_DIR/room_control.txt` has to find the units and the frame itself.
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -15,11 +18,36 @@
 #include <Eigen/Geometry>
 
 #include "core/mesh/glb_io.h"
+#include "core/mesh/mesh_io.h"
 #include "core/sfm/tag_layout.h"
 #include "core/sfm/tag_squares.h"
 
 namespace reconar {
 namespace {
+
+// A box 5 cm thick whose face centre + [a_min, a_max] along + [v_min, v_max] vertical faces
+// `normal` (into the room), the rest behind it; in the design's frame and units.
+Mesh FacingBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& along, const Eigen::Vector3d& vertical,
+               const Eigen::Vector3d& normal, double a_min, double a_max, double v_min, double v_max,
+               const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& to_design) {
+  Mesh box;
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d world = centre + (k & 1 ? a_max : a_min) * along + (k & 2 ? v_max : v_min) * vertical -
+                                  (k & 4 ? 0.05 : 0.0) * normal;
+    box.positions.push_back(to_design(world).cast<float>());
+  }
+  // Counter-clockwise from outside in the box's own axes (along, vertical, -normal) when they are
+  // right-handed: the face at the plane (k & 4 == 0) then faces the room.
+  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    box.triangles.push_back({q[0], q[1], q[2]});
+    box.triangles.push_back({q[0], q[2], q[3]});
+  }
+  if (along.cross(vertical).dot(-normal) < 0.0) {
+    for (auto& t : box.triangles) std::swap(t[1], t[2]);
+  }
+  return box;
+}
 
 int Run(int argc, char** argv) {
   if (argc != 3) {
@@ -61,6 +89,20 @@ int Run(int argc, char** argv) {
   };
   std::vector<NamedMesh> elements;
   const Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // the tag board's y
+  // No tag is on the floor or the ceiling, and the photos, taken at the tags' height, barely show
+  // them: they are put at the lowest and the highest dense point (the floor is no higher than
+  // anything standing on it).
+  Result<Mesh> dense = ReadPly(project + "/dense/points.ply");
+  if (!dense.ok()) {
+    std::fprintf(stderr, "%s\n", dense.status().ToString().c_str());
+    return 1;
+  }
+  std::vector<double> heights;
+  for (const Eigen::Vector3f& p : dense->positions) heights.push_back(up.dot(p.cast<double>()));
+  std::sort(heights.begin(), heights.end());
+  const double floor_height = heights.front(), ceiling_height = heights.back();
+  Eigen::AlignedBox3d room;  // the tags' extent
+  for (const LayoutTag& tag : layout->tags()) room.extend(tag.layout_from_tag.translation);
   for (const Wall& wall : walls) {
     std::vector<Eigen::Vector3d> corners;
     for (const LayoutTag* tag : wall.tags) {
@@ -84,29 +126,25 @@ int Run(int argc, char** argv) {
       v_min = std::min(v_min, (c - centre).dot(vertical));
       v_max = std::max(v_max, (c - centre).dot(vertical));
     }
-    a_min -= 0.5, a_max += 0.5, v_min -= 1.0, v_max += 1.0;
-    Mesh box;
-    for (int k = 0; k < 8; ++k) {
-      const Eigen::Vector3d world = centre + (k & 1 ? a_max : a_min) * along + (k & 2 ? v_max : v_min) * vertical -
-                                    (k & 4 ? 0.05 : 0.0) * normal;
-      box.positions.push_back(to_design_mm(world).cast<float>());
-    }
-    // Counter-clockwise from outside in the box's own axes (along, vertical, -normal) when they are
-    // right-handed: the face at the plane (k & 4 == 0) then faces the room.
-    const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& q : quads) {
-      box.triangles.push_back({q[0], q[1], q[2]});
-      box.triangles.push_back({q[0], q[2], q[3]});
-    }
-    if (along.cross(vertical).dot(-normal) < 0.0) {
-      for (auto& t : box.triangles) std::swap(t[1], t[2]);
-    }
+    a_min -= 0.5, a_max += 0.5;
+    v_min = floor_height - (centre.dot(up)), v_max = ceiling_height - centre.dot(up);
+    const Mesh box = FacingBox(centre, along, vertical, normal, a_min, a_max, v_min, v_max, to_design_mm);
     std::string name = "wall";
     for (const LayoutTag* tag : wall.tags) name += "_" + std::to_string(tag->id);
     std::printf("%s: %zu tags, normal (%.3f %.3f %.3f), %.2f x %.2f m\n", name.c_str(), wall.tags.size(), normal.x(),
                 normal.y(), normal.z(), a_max - a_min, v_max - v_min);
     elements.push_back({name, box});
   }
+  // Floor and ceiling: slabs over the tags' extent in x and z, half a metre beyond it.
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), z = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d middle = room.center();
+  const double half_x = room.sizes().x() / 2 + 0.5, half_z = room.sizes().z() / 2 + 0.5;
+  const Eigen::Vector3d floor_centre = middle + (floor_height - middle.dot(up)) * up;
+  const Eigen::Vector3d ceiling_centre = middle + (ceiling_height - middle.dot(up)) * up;
+  elements.push_back({"floor", FacingBox(floor_centre, x, -z, up, -half_x, half_x, -half_z, half_z, to_design_mm)});
+  elements.push_back({"ceiling", FacingBox(ceiling_centre, x, z, -up, -half_x, half_x, -half_z, half_z, to_design_mm)});
+  std::printf("floor at %.3f m, ceiling at %.3f m (the lowest and highest dense points), %.2f x %.2f m\n",
+              floor_height, ceiling_height, 2 * half_x, 2 * half_z);
   if (Status written = WriteGlbScene(out + "/room_design.glb", elements); !written.ok()) {
     std::fprintf(stderr, "%s\n", written.ToString().c_str());
     return 1;

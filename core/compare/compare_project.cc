@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <set>
 
@@ -136,6 +138,17 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
                                   : DeviationColour(report.deviation.signed_distance_m[i], 3.0 * options.deviation.tolerance));
   }
   RECONAR_RETURN_IF_ERROR(WritePly(report.out_dir + "/deviation.ply", coloured));
+  // The same points as glTF, with the colour scale as a strip beside them (a third of their width,
+  // along the world's x at the corner of their bounding box).
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& p : points) box.extend(p);
+  const double width = std::max(box.sizes().maxCoeff(), 1e-6);
+  const std::vector<NamedMesh> deviation_scene = {
+      {"as built, coloured by its deviation from the design", coloured},
+      DeviationLegendStrip(3.0 * options.deviation.tolerance, report.world_units_per_metre,
+                           box.min() - 0.05 * width * Eigen::Vector3d::UnitZ(), width / 3.0 * Eigen::Vector3d::UnitX(),
+                           width / 30.0 * Eigen::Vector3d::UnitY())};
+  RECONAR_RETURN_IF_ERROR(WriteGlbScene(report.out_dir + "/deviation.glb", deviation_scene));
   std::vector<NamedMesh> placed;
   for (const NamedMesh& element : design.elements) {
     NamedMesh moved{element.name, Mesh()};

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include <Eigen/Geometry>
 
@@ -13,21 +14,105 @@
 namespace reconar {
 namespace {
 
-// Registered photos that face the point (in front, within the frame, the face turned toward them).
-int FacingViews(const Reconstruction& views, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
-  int count = 0;
+// What the registered photos say about points on the design's surface. Each photo's view of the
+// as-built points is a coarse depth buffer (the nearest point per cell of kCellPx pixels); a
+// surface point the photo faces (in front, in the frame, its face turned toward the photo) is
+// then, from that photo:
+//   hidden       when an as-built point lies in front of it (beyond the margin): no evidence;
+//   present      when the nearest as-built point is at its depth (within the margin);
+//   see-through  when the nearest as-built point is behind it: the photo saw past where the
+//                surface should be, so it is not there;
+//   open         when the cell holds no point: looked at, nothing reconstructed either way.
+struct SurfaceSample {
+  Eigen::Vector3d point, normal;
+  int element = 0;
+  double area = 0.0;  // the share of its element's area it stands for
+  int unhidden = 0, see_through = 0, present = 0;
+};
+
+constexpr int kCellPx = 8;
+constexpr size_t kMaxBufferPoints = 400000;  // as-built points projected per photo (evenly thinned)
+constexpr int kSamplesPerElement = 256;
+
+void VoteFromViews(const Reconstruction& views, const std::vector<Eigen::Vector3d>& as_built, double margin,
+                   ThreadPool* pool, std::vector<SurfaceSample>* samples) {
+  std::vector<const SfmImage*> photos;
   for (const SfmImage& image : views.images) {
-    if (!image.registered || image.camera_id < 0 || static_cast<size_t>(image.camera_id) >= views.cameras.size()) continue;
-    const SfmCamera& camera = views.cameras[static_cast<size_t>(image.camera_id)];
-    const Eigen::Vector3d in_camera = image.cam_from_world * point;
-    if (!(in_camera.z() > 0.0)) continue;
-    const Eigen::Vector3d centre = CameraCenterInWorld(image.cam_from_world);
-    if (normal.dot(centre - point) <= 0.0) continue;
-    const Eigen::Vector2d pixel = camera.Project(in_camera);
-    if (pixel.x() < 0.0 || pixel.y() < 0.0 || pixel.x() > camera.width - 1 || pixel.y() > camera.height - 1) continue;
-    ++count;
+    if (image.registered && image.camera_id >= 0 && static_cast<size_t>(image.camera_id) < views.cameras.size()) {
+      photos.push_back(&image);
+    }
   }
-  return count;
+  const size_t stride = std::max<size_t>(1, as_built.size() / kMaxBufferPoints);
+  struct Votes {
+    std::vector<int> unhidden, see_through, present;
+    std::vector<float> depth;  // the worker's depth buffer
+  };
+  std::vector<Votes> votes(static_cast<size_t>(pool->num_threads()));
+  for (Votes& v : votes) {
+    v.unhidden.assign(samples->size(), 0);
+    v.see_through.assign(samples->size(), 0);
+    v.present.assign(samples->size(), 0);
+  }
+  pool->ParallelFor(0, photos.size(), [&](size_t p, int worker) {
+    const SfmImage& image = *photos[p];
+    const SfmCamera& camera = views.cameras[static_cast<size_t>(image.camera_id)];
+    const int columns = (camera.width + kCellPx - 1) / kCellPx, rows = (camera.height + kCellPx - 1) / kCellPx;
+    Votes& mine = votes[static_cast<size_t>(worker)];
+    mine.depth.assign(static_cast<size_t>(columns) * static_cast<size_t>(rows), INFINITY);
+    // Far outside the frame the distortion polynomial folds back into it: only points whose
+    // undistorted radius is within the frame's corners' are projected.
+    double max_r2 = 0.0;
+    for (const Eigen::Vector2d& corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(camera.width - 0.5, -0.5),
+                                         Eigen::Vector2d(-0.5, camera.height - 0.5),
+                                         Eigen::Vector2d(camera.width - 0.5, camera.height - 0.5)}) {
+      Eigen::Vector2d normalised((corner.x() - camera.cx) / camera.focal, (corner.y() - camera.cy) / camera.fy());
+      camera.Undistort(corner, &normalised);
+      max_r2 = std::max(max_r2, normalised.squaredNorm());
+    }
+    const auto cell_of = [&](const Eigen::Vector3d& in_camera) -> long {
+      if (!(in_camera.z() > 0.0) || !((in_camera.head<2>() / in_camera.z()).squaredNorm() <= max_r2)) return -1;
+      const Eigen::Vector2d pixel = camera.Project(in_camera);
+      if (!(pixel.x() >= -0.5 && pixel.y() >= -0.5 && pixel.x() < camera.width - 0.5 && pixel.y() < camera.height - 0.5)) {
+        return -1;
+      }
+      const int column = std::min(columns - 1, static_cast<int>((pixel.x() + 0.5) / kCellPx));
+      const int row = std::min(rows - 1, static_cast<int>((pixel.y() + 0.5) / kCellPx));
+      return static_cast<long>(row) * columns + column;
+    };
+    for (size_t i = 0; i < as_built.size(); i += stride) {
+      const Eigen::Vector3d in_camera = image.cam_from_world * as_built[i];
+      const long cell = cell_of(in_camera);
+      if (cell >= 0) {
+        float& nearest = mine.depth[static_cast<size_t>(cell)];
+        nearest = std::min(nearest, static_cast<float>(in_camera.z()));
+      }
+    }
+    const Eigen::Vector3d centre = CameraCenterInWorld(image.cam_from_world);
+    for (size_t k = 0; k < samples->size(); ++k) {
+      const SurfaceSample& sample = (*samples)[k];
+      if (sample.normal.dot(centre - sample.point) <= 0.0) continue;
+      const Eigen::Vector3d in_camera = image.cam_from_world * sample.point;
+      const long cell = cell_of(in_camera);
+      if (cell < 0) continue;
+      const double nearest = mine.depth[static_cast<size_t>(cell)];
+      // Depth along the optical axis; the margin along the ray, near enough for a cell's width.
+      if (nearest < in_camera.z() - margin) continue;  // hidden
+      ++mine.unhidden[k];
+      if (!std::isfinite(nearest)) continue;  // open
+      if (nearest > in_camera.z() + margin) {
+        ++mine.see_through[k];
+      } else {
+        ++mine.present[k];
+      }
+    }
+  });
+  for (const Votes& v : votes) {
+    for (size_t k = 0; k < samples->size(); ++k) {
+      (*samples)[k].unhidden += v.unhidden[k];
+      (*samples)[k].see_through += v.see_through[k];
+      (*samples)[k].present += v.present[k];
+    }
+  }
 }
 
 // The points' indices along a Morton (Z-order) curve over their bounding box, 2^10 cells a side:
@@ -116,18 +201,46 @@ Result<DeviationReport> ComputeDeviation(const Design& design, const Sim3& world
     if (report.element_of_point[i] >= 0) points_of[static_cast<size_t>(report.element_of_point[i])].push_back(i);
   }
 
-  // Areas, and the areas two registered photos face (sampled at each triangle's centroid).
+  // Areas; points spread over each element's surface (area-weighted, seeded: the same each run),
+  // and what the photos say about them.
   report.elements.resize(num_elements);
+  std::vector<double> triangle_area(surface.mesh.triangles.size());
   for (size_t t = 0; t < surface.mesh.triangles.size(); ++t) {
     const std::array<uint32_t, 3>& tri = surface.mesh.triangles[t];
     const Eigen::Vector3d a = surface.mesh.positions[tri[0]].cast<double>();
-    const Eigen::Vector3d b = surface.mesh.positions[tri[1]].cast<double>();
-    const Eigen::Vector3d c = surface.mesh.positions[tri[2]].cast<double>();
-    const double area = 0.5 * (b - a).cross(c - a).norm();
-    ElementDeviation& element = report.elements[static_cast<size_t>(surface.element_of_triangle[t])];
-    element.area_m2 += area;
-    if (views == nullptr || FacingViews(*views, (a + b + c) / 3.0, surface.face_normals[t]) >= 2) {
-      element.seen_area_m2 += area;
+    triangle_area[t] = 0.5 * (surface.mesh.positions[tri[1]].cast<double>() - a)
+                                 .cross(surface.mesh.positions[tri[2]].cast<double>() - a)
+                                 .norm();
+    report.elements[static_cast<size_t>(surface.element_of_triangle[t])].area_m2 += triangle_area[t];
+  }
+  std::vector<SurfaceSample> samples;
+  std::mt19937_64 random(1);
+  for (size_t e = 0; e < num_elements; ++e) {
+    if (triangles_of[e].empty() || !(report.elements[e].area_m2 > 0.0)) continue;
+    std::vector<double> areas;
+    for (size_t t : triangles_of[e]) areas.push_back(triangle_area[t]);
+    std::discrete_distribution<size_t> pick(areas.begin(), areas.end());
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int k = 0; k < kSamplesPerElement; ++k) {
+      const size_t t = triangles_of[e][pick(random)];
+      const std::array<uint32_t, 3>& tri = surface.mesh.triangles[t];
+      double u = unit(random), v = unit(random);
+      if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
+      const Eigen::Vector3d a = surface.mesh.positions[tri[0]].cast<double>();
+      const Eigen::Vector3d point = a + u * (surface.mesh.positions[tri[1]].cast<double>() - a) +
+                                    v * (surface.mesh.positions[tri[2]].cast<double>() - a);
+      samples.push_back({point, surface.face_normals[t], static_cast<int>(e),
+                         report.elements[e].area_m2 / kSamplesPerElement});
+    }
+  }
+  if (views != nullptr) VoteFromViews(*views, as_built, options.max_distance, &pool, &samples);
+  std::vector<double> see_through_area(num_elements, 0.0), evidence_area(num_elements, 0.0);
+  for (const SurfaceSample& sample : samples) {
+    ElementDeviation& element = report.elements[static_cast<size_t>(sample.element)];
+    if (views == nullptr || sample.unhidden >= 2) element.seen_area_m2 += sample.area;
+    if (sample.see_through + sample.present > 0) {
+      evidence_area[static_cast<size_t>(sample.element)] += sample.area;
+      if (sample.see_through > sample.present) see_through_area[static_cast<size_t>(sample.element)] += sample.area;
     }
   }
 
@@ -180,11 +293,17 @@ Result<DeviationReport> ComputeDeviation(const Design& design, const Sim3& world
     std::nth_element(densities.begin(), densities.begin() + static_cast<long>(densities.size() / 2), densities.end());
     report.density_per_m2 = densities[densities.size() / 2];
   }
-  for (ElementDeviation& element : report.elements) {
+  for (size_t e = 0; e < num_elements; ++e) {
+    ElementDeviation& element = report.elements[e];
     const double expected = report.density_per_m2 * element.seen_area_m2;
+    const bool too_few = element.points < options.missing_fraction * expected || element.points == 0;
+    // Missing needs the photos to have seen past it: over half of where they looked.
+    const bool seen_through = evidence_area[e] > 0.0 && see_through_area[e] > 0.5 * evidence_area[e];
     if (report.views_used && element.seen_area_m2 <= 0.0 && element.points < options.min_points) {
       element.verdict = "not_seen";
-    } else if (element.points < options.missing_fraction * expected || element.points == 0) {
+    } else if (too_few && report.views_used && !seen_through) {
+      element.verdict = "unknown";
+    } else if (too_few) {
       element.verdict = "missing";
     } else if (element.largest_move_m > options.tolerance || element.rms_m > options.tolerance) {
       element.verdict = "deviates";

@@ -32,7 +32,8 @@ struct DeviationOptions {
 struct ElementDeviation {
   std::string name;
   int points = 0;
-  double area_m2 = 0.0, seen_area_m2 = 0.0;  // all faces; the faces two registered photos face
+  // All faces; the part two registered photos face with nothing of the as-built in front of it.
+  double area_m2 = 0.0, seen_area_m2 = 0.0;
   double mean_m = 0.0, rms_m = 0.0;          // of the signed distances
   double p95_m = 0.0;                        // of their magnitudes
   double within_tolerance = 0.0;             // share of its points
@@ -40,7 +41,10 @@ struct ElementDeviation {
   // centre, the turn, and the largest displacement of any of its points.
   Eigen::Vector3d shift_m = Eigen::Vector3d::Zero();
   double turn_deg = 0.0, largest_move_m = 0.0;
-  std::string verdict;  // as_designed, deviates, missing, not_seen
+  // as_designed; deviates; missing (too few points for its seen area, and the photos saw past
+  // it: the as-built behind where it should stand); unknown (too few points, but nothing seen past
+  // it either: a surface the reconstruction could not hold, e.g. texture-poor); not_seen.
+  std::string verdict;
 };
 
 struct DeviationReport {

@@ -210,6 +210,32 @@ std::array<uint8_t, 4> DeviationColour(double signed_m, double full) {
   return {fade(-t), fade(-t), 255, 255};
 }
 
+NamedMesh DeviationLegendStrip(double full, double world_units_per_metre, const Eigen::Vector3d& start,
+                               const Eigen::Vector3d& along, const Eigen::Vector3d& across) {
+  constexpr int kSteps = 60;
+  NamedMesh legend;
+  char name[200];
+  std::snprintf(name, sizeof(name),
+                "legend: blue %.0f mm inside the design, white on it, red %.0f mm outside; grey on no element; the "
+                "strip is %.3g m long",
+                -1000.0 * full, 1000.0 * full, along.norm() / world_units_per_metre);
+  legend.name = name;
+  Mesh& strip = legend.mesh;
+  for (int k = 0; k <= kSteps; ++k) {
+    const double t = static_cast<double>(k) / kSteps;
+    const std::array<uint8_t, 4> colour = DeviationColour(-full + 2.0 * full * t, full);
+    for (const double side : {0.0, 1.0}) {
+      strip.positions.push_back((start + t * along + side * across).cast<float>());
+      strip.colors.push_back(colour);
+    }
+    if (k == 0) continue;
+    const uint32_t b = static_cast<uint32_t>(2 * k);
+    strip.triangles.push_back({b - 2, b, b + 1});
+    strip.triangles.push_back({b - 2, b + 1, b - 1});
+  }
+  return legend;
+}
+
 Image<uint8_t> DrawCompareReport(const CompareReport& report, const CompareOptions& options,
                                  const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up) {
   const int rows = std::min(kMaxRows, static_cast<int>(report.deviation.elements.size()));

@@ -10,12 +10,19 @@
 
 #include "core/base/image.h"
 #include "core/compare/compare_project.h"
+#include "core/mesh/mesh.h"
 
 namespace reconar {
 
 // The diverging colour scale of the outputs: blue below (inside) the design, white on it, red above
 // (outside), saturated at `full` metres.
 std::array<uint8_t, 4> DeviationColour(double signed_m, double full);
+
+// The scale as geometry, for the 3D outputs: a strip of quads from `start` along `along` (its
+// length) and `across` (its width), coloured from -full (at start) to +full, with its name saying
+// what the colours mean.
+NamedMesh DeviationLegendStrip(double full, double world_units_per_metre, const Eigen::Vector3d& start,
+                               const Eigen::Vector3d& along, const Eigen::Vector3d& across);
 
 // `points`: the as-built points the report was computed on (its element_of_point and
 // signed_distance_m are per point); `up`: the unit direction the top view looks down along.

@@ -14,6 +14,7 @@
 #include "core/compare/design.h"
 #include "core/compare/design_registration.h"
 #include "core/compare/deviation.h"
+#include "core/sfm/reconstruction.h"
 #include "tests/support/design_scene.h"
 
 namespace reconar {
@@ -190,6 +191,65 @@ TEST(CompareTest, TheIcpMayNotLeaveTheControl) {
   ASSERT_TRUE(registration.ok());
   EXPECT_TRUE(registration->refined);
   EXPECT_NEAR(registration->world_from_design.translation.x(), 0.05, 0.002);
+}
+
+// A camera at `centre` looking at `target`, its image y down toward -z of the world where it can.
+SfmImage LookingAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, const std::string& name) {
+  const Eigen::Vector3d forward = (target - centre).normalized();
+  const Eigen::Vector3d right = forward.cross(-Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d down = forward.cross(right);
+  SfmImage image;
+  image.name = name;
+  image.camera_id = 0;
+  image.registered = true;
+  image.cam_from_world.rotation.row(0) = right;
+  image.cam_from_world.rotation.row(1) = down;
+  image.cam_from_world.rotation.row(2) = forward;
+  image.cam_from_world.translation = -image.cam_from_world.rotation * centre;
+  return image;
+}
+
+// Missing needs the photos to have seen past where the element should stand: a box never built on
+// ground the photos saw is missing; a box amid a patch of ground the reconstruction lost, so wide
+// that no photo's ray through the box meets a point behind it, is unknown, not missing.
+TEST(CompareTest, MissingOnlyWhereThePhotosSawPastIt) {
+  Design design;
+  design.elements.push_back({"ground", BoxMesh({-3, -3, -0.1}, {3, 3, 0})});
+  design.elements.push_back({"never_built", BoxMesh({1.0, 1.0, 0}, {1.4, 1.4, 0.4})});
+  design.elements.push_back({"over_a_hole", BoxMesh({-1.2, -1.2, 0}, {-0.8, -0.8, 0.4})});
+  std::vector<Eigen::Vector3d> points, normals;
+  for (double x = -3; x <= 3; x += 0.02) {
+    for (double y = -3; y <= 3; y += 0.02) {
+      if (std::hypot(x + 1, y + 1) < 2.0) continue;  // the lost patch
+      points.emplace_back(x, y, 0.0);
+      normals.emplace_back(0, 0, 1);
+    }
+  }
+  Reconstruction views;
+  SfmCamera camera;
+  camera.focal = 500;
+  camera.cx = 320;
+  camera.cy = 240;
+  camera.width = 640;
+  camera.height = 480;
+  camera.k1 = -0.2;
+  views.cameras.push_back(camera);
+  for (int k = 0; k < 8; ++k) {
+    const double angle = 2.0 * M_PI * k / 8;
+    views.images.push_back(LookingAt({4.0 * std::cos(angle), 4.0 * std::sin(angle), 2.5}, {0, 0, 0},
+                                     "view_" + std::to_string(k)));
+  }
+  DeviationOptions options;
+  const Result<DeviationReport> report = ComputeDeviation(design, Sim3(), points, normals, &views, options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  for (const ElementDeviation& e : report->elements) {
+    std::printf("%-12s %7d points, area %.2f m2, seen %.2f m2: %s\n", e.name.c_str(), e.points, e.area_m2,
+                e.seen_area_m2, e.verdict.c_str());
+  }
+  EXPECT_EQ(report->elements[0].verdict, "as_designed");
+  EXPECT_EQ(report->elements[1].verdict, "missing");
+  EXPECT_EQ(report->elements[2].verdict, "unknown");
+  EXPECT_GT(report->elements[1].seen_area_m2, 0.3);  // its top and the sides the ring faces
 }
 
 TEST(CompareTest, ControlFileLinesAreCheckedAndNamed) {
