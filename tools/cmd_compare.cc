@@ -21,7 +21,8 @@ constexpr char kHelp[] =
     "point's signed distance to the nearest design surface (positive: outside it) gives per element\n"
     "the points, mean, RMS, 95th percentile and share within the tolerance; the element's own rigid\n"
     "fit to its points says how far it was moved or turned; the verdict is as_designed, deviates,\n"
-    "missing (photos looked at it, nothing was built) or not_seen.\n"
+    "missing (the photos saw past where it should stand), unknown (they looked, but nothing was\n"
+    "reconstructed there nor behind it) or not_seen.\n"
     "  --control FILE      the design coordinates of some of the project's tags, one line per tag:\n"
     "                      'ID X Y Z' (its centre) or 'ID' and its 4 corners' X Y Z (libapriltag's\n"
     "                      order); or of picked points: 'point X Y Z WX WY WZ' (design, then world\n"
@@ -38,7 +39,9 @@ constexpr char kHelp[] =
     "  --json              print compare/report.json on stdout\n"
     "Writes PROJECT/compare/report.json, deviation.ply (the points coloured: blue inside, white on,\n"
     "red outside the design, saturated at 3 x the tolerance; grey on no element) and\n"
-    "design_registered.glb (the design in the world frame, one node per element).\n";
+    "design_registered.glb (the design in the world frame, one node per element), deviation.glb (the\n"
+    "coloured points and the colour scale as a strip) and report.png (a histogram, a top view and the\n"
+    "table, to read on site).\n";
 
 }  // namespace
 
@@ -92,7 +95,8 @@ int RunCompare(int argc, char** argv, int first) {
     std::printf("%-24s %8d %9.1f %9.1f %9.1f %7.0f%%  %s\n", e.name.c_str(), e.points, 1000.0 * e.mean_m,
                 1000.0 * e.rms_m, 1000.0 * e.p95_m, 100.0 * e.within_tolerance, verdict.c_str());
   }
-  std::printf("written to %s (report.json, deviation.ply, design_registered.glb)\n", report->out_dir.c_str());
+  std::printf("written to %s (report.json, report.png, deviation.ply, deviation.glb, design_registered.glb)\n",
+              report->out_dir.c_str());
   return 0;
 }
 

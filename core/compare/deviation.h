@@ -22,7 +22,8 @@ struct DeviationOptions {
   // the ground under a missing box is not its bottom.
   double max_normal_angle_deg = 60.0;
   // An element seen by the photos whose seen faces hold fewer than this share of the points their
-  // area should (at the median density of the elements) is missing.
+  // area should (at the median density of the elements) is missing, or unknown when the photos did
+  // not see past it.
   double missing_fraction = 0.1;
   int min_points = 30;         // fewer: no fit of its own, no deviates verdict from statistics alone
   int max_fit_points = 20000;  // an element's own fit uses at most this many of its points (evenly thinned)
