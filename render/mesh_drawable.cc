@@ -40,6 +40,7 @@ void main() {
 constexpr const char* kFragmentShader = R"(#version 300 es
 precision highp float;
 uniform int u_shading_mode;
+uniform float u_opacity;
 in vec3 v_cam_position;
 in vec3 v_cam_normal;
 in vec4 v_color;
@@ -53,7 +54,7 @@ void main() {
     vec3 to_eye = normalize(-v_cam_position);
     shade = length_n > 0.0 ? 0.2 + 0.8 * abs(dot(normal / length_n, to_eye)) : 1.0;
   }
-  o_color = vec4(v_color.rgb * shade, 1.0);
+  o_color = vec4(v_color.rgb * shade, u_opacity);
 }
 )";
 
@@ -136,6 +137,7 @@ Result<MeshPipeline> MeshPipeline::Create() {
   pipeline.cam_normal_from_model_ = pipeline.program_.Uniform("u_cam_normal_from_model");
   pipeline.point_size_ = pipeline.program_.Uniform("u_point_size");
   pipeline.shading_mode_ = pipeline.program_.Uniform("u_shading_mode");
+  pipeline.opacity_ = pipeline.program_.Uniform("u_opacity");
   return pipeline;
 }
 
@@ -159,13 +161,21 @@ Status MeshPipeline::Draw(const MeshDrawable& mesh, const Eigen::Matrix4d& clip_
 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
+  const bool blended = style.opacity < 1.0f;
+  glDepthMask(blended ? GL_FALSE : GL_TRUE);
+  if (blended) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  } else {
+    glDisable(GL_BLEND);
+  }
   glUseProgram(program_.id());
   glUniformMatrix4fv(clip_from_model_, 1, GL_FALSE, clip_from_model);
   glUniformMatrix4fv(cam_from_model_, 1, GL_FALSE, cam_from_model_gl);
   glUniformMatrix3fv(cam_normal_from_model_, 1, GL_FALSE, normal_from_model.data());
   glUniform1f(point_size_, style.point_size_px);
   glUniform1i(shading_mode_, mode);
+  glUniform1f(opacity_, std::clamp(style.opacity, 0.0f, 1.0f));
   glBindVertexArray(mesh.vertex_array_.get());
   // Attributes without an array take the current generic value (context state, not VAO state).
   if (!mesh.has_colors_) glVertexAttrib4f(kColor, style.color[0], style.color[1], style.color[2], 1.0f);
@@ -176,6 +186,10 @@ Status MeshPipeline::Draw(const MeshDrawable& mesh, const Eigen::Matrix4d& clip_
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.index_count_), mesh.index_type_, nullptr);
   }
   glBindVertexArray(0);
+  if (blended) {
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+  }
   return CheckGlError("MeshPipeline::Draw");
 }
 

@@ -45,6 +45,9 @@ struct MeshStyle {
   std::array<float, 3> color = {0.85f, 0.75f, 0.6f};  // RGB 0..1 when the mesh has no vertex colours
   float point_size_px = 3.0f;                         // point clouds
   bool shading = true;                                // headlight Lambert; false = flat colour
+  // Below 1: blended over what is drawn (a design over the as-built), without hiding what is drawn
+  // after it (the depth buffer is not written).
+  float opacity = 1.0f;
 };
 
 class MeshPipeline {
@@ -64,6 +67,7 @@ class MeshPipeline {
   GLint cam_normal_from_model_ = -1;
   GLint point_size_ = -1;
   GLint shading_mode_ = -1;
+  GLint opacity_ = -1;
 };
 
 }  // namespace reconar

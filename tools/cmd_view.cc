@@ -60,7 +60,15 @@ constexpr char kHelp[] =
     "  --max-frames N        stop after N frames\n"
     "  --measure \"X1,Y1 X2,Y2\"  with --project: each frame, the distance +- sigma between the model's\n"
     "                        surface under these two pixels, drawn and in --json (in a window: click\n"
-    "                        two points instead)\n";
+    "                        two points instead)\n"
+    "As built against the design (after `reconar compare PROJECT DESIGN`):\n"
+    "  --design DESIGN       with --project: the registered design (PROJECT/compare) drawn\n"
+    "                        semi-transparent over the model, or over the as-built points coloured\n"
+    "                        by their deviation (blue inside, white on, red outside the design)\n"
+    "  --layer NAME          what is shown first: as-built, design (default with --design) or\n"
+    "                        deviation; in a window space or 'l' steps through them. To see the\n"
+    "                        design as a miniature on a tag instead, give it as --model with the\n"
+    "                        placement options.\n";
 
 Result<Eigen::Vector3d> ParseAxis(const std::string& text) {
   const bool negative = !text.empty() && text[0] == '-';
@@ -103,7 +111,8 @@ Result<ModelPlacement> PlacementFromArgs(const Args& args, const Mesh& mesh, dou
 int RunView(int argc, char** argv, int first) {
   std::set<std::string> valued = kTrackerValuedOptions;
   valued.insert({"model", "project", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
-                 "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces", "measure"});
+                 "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces", "measure",
+                 "design", "layer"});
   Args args(valued, {"no-axes", "smooth", "no-map", "json"});
   // A model or a project, and a camera or frames: one of each.
   const CommandUsage usage = {0, 0, {}, [](const Args& a) {
@@ -160,7 +169,26 @@ int RunView(int argc, char** argv, int first) {
     if (!placement.ok()) return Fail(placement.status());
     options.placement = *placement;
   }
-  auto view = ArView::Open(options, model->mesh);
+  std::optional<ArDesign> design;
+  if (args.Has("design")) {
+    if (!project) return Fail(InvalidArgument("--design needs --project (the project `reconar compare` compared)"));
+    auto loaded_design = LoadArDesign(args.Get("project"), args.Get("design"));
+    if (!loaded_design.ok()) return Fail(loaded_design.status());
+    design = std::move(*loaded_design);
+    options.layer = ArLayer::kDesign;
+  }
+  if (args.Has("layer")) {
+    const std::string layer = args.Get("layer");
+    if (layer == "as-built") {
+      options.layer = ArLayer::kAsBuilt;
+    } else if (layer == "design" || layer == "deviation") {
+      if (!design) return Fail(InvalidArgument("--layer " + layer + " needs --design"));
+      options.layer = layer == "design" ? ArLayer::kDesign : ArLayer::kDeviation;
+    } else {
+      return Fail(InvalidArgument("--layer: '" + layer + "' is not as-built, design or deviation"));
+    }
+  }
+  auto view = ArView::Open(options, model->mesh, design ? &*design : nullptr);
   if (!view.ok()) return Fail(view.status());
   std::fprintf(stderr, "reconar view: %s\n", (*view)->Describe(model_path).c_str());
   if (project && !project->has_tags) {

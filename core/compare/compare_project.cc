@@ -82,14 +82,23 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
   report.control_points = static_cast<int>(std::count_if(control.begin(), control.end(),
                                                           [](const ControlPair& pair) { return pair.tag < 0; }));
 
-  // The as-built points: the dense points (with their normals), else the mesh's vertices.
+  // The as-built points: the dense points (with their normals), else the mesh's vertices, else
+  // the sparse points (thin, but what a project of the sparse stage alone has).
+  Result<Reconstruction> views = ReadColmapTextModel(project.SparseDir());
   std::string source = project.DensePointsPath();
   if (!std::filesystem::exists(source, error)) source = project.MeshDir() + "/mesh.ply";
-  if (!std::filesystem::exists(source, error)) {
+  Mesh cloud;
+  if (std::filesystem::exists(source, error)) {
+    RECONAR_ASSIGN_OR_RETURN(cloud, ReadMeshFile(source));
+  } else if (views.ok()) {
+    source = project.SparseDir();
+    for (const SfmPoint& point : views->points) {
+      if (!point.deleted) cloud.positions.push_back(point.position.cast<float>());
+    }
+  } else {
     return FailedPrecondition(project.root() + " has no dense points (" + project.DensePointsPath() +
-                              ") nor mesh to compare with the design: run `reconar reconstruct` through its dense stage");
+                              "), mesh nor sparse model to compare with the design: run `reconar reconstruct`");
   }
-  RECONAR_ASSIGN_OR_RETURN(const Mesh cloud, ReadMeshFile(source));
   if (cloud.positions.empty()) return FileError(StatusCode::kCorruptData, source, "no points");
   report.as_built_source = source;
   report.as_built_points = static_cast<int>(cloud.positions.size());
@@ -98,7 +107,6 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
   for (const Eigen::Vector3f& p : cloud.positions) points.push_back(p.cast<double>());
   for (const Eigen::Vector3f& n : cloud.normals) normals.push_back(n.cast<double>());
 
-  Result<Reconstruction> views = ReadColmapTextModel(project.SparseDir());
   // A project without metres takes them from the design (drawn in metres unless the control's
   // scale is fitted on request): its scale fitted to the control, everything is measured in a
   // metric copy of the world, so that tolerances, distances and sizes are metres.

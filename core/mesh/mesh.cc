@@ -65,4 +65,24 @@ Mesh SubMesh(const Mesh& mesh, const std::vector<size_t>& triangles) {
   return part;
 }
 
+Mesh JoinMeshes(const std::vector<NamedMesh>& parts) {
+  Mesh joined;
+  bool normals = true, colours = true;
+  for (const NamedMesh& part : parts) {
+    if (part.mesh.positions.empty()) continue;
+    normals = normals && part.mesh.normals.size() == part.mesh.positions.size();
+    colours = colours && part.mesh.colors.size() == part.mesh.positions.size();
+  }
+  for (const NamedMesh& part : parts) {
+    const uint32_t offset = static_cast<uint32_t>(joined.positions.size());
+    joined.positions.insert(joined.positions.end(), part.mesh.positions.begin(), part.mesh.positions.end());
+    if (normals) joined.normals.insert(joined.normals.end(), part.mesh.normals.begin(), part.mesh.normals.end());
+    if (colours) joined.colors.insert(joined.colors.end(), part.mesh.colors.begin(), part.mesh.colors.end());
+    for (const std::array<uint32_t, 3>& t : part.mesh.triangles) {
+      joined.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
+  }
+  return joined;
+}
+
 }  // namespace reconar

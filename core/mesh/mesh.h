@@ -40,4 +40,7 @@ void ComputeVertexNormals(Mesh* mesh);
 // only the vertices they use, in their first-use order, and those vertices' normals and colours.
 Mesh SubMesh(const Mesh& mesh, const std::vector<size_t>& triangles);
 
+// The meshes as one, in order: normals and colours kept when every part with vertices has them.
+Mesh JoinMeshes(const std::vector<NamedMesh>& parts);
+
 }  // namespace reconar

@@ -46,6 +46,7 @@ struct EglContextOptions {
 struct WindowEvents {
   bool close_requested = false;  // the window manager's close button (WM_DELETE_WINDOW)
   bool quit_key = false;         // 'q' or Escape pressed in the window
+  int next_layer_presses = 0;    // space or 'l': show the next layer (as-built, design, deviation)
   bool resized = false;          // width() / height() changed
   // Presses of the first button (a mouse click, or a touch the window system turns into one),
   // window pixels (x, y) with row 0 at the top, in order.

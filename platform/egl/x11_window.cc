@@ -68,6 +68,7 @@ class X11Window final : public NativeOutput {
       } else if (event.type == KeyPress) {
         const KeySym key = XLookupKeysym(&event.xkey, 0);
         if (key == XK_q || key == XK_Escape) events.quit_key = true;
+        if (key == XK_space || key == XK_l) ++events.next_layer_presses;
       } else if (event.type == ButtonPress && event.xbutton.button == Button1) {
         events.taps.push_back({event.xbutton.x, event.xbutton.y});
       } else if (event.type == ConfigureNotify) {

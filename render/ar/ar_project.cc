@@ -1,11 +1,13 @@
 #include "render/ar/ar_project.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <system_error>
 
 #include "core/base/json_reader.h"
+#include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_file.h"
 #include "core/pipeline/project.h"
 #include "core/sfm/model_io.h"
@@ -115,13 +117,50 @@ Result<CameraIntrinsics> PhotoCameraForFrame(const std::vector<CameraIntrinsics>
                          std::to_string(height) + ": pass --intrinsics for this camera");
 }
 
+namespace {
+
+bool IsGltf(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".glb" || extension == ".gltf";
+}
+
+}  // namespace
+
 Result<ArModel> LoadArModel(const std::string& path, size_t max_faces) {
   ArModel model;
-  RECONAR_ASSIGN_OR_RETURN(model.mesh, ReadMeshFile(path));
+  if (IsGltf(path)) {
+    RECONAR_ASSIGN_OR_RETURN(const std::vector<NamedMesh> nodes, ReadGltfScene(path));
+    model.mesh = JoinMeshes(nodes);
+  } else {
+    RECONAR_ASSIGN_OR_RETURN(model.mesh, ReadMeshFile(path));
+  }
   auto simplified = SimplifyToFaceBudget(max_faces, &model.mesh);
   if (!simplified.ok()) return simplified.status().WithContext(path);
   if (simplified->simplified) model.simplified = *simplified;
   return model;
+}
+
+Result<ArDesign> LoadArDesign(const std::string& project_dir, const std::string& design_path) {
+  const std::string compare_dir = project_dir + "/compare";
+  const std::string run = "run `reconar compare " + project_dir + " " + design_path + "` first";
+  std::error_code error;
+  if (!std::filesystem::exists(compare_dir + "/report.json", error)) {
+    return FailedPrecondition(project_dir + " has no comparison with a design (" + compare_dir + "/report.json): " + run);
+  }
+  RECONAR_ASSIGN_OR_RETURN(const JsonValue report, ReadJsonFile(compare_dir + "/report.json"));
+  const JsonValue* compared = report.Find("design");
+  const std::string compared_design = compared != nullptr && compared->is_string() ? compared->string() : "";
+  if (std::filesystem::path(compared_design).filename() != std::filesystem::path(design_path).filename()) {
+    return FailedPrecondition(compare_dir + " compares " + (compared_design.empty() ? "no design" : compared_design) +
+                              ", not " + design_path + ": " + run);
+  }
+  ArDesign design;
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<NamedMesh> elements, ReadGltfScene(compare_dir + "/design_registered.glb"));
+  design.design = JoinMeshes(elements);
+  RECONAR_ASSIGN_OR_RETURN(design.deviation, ReadMeshFile(compare_dir + "/deviation.ply"));
+  return design;
 }
 
 }  // namespace reconar

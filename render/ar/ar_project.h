@@ -57,8 +57,20 @@ struct ArModel {
   std::optional<SimplifyReport> simplified;  // set when the mesh was over the face budget
 };
 
-// The model file (core/mesh/mesh_file.h formats), simplified to at most max_faces triangles
-// (0: as it is).
+// The model file (core/mesh/mesh_file.h formats; a glTF scene of several nodes whole, each node
+// in its place), simplified to at most max_faces triangles (0: as it is).
 Result<ArModel> LoadArModel(const std::string& path, size_t max_faces);
+
+// A registered design and the as-built points coloured by their deviation, in the model's frame.
+struct ArDesign {
+  Mesh design;
+  Mesh deviation;
+};
+
+// What `reconar compare PROJECT DESIGN` left in PROJECT/compare for the view: the registered
+// design (design_registered.glb, its elements joined) and the as-built points coloured by their
+// deviation (deviation.ply), in the project's world frame. FailedPrecondition saying what to run
+// when compare/report.json is missing or compared another design (by file name); file errors.
+Result<ArDesign> LoadArDesign(const std::string& project_dir, const std::string& design_path);
 
 }  // namespace reconar

@@ -84,7 +84,22 @@ void DrawMeasureLabel(const ViewMeasurement& measurement, const Eigen::Vector2d&
 
 }  // namespace
 
-Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const Mesh& model) {
+const char* ArLayerName(ArLayer layer) {
+  switch (layer) {
+    case ArLayer::kAsBuilt:
+      return "as-built";
+    case ArLayer::kDesign:
+      return "design";
+    case ArLayer::kDeviation:
+      return "deviation";
+  }
+  return "?";
+}
+
+Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const Mesh& model, const ArDesign* design) {
+  if (design == nullptr && options.layer != ArLayer::kAsBuilt) {
+    return InvalidArgument(std::string("the ") + ArLayerName(options.layer) + " layer needs a design (reconar compare)");
+  }
   const bool to_files = !options.out_dir.empty();
   if (to_files) RECONAR_RETURN_IF_ERROR(CreateDirectories(options.out_dir));
   ArSessionOptions session_options = options.session;
@@ -106,17 +121,26 @@ Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const
   render_options.samples = options.samples;
   RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<OverlayRenderer> renderer, OverlayRenderer::Create(render_options));
   RECONAR_ASSIGN_OR_RETURN(MeshDrawable drawable, MeshDrawable::Upload(model));
-  return std::unique_ptr<ArView>(
-      new ArView(options, std::move(session), std::move(*context), std::move(renderer), std::move(drawable)));
+  std::optional<MeshDrawable> design_drawable, deviation_drawable;
+  if (design != nullptr) {
+    RECONAR_ASSIGN_OR_RETURN(design_drawable, MeshDrawable::Upload(design->design));
+    RECONAR_ASSIGN_OR_RETURN(deviation_drawable, MeshDrawable::Upload(design->deviation));
+  }
+  return std::unique_ptr<ArView>(new ArView(options, std::move(session), std::move(*context), std::move(renderer),
+                                            std::move(drawable), std::move(design_drawable),
+                                            std::move(deviation_drawable)));
 }
 
 ArView::ArView(const ArViewOptions& options, std::unique_ptr<ArSession> session, std::unique_ptr<EglContext> context,
-               std::unique_ptr<OverlayRenderer> renderer, MeshDrawable model)
+               std::unique_ptr<OverlayRenderer> renderer, MeshDrawable model, std::optional<MeshDrawable> design,
+               std::optional<MeshDrawable> deviation)
     : options_(options),
       session_(std::move(session)),
       context_(std::move(context)),
       renderer_(std::move(renderer)),
-      model_(std::move(model)) {}
+      model_(std::move(model)),
+      design_(std::move(design)),
+      deviation_(std::move(deviation)) {}
 
 ArView::~ArView() = default;
 
@@ -146,7 +170,15 @@ Status ArView::Draw(bool* drawn_model) {
   }
   const Eigen::Matrix4d cam_from_model =
       options_.placement ? CamFromModel(pose.cam_from_world, *options_.placement) : pose.cam_from_world.Matrix();
-  RECONAR_RETURN_IF_ERROR(renderer_->DrawMesh(model_, intrinsics, cam_from_model, options_.style));
+  const bool deviation_layer = options_.layer == ArLayer::kDeviation && deviation_;
+  RECONAR_RETURN_IF_ERROR(
+      renderer_->DrawMesh(deviation_layer ? *deviation_ : model_, intrinsics, cam_from_model, options_.style));
+  if (options_.layer != ArLayer::kAsBuilt && design_) {
+    MeshStyle design_style = options_.style;
+    design_style.opacity = options_.design_opacity;
+    design_style.color = options_.design_colour;
+    RECONAR_RETURN_IF_ERROR(renderer_->DrawMesh(*design_, intrinsics, cam_from_model, design_style));
+  }
   *drawn_model = true;
   if (!options_.draw_axes) return Status::Ok();
   for (const LayoutTag& tag : pose.markers) {
@@ -215,6 +247,10 @@ Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& sessi
     if (to_files) return true;
     const WindowEvents events = context_->PollEvents();
     if (options_.measurer) TakeTaps(events.taps);
+    if (design_ && events.next_layer_presses > 0) {
+      options_.layer = static_cast<ArLayer>((static_cast<int>(options_.layer) + events.next_layer_presses) % 3);
+      std::fprintf(stderr, "showing the %s layer\n", ArLayerName(options_.layer));
+    }
     return !events.should_quit();
   };
   RECONAR_ASSIGN_OR_RETURN(report.session, session_->Run(draw_frame));

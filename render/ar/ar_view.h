@@ -15,12 +15,19 @@
 #include "core/measure/measurement.h"
 #include "core/mesh/mesh.h"
 #include "platform/egl/egl_context.h"
+#include "render/ar/ar_project.h"
 #include "render/ar/ar_session.h"
 #include "render/mesh_drawable.h"
 #include "render/model_placement.h"
 #include "render/overlay_renderer.h"
 
 namespace reconar {
+
+// What the view draws over the video (with a design from `reconar compare`, space or 'l' in the
+// window steps through them): the as-built model; the model and the registered design over it,
+// semi-transparent; the as-built points coloured by their deviation, with the design.
+enum class ArLayer { kAsBuilt, kDesign, kDeviation };
+const char* ArLayerName(ArLayer layer);  // "as-built", "design", "deviation"
 
 struct ArViewOptions {
   ArSessionOptions session;  // frames.want_rgb is forced on
@@ -38,6 +45,9 @@ struct ArViewOptions {
   // window without measure_pixels, two clicks (taps) on the picture set them, a third starts again.
   std::shared_ptr<ProjectMeasurer> measurer;
   std::optional<std::array<Eigen::Vector2d, 2>> measure_pixels;
+  ArLayer layer = ArLayer::kAsBuilt;  // the first layer shown (kDesign, kDeviation need a design)
+  float design_opacity = 0.45f;
+  std::array<float, 3> design_colour = {0.1f, 0.85f, 0.95f};
 };
 
 // The frame's measure (ArViewOptions::measure_pixels).
@@ -61,7 +71,10 @@ class ArView {
  public:
   // Creates out_dir, opens the session, the EGL context (surfaceless for PNGs, else a window; no
   // display is FailedPrecondition saying to use --out) and the renderer, and uploads the model.
-  static Result<std::unique_ptr<ArView>> Open(const ArViewOptions& options, const Mesh& model);
+  // `design` (may be null): the layers kDesign and kDeviation; InvalidArgument when options.layer
+  // asks for one without it.
+  static Result<std::unique_ptr<ArView>> Open(const ArViewOptions& options, const Mesh& model,
+                                              const ArDesign* design = nullptr);
   ~ArView();
 
   // "SOURCE; EGL-ROUTE RENDERER; model MODEL_NAME (N vertices, M triangles)".
@@ -76,7 +89,8 @@ class ArView {
 
  private:
   ArView(const ArViewOptions& options, std::unique_ptr<ArSession> session, std::unique_ptr<EglContext> context,
-         std::unique_ptr<OverlayRenderer> renderer, MeshDrawable model);
+         std::unique_ptr<OverlayRenderer> renderer, MeshDrawable model, std::optional<MeshDrawable> design,
+         std::optional<MeshDrawable> deviation);
   // The frame, the model and the tags' axes at this frame's pose; true in *drawn_model when the
   // model was drawn.
   Status Draw(bool* drawn_model);
@@ -86,6 +100,7 @@ class ArView {
   std::unique_ptr<EglContext> context_;
   std::unique_ptr<OverlayRenderer> renderer_;
   MeshDrawable model_;
+  std::optional<MeshDrawable> design_, deviation_;
   Image<uint8_t> rgb_;
   // The line between the measured pixels (or the ring of a first tap) and the label, into rgb_.
   void DrawMeasureMarks();

@@ -315,6 +315,41 @@ TEST_F(OverlayRendererTest, NearSurfacesHideFarOnes) {
   }
 }
 
+// A semi-transparent mesh (a design over the as-built) blends over what is drawn, is hidden by what
+// stands in front of it, and hides nothing drawn after it.
+TEST_F(OverlayRendererTest, SemiTransparentMeshesBlendAndHideNothing) {
+  const CameraIntrinsics intrinsics = OffCentreCamera();
+  auto renderer = MakeRenderer(640, 480);
+  ASSERT_NE(renderer, nullptr);
+  const Eigen::Vector3f on_axis(0.0f, 0.0f, 1.0f);
+  Mesh far_green, veil, behind_red;
+  AddSquare(on_axis * 3.0f, 0.6f, {0, 255, 0, 255}, &far_green);
+  AddSquare(on_axis * 2.0f, 0.3f, {0, 0, 255, 255}, &veil);
+  AddSquare(on_axis * 2.5f, 0.05f, {255, 0, 0, 255}, &behind_red);
+  auto green = MeshDrawable::Upload(far_green), blue = MeshDrawable::Upload(veil), red = MeshDrawable::Upload(behind_red);
+  ASSERT_TRUE(green.ok() && blue.ok() && red.ok());
+  MeshStyle unlit;
+  unlit.shading = false;
+  MeshStyle half = unlit;
+  half.opacity = 0.5f;
+  ASSERT_TRUE(renderer->BeginFrame().ok());
+  ASSERT_TRUE(renderer->DrawMesh(*green, intrinsics, Eigen::Matrix4d::Identity(), unlit).ok());
+  ASSERT_TRUE(renderer->DrawMesh(*blue, intrinsics, Eigen::Matrix4d::Identity(), half).ok());
+  ASSERT_TRUE(renderer->DrawMesh(*red, intrinsics, Eigen::Matrix4d::Identity(), unlit).ok());
+  Image<uint8_t> rendered;
+  ASSERT_TRUE(renderer->ReadRgb(&rendered).ok());
+  const auto pixel = [&](const Eigen::Vector3d& point) {
+    const Eigen::Vector2d p = intrinsics.Project(point);
+    return PixelAt(rendered, int(std::lround(p.x())), int(std::lround(p.y())));
+  };
+  const Rgb blended = pixel({0.15, 0.15, 2.0});  // the veil over the green
+  EXPECT_NEAR(blended[0], 0, 2);
+  EXPECT_NEAR(blended[1], 128, 2);
+  EXPECT_NEAR(blended[2], 128, 2);
+  EXPECT_EQ(pixel({0.0, 0.0, 2.5}), (Rgb{255, 0, 0}));  // behind the veil but drawn after it: whole
+  EXPECT_EQ(pixel({0.5, 0.5, 3.0}), (Rgb{0, 255, 0}));  // beyond the veil: untouched
+}
+
 // A mesh of more than 65536 vertices (32-bit indices) draws the triangles whose indices are large.
 TEST_F(OverlayRendererTest, MeshesBeyond16BitIndicesDraw) {
   const CameraIntrinsics intrinsics = OffCentreCamera();

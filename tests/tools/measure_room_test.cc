@@ -4,7 +4,7 @@
 // at least 90 % of them within 2σ of it, with a median σ under 2 mm (an honest σ that is also
 // useful). A tag corner picked in two photos lands on the model's corner within 2σ. What the model
 // cannot place is an error naming the point and the reason. The JSON is read back as a script would.
-// The view measures a tag's edge tapped by its pixels.
+// The view measures a tag's edge tapped by its pixels, and draws a design registered by `reconar compare`.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,11 +14,15 @@
 #include <sstream>
 #include <string>
 
+#include "core/base/atomic_file.h"
 #include "core/base/json_reader.h"
 #include "core/io/image_io.h"
 #include "core/geometry/triangulation.h"
+#include "core/mesh/glb_io.h"
 #include "core/sfm/model_io.h"
+#include "core/sfm/tag_layout.h"
 #include "core/sfm/tag_observations.h"
+#include "tests/support/design_scene.h"
 #include "tests/support/ground_truth.h"
 #include "tests/support/run_command.h"
 
@@ -163,7 +167,8 @@ TEST(MeasureRoom, TheSigmaCoversTheTagsThatDidNotSetTheScale) {
 // Tap-to-measure in the view: 16 of the room's photos round tag 4, reconstructed whole (mesh and
 // dense points); the view of one photo with --measure on tag 4's bottom edge (its corners as
 // detected) draws the line and its label into the PNG and gives 0.127 m within 2σ in the JSON.
-TEST(MeasureRoom, TheViewMeasuresATagEdgeByItsPixels) {
+// Then a design registered to the project by `reconar compare` is drawn over the same frame.
+TEST(MeasureRoom, TheViewMeasuresATagEdgeAndShowsTheDesign) {
   const std::string data = testing::SharedDataPath("apriltag_swatbotics_mapping");
   const fs::path root = fs::temp_directory_path() / ("reconar_measure_view_" + std::to_string(::getpid()));
   fs::remove_all(root);
@@ -178,13 +183,14 @@ TEST(MeasureRoom, TheViewMeasuresATagEdgeByItsPixels) {
 
   auto detections = ReadTagDetections(project + "/tags/detections.txt");
   ASSERT_TRUE(detections.ok()) << detections.status().ToString();
-  Eigen::Vector2d a = Eigen::Vector2d::Zero(), b = Eigen::Vector2d::Zero();
+  Eigen::Vector2d a = Eigen::Vector2d::Zero(), b = Eigen::Vector2d::Zero(), centre = Eigen::Vector2d::Zero();
   for (const ImageTagObservations& image : detections->images) {
     if (image.image_name != "IMG_1415.JPG") continue;
     for (const TagObservation& tag : image.tags) {
       if (tag.tag_id != 4) continue;
       a = tag.corners[0];
       b = tag.corners[1];
+      for (const Eigen::Vector2d& corner : tag.corners) centre += corner / 4.0;
     }
   }
   ASSERT_GT((b - a).norm(), 10.0) << "tag 4 in IMG_1415.JPG";
@@ -223,6 +229,60 @@ TEST(MeasureRoom, TheViewMeasuresATagEdgeByItsPixels) {
                                     (root / "out").string() + " --measure 1,2,3", testing::StderrMode::kSeparate);
   EXPECT_EQ(bad.exit_code, 2) << bad.error;
   EXPECT_NE(bad.error.find("expected \"X1,Y1 X2,Y2\""), std::string::npos) << bad.error;
+
+  // A design of the room's tags as plates standing 2.5 cm off the wall, in millimetres in a frame
+  // of its own, placed by the tags' centres (`reconar compare`), drawn by the view over the same
+  // frame: tag 4's middle turns toward the design's cyan, and nothing changes on the as-built layer.
+  auto layout = ReadTagLayout(project + "/tags.layout");
+  ASSERT_TRUE(layout.ok()) << layout.status().ToString();
+  const Eigen::Vector3d design_origin(10.0, 20.0, 0.0);
+  std::vector<NamedMesh> plates;
+  std::ostringstream control;
+  control.precision(12);
+  for (const LayoutTag& tag : layout->tags()) {
+    const double half = tag.size / 2;
+    Mesh plate = testing::BoxMesh({-half, -half, 0.02}, {half, half, 0.03});
+    for (Eigen::Vector3f& v : plate.positions) {
+      v = (1000.0 * (tag.layout_from_tag * v.cast<double>() + design_origin)).cast<float>();
+    }
+    plates.push_back({"plate_" + std::to_string(tag.id), plate});
+    const Eigen::Vector3d centre_mm = 1000.0 * (tag.layout_from_tag.translation + design_origin);
+    control << tag.id << " " << centre_mm.x() << " " << centre_mm.y() << " " << centre_mm.z() << "\n";
+  }
+  const std::string design = (root / "plates.glb").string(), control_path = (root / "plates.txt").string();
+  ASSERT_TRUE(WriteGlbScene(design, plates).ok());
+  ASSERT_TRUE(WriteFileAtomically(control_path, control.str()).ok());
+  const CommandRun not_yet = RunReconar("view --project " + project + " --frames " + frames + " --out " +
+                                            (root / "design").string() + " --design " + design,
+                                        testing::StderrMode::kSeparate);
+  EXPECT_NE(not_yet.exit_code, 0);
+  EXPECT_NE(not_yet.error.find("reconar compare"), std::string::npos) << not_yet.error;
+  const CommandRun compared = RunReconar("compare " + project + " " + design + " --control " + control_path);
+  ASSERT_EQ(compared.exit_code, 0) << compared.output;
+  EXPECT_NE(compared.output.find("units mm"), std::string::npos) << compared.output;
+  const auto tint = [&](const std::string& layer) {  // (G + B) / 2 - R about tag 4's middle
+    const fs::path out = root / layer;
+    const CommandRun drawn = RunReconar("view --project " + project + " --frames " + frames + " --out " + out.string() +
+                                            " --design " + design + " --layer " + layer,
+                                        testing::StderrMode::kSeparate);
+    EXPECT_EQ(drawn.exit_code, 0) << drawn.error;
+    auto picture = ReadImage((out / "IMG_1415.png").string());
+    if (!picture.ok()) return -1000.0;
+    double sum = 0.0;
+    int count = 0;
+    for (int dy = -3; dy <= 3; ++dy) {
+      for (int dx = -3; dx <= 3; ++dx) {
+        const uint8_t* p = picture->rgb.row(static_cast<int>(std::lround(centre.y())) + dy) +
+                           3 * (std::lround(centre.x()) + dx);
+        sum += 0.5 * (p[1] + p[2]) - p[0];
+        ++count;
+      }
+    }
+    return sum / count;
+  };
+  const double as_built = tint("as-built"), with_design = tint("design");
+  std::printf("tag 4's middle: (G + B) / 2 - R %.1f as built, %.1f with the design over it\n", as_built, with_design);
+  EXPECT_GT(with_design, as_built + 40.0);
   fs::remove_all(root);
 }
 
