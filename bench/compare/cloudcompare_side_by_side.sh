@@ -38,11 +38,14 @@ fi
 
 seconds() { /usr/bin/time -f "%e" "$@" 2>&1 > /dev/null | tail -1; }
 ours_whole=$(seconds "$build/bin/reconar" compare "$project" "$work/design.ply" --no-icp --max-distance "$max_distance")
-cc() { QT_QPA_PLATFORM=offscreen CloudCompare -SILENT -NO_TIMESTAMP -AUTO_SAVE OFF -O "$points" -O "$work/design.ply" \
-         -C2M_DIST "$@"; }
-cc_bounded=$(seconds cc -MAX_DIST "$max_distance" -MAX_TCOUNT 2 -LOG_FILE "$work/cc_bounded.log")
-cc_threads=$(seconds cc -MAX_TCOUNT 2 -LOG_FILE "$work/cc_threads.log")
-cc -MAX_DIST "$max_distance" -MAX_TCOUNT 2 -C_EXPORT_FMT ASC -PREC 9 -SAVE_CLOUDS FILE "$work/cc.asc" > /dev/null 2>&1
+export QT_QPA_PLATFORM=offscreen
+cc() { local log=$1; shift; CloudCompare -SILENT -LOG_FILE "$log" -NO_TIMESTAMP -AUTO_SAVE OFF -O "$points" -O "$work/design.ply" -C2M_DIST "$@"; }
+export -f cc
+export points work
+cc_bounded=$(seconds bash -c 'cc "$0" -MAX_DIST "$1" -MAX_TCOUNT 2' "$work/cc_bounded.log" "$max_distance")
+cc_threads=$(seconds bash -c 'cc "$0" -MAX_TCOUNT 2' "$work/cc_threads.log")
+cc "$work/cc_save.log" -MAX_DIST "$max_distance" -MAX_TCOUNT 2 -C_EXPORT_FMT ASC -PREC 9 -SAVE_CLOUDS FILE "$work/cc.asc" \
+  > /dev/null 2>&1
 
 echo "whole runs (s): reconar compare $ours_whole; CloudCompare -MAX_DIST (1 thread) $cc_bounded, unbounded (2 threads) $cc_threads"
 echo "CloudCompare's log, bounded:   $(grep -o 'Time: [0-9.]* s' "$work/cc_bounded.log" | tr '\n' ' ')"

@@ -179,13 +179,17 @@ Result<DeviationReport> ComputeDeviation(const Design& design, const Sim3& world
   const std::vector<uint32_t> order = SpatialOrder(as_built);
   constexpr size_t kChunkPoints = 4096;
   pool.ParallelFor(0, (as_built.size() + kChunkPoints - 1) / kChunkPoints, [&](size_t chunk, int) {
-    const size_t end = std::min(as_built.size(), (chunk + 1) * kChunkPoints);
-    int previous = -1;
-    for (size_t k = chunk * kChunkPoints; k < end; ++k) {
+    const size_t begin = chunk * kChunkPoints, end = std::min(as_built.size(), (chunk + 1) * kChunkPoints);
+    std::vector<Eigen::Vector3d> queries;
+    queries.reserve(end - begin);
+    for (size_t k = begin; k < end; ++k) queries.push_back(as_built[order[k]]);
+    std::vector<NearestSurfacePoint> answers(queries.size());
+    std::vector<int> candidates;
+    bvh.NearestBatch(queries.data(), queries.size(), options.max_distance, answers.data(), &candidates);
+    for (size_t k = begin; k < end; ++k) {
       const size_t i = order[k];
-      const NearestSurfacePoint nearest = bvh.Nearest(as_built[i], options.max_distance, previous);
+      const NearestSurfacePoint& nearest = answers[k - begin];
       if (nearest.triangle < 0) continue;
-      previous = nearest.triangle;
       const Eigen::Vector3d& normal = surface.face_normals[static_cast<size_t>(nearest.triangle)];
       if (!as_built_normals.empty() && as_built_normals[i].norm() > 0.0 &&
           as_built_normals[i].normalized().dot(normal) < min_cos) {

@@ -15,6 +15,10 @@ struct StepSums {
   Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> right = Eigen::Matrix<double, 6, 1>::Zero();
   std::vector<double> residuals;  // magnitudes
+  // Scratch of the nearest-point queries.
+  std::vector<Eigen::Vector3d> moved;
+  std::vector<NearestSurfacePoint> nearest;
+  std::vector<int> candidates;
 };
 
 constexpr size_t kChunkPoints = 4096;
@@ -44,13 +48,15 @@ PointToPlaneReport AlignPointsToSurface(const std::vector<Eigen::Vector3d>& poin
       sums.normal_matrix.setZero();
       sums.right.setZero();
       sums.residuals.clear();
-      const size_t end = std::min(points.size(), (chunk + 1) * kChunkPoints);
-      int previous = -1;
-      for (size_t i = chunk * kChunkPoints; i < end; ++i) {
-        const Eigen::Vector3d q = report.surface_from_points * points[i];
-        const NearestSurfacePoint nearest = surface.Nearest(q, bound, previous);
+      const size_t begin = chunk * kChunkPoints, end = std::min(points.size(), (chunk + 1) * kChunkPoints);
+      sums.moved.clear();
+      for (size_t i = begin; i < end; ++i) sums.moved.push_back(report.surface_from_points * points[i]);
+      sums.nearest.resize(sums.moved.size());
+      surface.NearestBatch(sums.moved.data(), sums.moved.size(), bound, sums.nearest.data(), &sums.candidates);
+      for (size_t i = begin; i < end; ++i) {
+        const Eigen::Vector3d& q = sums.moved[i - begin];
+        const NearestSurfacePoint& nearest = sums.nearest[i - begin];
         if (nearest.triangle < 0) continue;
-        previous = nearest.triangle;
         const Eigen::Vector3d& n = face_normals[static_cast<size_t>(nearest.triangle)];
         const double r = n.dot(q - nearest.point);
         sums.residuals.push_back(std::abs(r));

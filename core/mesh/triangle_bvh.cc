@@ -135,32 +135,37 @@ Eigen::Vector3d ClosestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3
 
 }  // namespace
 
-NearestSurfacePoint TriangleBvh::Nearest(const Eigen::Vector3d& query, double max_distance, int hint) const {
-  NearestSurfacePoint nearest;
-  if (nodes_.empty()) return nearest;
-  double best2 = max_distance < 1e150 ? max_distance * max_distance : INFINITY;
-  const Eigen::Vector3f query_f = query.cast<float>();
-  // Single-precision box distances may come out a little long: pruned only beyond a margin.
-  float prune2 = static_cast<float>(best2 * (1.0 + 1e-5) + 1e-12);
-  const auto try_triangle = [&](int k) {
-    // The triangle's box bounds its distance from below: most triangles of a leaf end there.
-    const std::array<Eigen::Vector3f, 2>& box = boxes_[static_cast<size_t>(k)];
-    if (!(BoxDistanceSquared(box[0], box[1], query_f) <= prune2)) return;
-    const std::array<Eigen::Vector3f, 3>& c = corners_[static_cast<size_t>(k)];
-    bool interior = false;
-    const Eigen::Vector3d point =
-        ClosestOnTriangle(query, c[0].cast<double>(), c[1].cast<double>(), c[2].cast<double>(), &interior);
-    const double d2 = (point - query).squaredNorm();
-    if (d2 <= best2) {
-      best2 = d2;
-      prune2 = static_cast<float>(best2 * (1.0 + 1e-5) + 1e-12);
-      nearest = {order_[static_cast<size_t>(k)], std::sqrt(d2), point, interior};
-    }
-  };
+void TriangleBvh::TryTriangle(int k, const Eigen::Vector3d& query, const Eigen::Vector3f& query_f,
+                              NearestSearch* search) const {
+  // The triangle's box bounds its distance from below: most triangles of a leaf end there.
+  const std::array<Eigen::Vector3f, 2>& box = boxes_[static_cast<size_t>(k)];
+  if (!(BoxDistanceSquared(box[0], box[1], query_f) <= search->prune2)) return;
+  const std::array<Eigen::Vector3f, 3>& c = corners_[static_cast<size_t>(k)];
+  bool interior = false;
+  const Eigen::Vector3d point =
+      ClosestOnTriangle(query, c[0].cast<double>(), c[1].cast<double>(), c[2].cast<double>(), &interior);
+  const double d2 = (point - query).squaredNorm();
+  if (d2 <= search->best2) {
+    search->SetBest(d2);
+    search->nearest = {order_[static_cast<size_t>(k)], std::sqrt(d2), point, interior};
+  }
+}
+
+TriangleBvh::NearestSearch TriangleBvh::StartSearch(const Eigen::Vector3d& query, double max_distance,
+                                                    int hint) const {
+  NearestSearch search;
+  search.SetBest(max_distance < 1e150 ? max_distance * max_distance : INFINITY);
   // A usable triangle near the query (the previous query's, for points in order) bounds the search.
   if (hint >= 0 && static_cast<size_t>(hint) < position_of_.size() && position_of_[static_cast<size_t>(hint)] >= 0) {
-    try_triangle(position_of_[static_cast<size_t>(hint)]);
+    TryTriangle(position_of_[static_cast<size_t>(hint)], query, query.cast<float>(), &search);
   }
+  return search;
+}
+
+NearestSurfacePoint TriangleBvh::Nearest(const Eigen::Vector3d& query, double max_distance, int hint) const {
+  if (nodes_.empty()) return NearestSurfacePoint();
+  NearestSearch search = StartSearch(query, max_distance, hint);
+  const Eigen::Vector3f query_f = query.cast<float>();
   struct Entry {
     int node;
     float distance2;  // from the query to the node's box
@@ -170,10 +175,10 @@ NearestSurfacePoint TriangleBvh::Nearest(const Eigen::Vector3d& query, double ma
   stack[top++] = {0, BoxDistanceSquared(nodes_[0].box_min, nodes_[0].box_max, query_f)};
   while (top > 0) {
     const Entry entry = stack[--top];
-    if (!(entry.distance2 <= prune2)) continue;
+    if (!(entry.distance2 <= search.prune2)) continue;
     const Node& node = nodes_[static_cast<size_t>(entry.node)];
     if (node.count > 0) {
-      for (int k = node.first; k < node.first + node.count; ++k) try_triangle(k);
+      for (int k = node.first; k < node.first + node.count; ++k) TryTriangle(k, query, query_f, &search);
       continue;
     }
     if (top + 2 > static_cast<int>(sizeof(stack) / sizeof(stack[0]))) continue;
@@ -184,14 +189,85 @@ NearestSurfacePoint TriangleBvh::Nearest(const Eigen::Vector3d& query, double ma
     const float to_b = BoxDistanceSquared(b.box_min, b.box_max, query_f);
     // The nearer child is searched first: pushed last.
     if (to_a <= to_b) {
-      if (to_b <= prune2) stack[top++] = {second, to_b};
-      if (to_a <= prune2) stack[top++] = {first, to_a};
+      if (to_b <= search.prune2) stack[top++] = {second, to_b};
+      if (to_a <= search.prune2) stack[top++] = {first, to_a};
     } else {
-      if (to_a <= prune2) stack[top++] = {first, to_a};
-      if (to_b <= prune2) stack[top++] = {second, to_b};
+      if (to_a <= search.prune2) stack[top++] = {first, to_a};
+      if (to_b <= search.prune2) stack[top++] = {second, to_b};
     }
   }
-  return nearest;
+  return search.nearest;
+}
+
+void TriangleBvh::NearestBatch(const Eigen::Vector3d* queries, size_t count, double max_distance,
+                               NearestSurfacePoint* nearest, std::vector<int>* candidates) const {
+  constexpr size_t kGroup = 16;
+  int hint = -1;
+  std::array<NearestSearch, kGroup> searches;
+  for (size_t begin = 0; begin < count; begin += kGroup) {
+    const size_t end = std::min(count, begin + kGroup);
+    // The group's first query searched alone: its triangle bounds the others' distances, and every
+    // triangle that can beat those bounds lies within the largest of them of the group's box.
+    nearest[begin] = Nearest(queries[begin], max_distance, hint);
+    if (nearest[begin].triangle >= 0) hint = nearest[begin].triangle;
+    Eigen::Vector3f group_min = Eigen::Vector3f::Constant(INFINITY), group_max = -group_min;
+    double reach2 = 0.0;
+    for (size_t i = begin + 1; i < end; ++i) {
+      searches[i - begin] = StartSearch(queries[i], max_distance, hint);
+      reach2 = std::max(reach2, searches[i - begin].best2);
+      const Eigen::Vector3f query_f = queries[i].cast<float>();
+      group_min = group_min.cwiseMin(query_f);
+      group_max = group_max.cwiseMax(query_f);
+    }
+    if (end - begin < 2) continue;
+    if (!(reach2 < INFINITY) || !group_min.allFinite() || !group_max.allFinite()) {
+      for (size_t i = begin + 1; i < end; ++i) nearest[i] = Nearest(queries[i], max_distance, hint);
+      continue;
+    }
+    const float reach2_f = static_cast<float>(reach2 * (1.0 + 1e-5) + 1e-12);
+    const auto box_to_group = [&](const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max) {
+      return (box_min - group_max).cwiseMax(group_min - box_max).cwiseMax(0.0f).squaredNorm();
+    };
+    // A group spread wide (or far from the surface) has too many candidates to share: its queries
+    // are searched one by one.
+    constexpr size_t kMaxCandidates = 32;
+    candidates->clear();
+    int stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    bool shared = true;
+    while (top > 0 && shared) {
+      const Node& node = nodes_[static_cast<size_t>(stack[--top])];
+      if (!(box_to_group(node.box_min, node.box_max) <= reach2_f)) continue;
+      if (node.count > 0) {
+        for (int k = node.first; k < node.first + node.count; ++k) {
+          const std::array<Eigen::Vector3f, 2>& box = boxes_[static_cast<size_t>(k)];
+          if (box_to_group(box[0], box[1]) <= reach2_f) candidates->push_back(k);
+        }
+        shared = candidates->size() <= kMaxCandidates;
+        continue;
+      }
+      if (top + 2 > static_cast<int>(sizeof(stack) / sizeof(stack[0]))) {
+        shared = false;
+        continue;
+      }
+      stack[top++] = node.first;
+      stack[top++] = static_cast<int>(&node - nodes_.data()) + 1;
+    }
+    if (!shared) {
+      for (size_t i = begin + 1; i < end; ++i) {
+        nearest[i] = Nearest(queries[i], max_distance, hint);
+        if (nearest[i].triangle >= 0) hint = nearest[i].triangle;
+      }
+      continue;
+    }
+    for (size_t i = begin + 1; i < end; ++i) {
+      NearestSearch& search = searches[i - begin];
+      const Eigen::Vector3f query_f = queries[i].cast<float>();
+      for (const int k : *candidates) TryTriangle(k, queries[i], query_f, &search);
+      nearest[i] = search.nearest;
+    }
+  }
 }
 
 RayHit TriangleBvh::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double min_distance,

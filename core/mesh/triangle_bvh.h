@@ -9,6 +9,7 @@
 // the surface to a point is found depth first, nearer box first, pruned by the best so far
 // (closest point on a triangle after Ericson, Real-Time Collision Detection, 5.1.5).
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -46,6 +47,12 @@ class TriangleBvh {
   // first so that its distance prunes the search; any value is safe.
   NearestSurfacePoint Nearest(const Eigen::Vector3d& query, double max_distance = 1e300, int hint = -1) const;
 
+  // Nearest for each of `count` queries, the same distances (an exact tie may name another
+  // triangle); faster for queries near one another (in spatial order): the tree is searched once
+  // for each group of them. `candidates` is scratch.
+  void NearestBatch(const Eigen::Vector3d* queries, size_t count, double max_distance, NearestSurfacePoint* nearest,
+                    std::vector<int>* candidates) const;
+
   int num_triangles() const { return static_cast<int>(order_.size()); }  // the usable ones
 
  private:
@@ -55,6 +62,20 @@ class TriangleBvh {
     int count = 0;  // leaf: its triangles; inner: 0
   };
   int Build(int begin, int end, std::vector<Eigen::Vector3f>* centroids);
+
+  struct NearestSearch {
+    double best2 = INFINITY;
+    // best2 in single precision, a little longer: box distances come out a little long.
+    float prune2 = INFINITY;
+    NearestSurfacePoint nearest;
+    void SetBest(double d2) {
+      best2 = d2;
+      prune2 = static_cast<float>(d2 * (1.0 + 1e-5) + 1e-12);
+    }
+  };
+  NearestSearch StartSearch(const Eigen::Vector3d& query, double max_distance, int hint) const;
+  // Triangle at position k of order_ against the search's best.
+  void TryTriangle(int k, const Eigen::Vector3d& query, const Eigen::Vector3f& query_f, NearestSearch* search) const;
 
   std::vector<int> order_;  // the usable triangles (indices in range, finite corners) in leaf order
   // Per position in order_ (per mesh triangle while building): the corners, and their min and max.

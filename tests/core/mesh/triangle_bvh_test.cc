@@ -117,6 +117,39 @@ TEST(TriangleBvhTest, FindsTheNearestSurfacePointAsTestingEveryTriangleDoes) {
   }
 }
 
+// The batch gives each query the distance Nearest gives it, for queries clustered (the groups
+// share their candidates), scattered (they search one by one) and bounded.
+TEST(TriangleBvhTest, NearestBatchAgreesWithNearest) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  Mesh mesh;
+  for (int t = 0; t < 3000; ++t) {
+    const Eigen::Vector3d centre(coordinate(random), coordinate(random), 0.2 * coordinate(random));
+    for (int k = 0; k < 3; ++k) {
+      mesh.positions.push_back(
+          (centre + 0.05 * Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random))).cast<float>());
+    }
+    mesh.triangles.push_back({uint32_t(3 * t), uint32_t(3 * t + 1), uint32_t(3 * t + 2)});
+  }
+  const TriangleBvh bvh(mesh);
+  std::vector<Eigen::Vector3d> queries;
+  for (int cluster = 0; cluster < 40; ++cluster) {
+    const Eigen::Vector3d centre(coordinate(random), coordinate(random), 0.3 * coordinate(random));
+    for (int k = 0; k < 20; ++k) queries.push_back(centre + 0.01 * Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random)));
+  }
+  for (int k = 0; k < 300; ++k) queries.push_back(1.5 * Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random)));
+  std::vector<int> candidates;
+  for (const double bound : {1e300, 0.05}) {
+    std::vector<NearestSurfacePoint> batch(queries.size());
+    bvh.NearestBatch(queries.data(), queries.size(), bound, batch.data(), &candidates);
+    for (size_t q = 0; q < queries.size(); ++q) {
+      const NearestSurfacePoint alone = bvh.Nearest(queries[q], bound);
+      ASSERT_EQ(batch[q].triangle >= 0, alone.triangle >= 0) << "query " << q << " bound " << bound;
+      if (alone.triangle >= 0) EXPECT_EQ(batch[q].distance, alone.distance) << "query " << q << " bound " << bound;
+    }
+  }
+}
+
 TEST(TriangleBvhTest, NearestSkipsUnusableTrianglesEvenAsHints) {
   Mesh mesh;
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {NAN, 0, 0}, {0, 0, 5}, {1, 0, 5}, {0, 1, 5}};
