@@ -65,6 +65,7 @@ int RunCompare(int argc, char** argv, int first) {
   options.deviation.num_threads = *threads;
   Result<CompareReport> report = CompareWithDesign(Project(args.positionals()[0]), args.positionals()[1], options);
   if (!report.ok()) return Fail(report.status());
+  for (const std::string& warning : report->warnings) std::fprintf(stderr, "reconar compare: warning: %s\n", warning.c_str());
   if (args.Has("json")) {
     std::fputs(CompareReportJson(*report, options).c_str(), stdout);
     return 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include <Eigen/Geometry>
 #include <filesystem>
@@ -129,6 +130,25 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
   RECONAR_ASSIGN_OR_RETURN(report.deviation,
                            ComputeDeviation(design, report.registration.world_from_design, metric_points, normals,
                                             views.ok() ? &*views : nullptr, options.deviation));
+  // A design placed where the model is not: nothing to compare, and a report would only say
+  // "missing" everywhere.
+  const long on_design = std::count_if(report.deviation.element_of_point.begin(),
+                                       report.deviation.element_of_point.end(), [](int e) { return e >= 0; });
+  if (on_design == 0) {
+    return FailedPrecondition("the design " + design_path + " does not overlap the model: no as-built point of " +
+                              source + " lies within " + std::to_string(options.deviation.max_distance) +
+                              " m of it" + (control.empty() ? " (no --control: the design is taken as drawn in the "
+                                                              "world frame)"
+                                                            : "; check the control file " + options.control_path));
+  }
+  if (on_design < static_cast<long>(points.size() / 100)) {
+    char warning[200];
+    std::snprintf(warning, sizeof(warning),
+                  "only %.2f %% of the as-built points lie within %.3g m of the design: is it placed right?",
+                  100.0 * static_cast<double>(on_design) / static_cast<double>(points.size()),
+                  options.deviation.max_distance);
+    report.warnings.push_back(warning);
+  }
   // Back to the world frame: world_from_design = world_from_metric * metric_from_design.
   Sim3& world_from_design = report.registration.world_from_design;
   world_from_design.scale *= report.world_units_per_metre;
@@ -234,6 +254,9 @@ std::string CompareReportJson(const CompareReport& report, const CompareOptions&
     json.Key("verdict").String(e.verdict);
     json.EndObject();
   }
+  json.EndArray();
+  json.Key("warnings").BeginArray();
+  for (const std::string& warning : report.warnings) json.String(warning);
   json.EndArray();
   json.Key("seconds").Double(report.seconds);
   json.EndObject();

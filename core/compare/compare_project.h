@@ -4,6 +4,7 @@
 // element, and written to PROJECT/compare/: report.json, deviation.ply (the as-built points
 // coloured by their signed deviation), design_registered.glb (the design in the world frame).
 #include <string>
+#include <vector>
 
 #include "core/base/status.h"
 #include "core/compare/design_registration.h"
@@ -31,12 +32,14 @@ struct CompareReport {
   bool units_assumed = false;
   DesignRegistration registration;  // world_from_design in the world frame; lengths in metres
   DeviationReport deviation;
+  std::vector<std::string> warnings;  // e.g. a design that barely overlaps the model
   std::string out_dir;
   double seconds = 0.0;
 };
 
 // Errors name the file: a design or control file that does not read, a control tag the project
-// did not reconstruct, a project without dense points or mesh. Outputs are written atomically.
+// did not reconstruct, a project without dense points, mesh or sparse model, a design that no
+// as-built point lies near (FailedPrecondition, nothing written). Outputs are written atomically.
 Result<CompareReport> CompareWithDesign(const Project& project, const std::string& design_path,
                                         const CompareOptions& options);
 
@@ -46,7 +49,8 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
 // "control_rms_m", "control_residuals_m", "refined", "icp_rms_m", "points_used", "overlap",
 // "icp_iterations", "icp_turn_deg", "icp_shift_m", "free_directions"}, "density_per_m2",
 // "elements": [{"name", "points", "area_m2", "seen_area_m2", "mean_m", "rms_m", "p95_m",
-// "within_tolerance", "shift_m": [3], "turn_deg", "largest_move_m", "verdict"}], "seconds"}.
+// "within_tolerance", "shift_m": [3], "turn_deg", "largest_move_m", "verdict"}], "warnings": [...],
+// "seconds"}.
 std::string CompareReportJson(const CompareReport& report, const CompareOptions& options);
 
 }  // namespace reconar

@@ -31,6 +31,17 @@ Result<Design> ReadDesign(const std::string& path) {
                                        [](const NamedMesh& element) { return element.mesh.triangles.empty(); }),
                         design.elements.end());
   if (design.elements.empty()) return FileError(StatusCode::kCorruptData, path, "no element of the design has a triangle");
+  for (const NamedMesh& element : design.elements) {
+    for (const std::array<uint32_t, 3>& triangle : element.mesh.triangles) {
+      for (const uint32_t v : triangle) {
+        if (v >= element.mesh.positions.size() || !element.mesh.positions[v].allFinite()) {
+          return FileError(StatusCode::kCorruptData, path,
+                           "element '" + element.name + "': vertex " + std::to_string(v) +
+                               (v >= element.mesh.positions.size() ? " does not exist" : " is not a finite point"));
+        }
+      }
+    }
+  }
   return design;
 }
 

@@ -25,7 +25,7 @@ struct Design {
 };
 
 // kInvalidArgument for a file of another kind; the readers' errors (naming the file) otherwise;
-// kCorruptData when no element has a triangle.
+// kCorruptData when no element has a triangle or a triangle's vertex is missing or not finite.
 Result<Design> ReadDesign(const std::string& path);
 
 struct ControlTag {

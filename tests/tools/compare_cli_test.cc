@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "core/base/json_reader.h"
@@ -165,6 +166,44 @@ TEST_F(CompareCliTest, BadInputIsNamed) {
   run = testing::RunReconar("compare " + project_ + " " + dir_ + "/broken.glb");
   EXPECT_NE(run.exit_code, 0);
   EXPECT_NE(run.output.find("broken.glb"), std::string::npos) << run.output;
+
+  // A design with a vertex that is not a number: the OBJ reader refuses the number, a PLY's reads
+  // as NaN and the design refuses the vertex.
+  std::ofstream(dir_ + "/nan.obj") << "g slab\nv 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n";
+  run = testing::RunReconar("compare " + project_ + " " + dir_ + "/nan.obj");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.output.find("nan.obj: OBJ line 4"), std::string::npos) << run.output;
+  std::ofstream(dir_ + "/nan.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                      "end_header\n0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n";
+  run = testing::RunReconar("compare " + project_ + " " + dir_ + "/nan.ply");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.output.find("nan.ply"), std::string::npos) << run.output;
+
+  // A design in no unit: the control's scale is 2.5 mm per design unit.
+  {
+    std::ifstream control_in(dir_ + "/control.txt");
+    std::ofstream control_out(dir_ + "/odd_unit.txt");
+    for (std::string line; std::getline(control_in, line);) {
+      std::istringstream fields(line);
+      std::string word;
+      fields >> word;
+      control_out << word;
+      for (double value; fields >> value;) control_out << " " << value / 2.5;
+      control_out << "\n";
+    }
+  }
+  run = testing::RunReconar("compare " + project_ + " " + dir_ + "/design.glb --control " + dir_ + "/odd_unit.txt");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.output.find("no metre, centimetre, millimetre, inch or foot"), std::string::npos) << run.output;
+
+  // A design far from the model: no as-built point near it.
+  Mesh far_away = testing::BoxMesh({100, 100, 0}, {101, 101, 1});
+  ASSERT_TRUE(WriteGlbScene(dir_ + "/far.glb", {{"far", far_away}}).ok());
+  run = testing::RunReconar("compare " + project_ + " " + dir_ + "/far.glb");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.output.find("does not overlap the model"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(project_ + "/compare/report.json"));
 
   std::filesystem::remove(project_ + "/dense/points.ply");
   run = testing::RunReconar("compare " + project_ + " " + dir_ + "/design.glb");
