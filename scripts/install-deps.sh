@@ -25,7 +25,7 @@ host_packages=(build-essential clang lld cmake ninja-build pkg-config
   libgtest-dev libbenchmark-dev
   libapriltag-dev libcamera-dev libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   libgbm-dev libdrm-dev libx11-dev
-  poppler-utils librsvg2-bin xvfb xauth)
+  poppler-utils librsvg2-bin xvfb xauth libifcplusplus-dev)
 cross_packages=(g++-aarch64-linux-gnu qemu-user libstdc++6:arm64 libgcc-s1:arm64
   libjpeg62-turbo-dev:arm64 libpng-dev:arm64 libgtest-dev:arm64 libsuitesparse-dev:arm64
   libapriltag3:arm64 libcamera-dev:arm64 libegl-dev:arm64 libgles-dev:arm64 libgbm-dev:arm64
