@@ -14,6 +14,7 @@
 #include "core/compare/design.h"
 #include "core/compare/design_registration.h"
 #include "core/compare/deviation.h"
+#include "core/math/rigid3.h"
 #include "core/sfm/reconstruction.h"
 #include "tests/support/design_scene.h"
 
@@ -193,19 +194,13 @@ TEST(CompareTest, TheIcpMayNotLeaveTheControl) {
   EXPECT_NEAR(registration->world_from_design.translation.x(), 0.05, 0.002);
 }
 
-// A camera at `centre` looking at `target`, its image y down toward -z of the world where it can.
+// A registered photo at `centre` looking at `target`, the world's z up.
 SfmImage LookingAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, const std::string& name) {
-  const Eigen::Vector3d forward = (target - centre).normalized();
-  const Eigen::Vector3d right = forward.cross(-Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d down = forward.cross(right);
   SfmImage image;
   image.name = name;
   image.camera_id = 0;
   image.registered = true;
-  image.cam_from_world.rotation.row(0) = right;
-  image.cam_from_world.rotation.row(1) = down;
-  image.cam_from_world.rotation.row(2) = forward;
-  image.cam_from_world.translation = -image.cam_from_world.rotation * centre;
+  image.cam_from_world = CamFromWorldLookingAt(centre, target, Eigen::Vector3d::UnitZ());
   return image;
 }
 
