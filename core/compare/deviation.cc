@@ -31,7 +31,7 @@ struct SurfaceSample {
 };
 
 constexpr int kCellPx = 8;
-constexpr size_t kMaxBufferPoints = 400000;  // as-built points projected per photo (evenly thinned)
+constexpr size_t kMaxBufferPoints = 150000;  // as-built points projected per photo (evenly thinned)
 constexpr int kSamplesPerElement = 256;
 
 void VoteFromViews(const Reconstruction& views, const std::vector<Eigen::Vector3d>& as_built, double margin,

@@ -26,7 +26,7 @@ struct DeviationOptions {
   // not see past it.
   double missing_fraction = 0.1;
   int min_points = 30;         // fewer: no fit of its own, no deviates verdict from statistics alone
-  int max_fit_points = 20000;  // an element's own fit uses at most this many of its points (evenly thinned)
+  int max_fit_points = 10000;  // an element's own fit uses at most this many of its points (evenly thinned)
   int num_threads = 0;         // 0: one per core
 };
 
