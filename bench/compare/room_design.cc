@@ -9,6 +9,7 @@
 // OUT_DIR/room_control.txt` has to find the units and the frame itself.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <fstream>
 #include <string>
@@ -55,6 +56,8 @@ int Run(int argc, char** argv) {
     return 2;
   }
   const std::string project = argv[1], out = argv[2];
+  std::error_code made;
+  std::filesystem::create_directories(out, made);
   Result<TagLayout> layout = ReadTagLayout(project + "/tags.layout");
   if (!layout.ok()) {
     std::fprintf(stderr, "%s\n", layout.status().ToString().c_str());
@@ -131,8 +134,17 @@ int Run(int argc, char** argv) {
     const Mesh box = FacingBox(centre, along, vertical, normal, a_min, a_max, v_min, v_max, to_design_mm);
     std::string name = "wall";
     for (const LayoutTag* tag : wall.tags) name += "_" + std::to_string(tag->id);
-    std::printf("%s: %zu tags, normal (%.3f %.3f %.3f), %.2f x %.2f m\n", name.c_str(), wall.tags.size(), normal.x(),
-                normal.y(), normal.z(), a_max - a_min, v_max - v_min);
+    // The flatness the tags show: their corners' distances from the wall's (upright) plane.
+    double squares = 0.0, largest = 0.0;
+    for (const Eigen::Vector3d& c : corners) {
+      const double off = (c - centre).dot(normal);
+      squares += off * off;
+      largest = std::max(largest, std::abs(off));
+    }
+    std::printf("%s: %zu tags, normal (%.3f %.3f %.3f), %.2f x %.2f m; tag corners off its plane: RMS %.1f mm, "
+                "largest %.1f mm\n",
+                name.c_str(), wall.tags.size(), normal.x(), normal.y(), normal.z(), a_max - a_min, v_max - v_min,
+                1000.0 * std::sqrt(squares / static_cast<double>(corners.size())), 1000.0 * largest);
     elements.push_back({name, box});
   }
   // Floor and ceiling: slabs over the tags' extent in x and z, half a metre beyond it.
