@@ -377,7 +377,13 @@ class PlyBodyParser {
         double value = 0.0;
         const ReadOutcome outcome = reader_.Read(property.type, &value);
         if (outcome != ReadOutcome::kOk) return ValueError(outcome, "vertex " + std::to_string(i));
-        switch (roles_[p]) {
+        const VertexRole role = roles_[p];
+        const bool is_position = role == VertexRole::kX || role == VertexRole::kY || role == VertexRole::kZ;
+        // Also keeps the conversion to float defined; NaN fails the comparison.
+        if (is_position && !(std::abs(value) <= std::numeric_limits<float>::max())) {
+          return Error("vertex " + std::to_string(i) + ": " + property.name + " is not a finite float");
+        }
+        switch (role) {
           case VertexRole::kSkip: break;
           case VertexRole::kX: position.x() = static_cast<float>(value); break;
           case VertexRole::kY: position.y() = static_cast<float>(value); break;
@@ -464,6 +470,7 @@ class PlyBodyParser {
   }
 
   Status SkipElement(const PlyElement& element) {
+    if (element.properties.empty()) return Status::Ok();  // rows of no bytes, however many
     for (int64_t i = 0; i < element.count; ++i) {
       const std::string where = element.name + " " + std::to_string(i);
       for (const PlyProperty& property : element.properties) {

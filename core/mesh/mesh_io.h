@@ -10,8 +10,9 @@
 //   fewer than three corners are skipped. Other face properties are skipped.
 // - every other element (edge, range_grid, material, ...) is skipped.
 // Errors: kNotFound for a missing file; kCorruptData naming the file and the place for a bad header,
-// a truncated body, a malformed number or a vertex index out of range; kUnsupported for valid PLY
-// we do not read (a colour property of another integer type, a list-typed x).
+// a truncated body, a malformed number, a position that is not a finite float or a vertex index out
+// of range; kUnsupported for valid PLY we do not read (a colour property of another integer type, a
+// list-typed x).
 //
 // WritePly writes x y z (float), nx ny nz (float) when the mesh has normals, red green blue alpha
 // (uchar) when it has colours, and "face" with "list uchar int vertex_indices" when it has

@@ -72,7 +72,8 @@ bool ParseFloat(std::string_view text, float* value) {
   const char* last = text.data() + text.size();
   if (last - first > 1 && *first == '+' && first[1] != '-') ++first;  // from_chars takes no '+'
   const auto result = std::from_chars(first, last, *value);  // as float, so shortest float text is exact
-  return result.ec == std::errc() && result.ptr == last;
+  // from_chars also reads "nan" and "inf", which are no coordinates.
+  return result.ec == std::errc() && result.ptr == last && std::isfinite(*value);
 }
 
 bool ParseInt(std::string_view text, int64_t* value) {

@@ -19,8 +19,8 @@
 // names one and there are as many "vn" as "v" lines (point clouds); when some vertex would get two
 // different normals or none, the mesh is returned without normals. Colours are kept when every
 // vertex has them (alpha 255). Errors: kNotFound for a missing file; kCorruptData naming the file
-// and line for a malformed number, a bad corner or an index out of range, and for a file without
-// any vertex.
+// and line for a malformed number (nan and inf among them), a bad corner or an index out of range,
+// and for a file without any vertex.
 //
 // ReadObjGroups reads the same, and splits the triangles by the group their face was in ("g NAME"
 // or "o NAME", the latest of either; faces before any are the group "default"): one NamedMesh per

@@ -2,6 +2,7 @@
 // requires, hand-made files in the other forms common .glb files use, and damaged or unsupported
 // inputs (a Status naming the file, never a crash).
 #include "core/mesh/glb_io.h"
+#include "tests/support/base64.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -17,6 +18,8 @@
 
 namespace reconar {
 namespace {
+
+using testing::DataUri;
 
 uint32_t Load32(const std::string& bytes, size_t offset) {
   uint32_t value = 0;
@@ -444,22 +447,6 @@ TEST(GlbTest, SceneWriterRejectsBadElements) {
   EXPECT_EQ(status.code(), StatusCode::kIoError);
 }
 
-std::string Base64(const std::string& bytes) {
-  static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string text;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    uint32_t group = static_cast<uint32_t>(static_cast<uint8_t>(bytes[i])) << 16;
-    if (i + 1 < bytes.size()) group |= static_cast<uint32_t>(static_cast<uint8_t>(bytes[i + 1])) << 8;
-    if (i + 2 < bytes.size()) group |= static_cast<uint8_t>(bytes[i + 2]);
-    text += kAlphabet[group >> 18];
-    text += kAlphabet[(group >> 12) & 63];
-    text += i + 1 < bytes.size() ? kAlphabet[(group >> 6) & 63] : '=';
-    text += i + 2 < bytes.size() ? kAlphabet[group & 63] : '=';
-  }
-  return text;
-}
-
-std::string DataUri(const std::string& bytes) { return "data:application/octet-stream;base64," + Base64(bytes); }
 
 std::string JsonNumbers(const double* values, int count) {
   std::string text;

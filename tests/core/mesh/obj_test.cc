@@ -149,6 +149,9 @@ TEST_F(ObjTest, DamagedFilesGiveStatusesNamingFileAndLine) {
       {"# only a comment\nvt 0 0\n", StatusCode::kCorruptData, "no vertex"},
       {"v 0 0\n", StatusCode::kCorruptData, "line 1: 'v' needs 3"},
       {"v 0 0 0\nv 1 x 0\n", StatusCode::kCorruptData, "line 2: malformed number 'x'"},
+      // Numbers from_chars reads but no coordinate is (found by design_fuzz).
+      {"v 0 0 0\nv 0 4 nan\nf 1 2 1\n", StatusCode::kCorruptData, "line 2: malformed number 'nan'"},
+      {"v 0 0 0\nvn 0 -inf 1\n", StatusCode::kCorruptData, "line 2: malformed number '-inf'"},
       {"v 0 0 0\nvn 0 0\n", StatusCode::kCorruptData, "line 2: 'vn' needs 3"},
       {"v 0 0 0\nf 1 1\n", StatusCode::kCorruptData, "at least 3 corners"},
       {"v 0 0 0\nv 1 0 0\nf 1 2 3\n", StatusCode::kCorruptData, "line 3: vertex index 3 out of range [1, 2]"},

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "core/base/atomic_file.h"
@@ -147,6 +148,18 @@ TEST_F(PlyTest, AsciiSkipsOtherElementsAndProperties) {
   EXPECT_EQ(read->triangles, expected);
 }
 
+// Found by design_fuzz: such an element's 2^32 - 1 empty rows took minutes to skip one by one.
+TEST_F(PlyTest, AnElementWithoutPropertiesIsSkippedAtOnce) {
+  const std::string text =
+      "ply\nformat ascii 1.0\nelement edge 4294967295\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "element material 9223372036854775807\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const Result<Mesh> read = ReadPly(Write("empty_rows.ply", text));
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  EXPECT_EQ(read->positions.size(), 3u);
+  EXPECT_EQ(read->triangles.size(), 1u);
+}
+
 TEST_F(PlyTest, OutOfRangeIndexNamesFileAndFace) {
   const std::string text =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
@@ -192,6 +205,38 @@ TEST_F(PlyTest, HugeDeclaredCountsFailBeforeAllocating) {
   ASSERT_FALSE(read.ok());
   EXPECT_EQ(read.status().code(), StatusCode::kCorruptData);
   EXPECT_NE(read.status().message().find("truncated"), std::string::npos) << read.status().message();
+}
+
+// Found by design_fuzz: NaN and infinity in binary or ascii, a double beyond float's range.
+TEST_F(PlyTest, PositionsThatAreNotFiniteFloatsNameFileAndVertex) {
+  const auto binary = [](float x_of_vertex_1) {
+    std::string text =
+        "ply\nformat binary_big_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n";
+    for (const float value : {0.0f, 0.0f, 0.0f, x_of_vertex_1, 0.0f, 0.0f}) text += BigEndian32(&value);
+    return text;
+  };
+  const std::string ascii_header =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty double y\nproperty float z\n"
+      "end_header\n";
+  const struct {
+    const char* name;
+    std::string text;
+    const char* message_part;
+  } cases[] = {
+      {"binary_nan", binary(std::numeric_limits<float>::quiet_NaN()), "vertex 1: x is not a finite float"},
+      {"binary_infinity", binary(-std::numeric_limits<float>::infinity()), "vertex 1: x is not a finite float"},
+      {"ascii_nan", ascii_header + "0 0 0\n1 2 nan\n", "vertex 1: z is not a finite float"},
+      {"ascii_beyond_float", ascii_header + "0 1e39 0\n1 2 3\n", "vertex 0: y is not a finite float"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = Write(std::string(c.name) + ".ply", c.text);
+    const Result<Mesh> read = ReadPly(path);
+    ASSERT_FALSE(read.ok()) << c.name;
+    EXPECT_EQ(read.status().code(), StatusCode::kCorruptData) << c.name;
+    EXPECT_NE(read.status().message().find(path), std::string::npos) << read.status().message();
+    EXPECT_NE(read.status().message().find(c.message_part), std::string::npos) << read.status().message();
+  }
 }
 
 TEST_F(PlyTest, BadHeadersAndValues) {

@@ -3,28 +3,28 @@
 //   localization_map_fuzz [--seconds S] [--seed N]    (S: CPU seconds of this process)
 //
 // Starts from valid map files (tests/core/sfm/sample_localization_map.h) and applies 1-4 random
-// mutations per iteration: bit flips, byte sets, special doubles, chunk deletions, duplications and
-// insertions, truncations, and extreme values written into count fields (the offsets where the
-// valid file holds one of the map's counts). In most iterations the header's payload size and CRC
-// are then repaired so that the structural parser behind the checksum sees the damage. Every result
-// must be an ok map whose invariants hold or an InvalidArgument naming the input; a crash or
-// sanitizer report is the failure this harness exists to find (run it in an ASan+UBSan build). Exit
-// status 1 when an accepted map breaks an invariant or a status is not InvalidArgument.
+// mutations per iteration (tests/support/byte_mutator.h): bit flips, byte sets, special doubles,
+// chunk deletions, duplications and insertions, truncations, and extreme values written into count
+// fields (the offsets where the valid file holds one of the map's counts). In most iterations the
+// header's payload size and CRC are then repaired so that the structural parser behind the
+// checksum sees the damage. Every result must be an ok map whose invariants hold or an
+// InvalidArgument naming the input; a crash or sanitizer report is the failure this harness exists
+// to find (run it in an ASan+UBSan build). Exit status 1 when an accepted map breaks an invariant
+// or a status is not InvalidArgument.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
-#include <limits>
 #include <map>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "core/base/atomic_file.h"
 #include "core/sfm/localization_map.h"
 #include "tests/core/sfm/sample_localization_map.h"
+#include "tests/support/byte_mutator.h"
 
 namespace reconar {
 namespace {
@@ -34,7 +34,7 @@ constexpr char kWhat[] = "fuzz.rmap";
 
 struct Seed {
   std::string bytes;
-  std::vector<size_t> count_offsets;  // where the file holds a uint32 equal to one of the map's counts
+  testing::MutationHints hints;  // its header, and where it holds a uint32 equal to one of the map's counts
 };
 
 Seed MakeSeed(const LocalizationMap& map, const std::string& path) {
@@ -51,6 +51,7 @@ Seed MakeSeed(const LocalizationMap& map, const std::string& path) {
   }
   std::remove(path.c_str());
   seed.bytes = std::move(bytes).value();
+  seed.hints.header_bytes = kHeaderBytes;
   std::vector<uint32_t> counts = {static_cast<uint32_t>(map.frame.size()), static_cast<uint32_t>(map.points.size()),
                                   static_cast<uint32_t>(map.keyframes.size()),
                                   static_cast<uint32_t>(map.vocabulary.num_nodes()),
@@ -64,131 +65,13 @@ Seed MakeSeed(const LocalizationMap& map, const std::string& path) {
     std::memcpy(&value, &seed.bytes[at], sizeof(value));
     for (const uint32_t count : counts) {
       if (value == count && count > 0) {
-        seed.count_offsets.push_back(at);
+        seed.hints.count_offsets.push_back(at);
         break;
       }
     }
   }
   return seed;
 }
-
-class Mutator {
- public:
-  explicit Mutator(uint64_t seed) : rng_(seed) {}
-
-  int Uniform(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
-  bool Chance(double p) { return std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < p; }
-
-  // A position, mostly in the payload.
-  size_t Position(const std::string& bytes) {
-    if (bytes.empty()) return 0;
-    if (bytes.size() > kHeaderBytes && !Chance(0.05)) {
-      return static_cast<size_t>(Uniform(static_cast<int>(kHeaderBytes), static_cast<int>(bytes.size()) - 1));
-    }
-    return static_cast<size_t>(Uniform(0, static_cast<int>(bytes.size()) - 1));
-  }
-
-  uint32_t InterestingCount(uint32_t original) {
-    switch (Uniform(0, 9)) {
-      case 0:
-        return 0;
-      case 1:
-        return 1;
-      case 2:
-        return original + 1;
-      case 3:
-        return original - 1;
-      case 4:
-        return 0xffffffffu;
-      case 5:
-        return 0x7fffffffu;
-      case 6:
-        return 0x80000000u;
-      case 7:
-        return original * 2;
-      case 8:
-        return static_cast<uint32_t>(Uniform(0, 1 << 16));
-      default:
-        return static_cast<uint32_t>(rng_());
-    }
-  }
-
-  // One mutation; returns its name.
-  const char* Mutate(const Seed& seed, std::string* bytes) {
-    const size_t size = bytes->size();
-    switch (Uniform(0, 8)) {
-      case 0: {
-        if (size == 0) return "none";
-        const size_t at = Position(*bytes);
-        (*bytes)[at] = static_cast<char>((*bytes)[at] ^ (1 << Uniform(0, 7)));
-        return "bit flip";
-      }
-      case 1: {
-        if (size == 0) return "none";
-        static constexpr uint8_t kValues[] = {0x00, 0xff, 0x7f, 0x80, 0x01, 0xfe};
-        const size_t at = Position(*bytes);
-        (*bytes)[at] = static_cast<char>(Chance(0.5) ? kValues[Uniform(0, 5)] : Uniform(0, 255));
-        return "byte set";
-      }
-      case 2: {
-        if (size < 8) return "none";
-        const double kDoubles[] = {std::numeric_limits<double>::quiet_NaN(),
-                                   std::numeric_limits<double>::infinity(),
-                                   -std::numeric_limits<double>::infinity(),
-                                   0.0,
-                                   -1.0,
-                                   1e308,
-                                   1e-310};
-        const size_t at = std::min(Position(*bytes), size - 8);
-        std::memcpy(&(*bytes)[at], &kDoubles[Uniform(0, 6)], sizeof(double));
-        return "special double";
-      }
-      case 3: {
-        if (size == 0) return "none";
-        const size_t at = Position(*bytes);
-        const size_t length = std::min(size - at, static_cast<size_t>(Chance(0.8) ? Uniform(1, 16) : Uniform(1, 512)));
-        bytes->erase(at, length);
-        return "chunk deletion";
-      }
-      case 4: {
-        if (size == 0) return "none";
-        const size_t from = Position(*bytes);
-        const size_t length = std::min(size - from, static_cast<size_t>(Uniform(1, 256)));
-        const std::string chunk = bytes->substr(from, length);
-        bytes->insert(Chance(0.5) ? from : Position(*bytes), chunk);
-        return "chunk duplication";
-      }
-      case 5: {
-        std::string chunk(static_cast<size_t>(Chance(0.8) ? Uniform(1, 16) : Uniform(1, 512)), '\0');
-        for (char& c : chunk) c = static_cast<char>(Uniform(0, 255));
-        bytes->insert(Position(*bytes), chunk);
-        return "chunk insertion";
-      }
-      case 6: {
-        if (size == 0) return "none";
-        bytes->resize(static_cast<size_t>(Uniform(0, static_cast<int>(size) - 1)));
-        return "truncation";
-      }
-      default: {
-        size_t at = 0;
-        if (!seed.count_offsets.empty() && Chance(0.8)) {
-          at = seed.count_offsets[static_cast<size_t>(Uniform(0, static_cast<int>(seed.count_offsets.size()) - 1))];
-        } else {
-          at = Position(*bytes);
-        }
-        if (at + 4 > size) return "none";
-        uint32_t value = 0;
-        std::memcpy(&value, &(*bytes)[at], sizeof(value));
-        value = InterestingCount(value);
-        std::memcpy(&(*bytes)[at], &value, sizeof(value));
-        return "count field";
-      }
-    }
-  }
-
- private:
-  std::mt19937_64 rng_;
-};
 
 // The promises of an accepted map (what localisation relies on without checking again).
 std::string BrokenInvariant(const LocalizationMap& map) {
@@ -265,7 +148,7 @@ int Run(double seconds, uint64_t seed_value) {
       return 1;
     }
   }
-  Mutator mutator(seed_value);
+  testing::ByteMutator mutator(seed_value);
   std::map<std::string, long> refusals;
   long iterations = 0;
   long accepted = 0;
@@ -279,7 +162,7 @@ int Run(double seconds, uint64_t seed_value) {
     const Seed& seed = seeds[static_cast<size_t>(mutator.Uniform(0, static_cast<int>(seeds.size()) - 1))];
     bytes = seed.bytes;
     const int num_mutations = mutator.Chance(0.6) ? 1 : mutator.Uniform(2, 4);
-    for (int i = 0; i < num_mutations; ++i) mutator.Mutate(seed, &bytes);
+    for (int i = 0; i < num_mutations; ++i) mutator.Mutate(seed.hints, &bytes);
     if (mutator.Chance(0.85)) {
       testing::RepairMapHeader(&bytes);
       ++repaired;
