@@ -177,16 +177,8 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
                            box.min() - 0.05 * width * Eigen::Vector3d::UnitZ(), width / 3.0 * Eigen::Vector3d::UnitX(),
                            width / 30.0 * Eigen::Vector3d::UnitY())};
   RECONAR_RETURN_IF_ERROR(WriteGlbScene(report.out_dir + "/deviation.glb", deviation_scene));
-  std::vector<NamedMesh> placed;
-  for (const NamedMesh& element : design.elements) {
-    NamedMesh moved{element.name, Mesh()};
-    for (const Eigen::Vector3f& p : element.mesh.positions) {
-      moved.mesh.positions.push_back(report.registration.world_from_design.Apply(p.cast<double>()).cast<float>());
-    }
-    moved.mesh.triangles = element.mesh.triangles;
-    ComputeVertexNormals(&moved.mesh);
-    placed.push_back(std::move(moved));
-  }
+  std::vector<NamedMesh> placed = PlacedElements(design, report.registration.world_from_design);
+  for (NamedMesh& element : placed) ComputeVertexNormals(&element.mesh);
   RECONAR_RETURN_IF_ERROR(WriteGlbScene(report.out_dir + "/design_registered.glb", placed));
   // The top view looks down the world's up: the tag board's y for a project registered by tags,
   // else the points' thinnest direction (the floor's normal for a room, a wall's for a facade).

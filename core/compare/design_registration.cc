@@ -45,18 +45,27 @@ double ControlRms(const std::vector<ControlPair>& control, const Sim3& world_fro
 
 }  // namespace
 
+std::vector<NamedMesh> PlacedElements(const Design& design, const Sim3& world_from_design) {
+  std::vector<NamedMesh> placed;
+  placed.reserve(design.elements.size());
+  for (const NamedMesh& element : design.elements) {
+    NamedMesh moved{element.name, Mesh()};
+    moved.mesh.positions.reserve(element.mesh.positions.size());
+    for (const Eigen::Vector3f& p : element.mesh.positions) {
+      moved.mesh.positions.push_back(world_from_design.Apply(p.cast<double>()).cast<float>());
+    }
+    moved.mesh.triangles = element.mesh.triangles;
+    placed.push_back(std::move(moved));
+  }
+  return placed;
+}
+
 DesignSurface PlaceDesign(const Design& design, const Sim3& world_from_design) {
   DesignSurface surface;
+  surface.mesh = JoinMeshes(PlacedElements(design, world_from_design));
   for (size_t e = 0; e < design.elements.size(); ++e) {
-    const Mesh& mesh = design.elements[e].mesh;
-    const uint32_t offset = static_cast<uint32_t>(surface.mesh.positions.size());
-    for (const Eigen::Vector3f& p : mesh.positions) {
-      surface.mesh.positions.push_back(world_from_design.Apply(p.cast<double>()).cast<float>());
-    }
-    for (const std::array<uint32_t, 3>& t : mesh.triangles) {
-      surface.mesh.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-      surface.element_of_triangle.push_back(static_cast<int>(e));
-    }
+    surface.element_of_triangle.insert(surface.element_of_triangle.end(), design.elements[e].mesh.triangles.size(),
+                                       static_cast<int>(e));
   }
   surface.face_normals.reserve(surface.mesh.triangles.size());
   for (const std::array<uint32_t, 3>& t : surface.mesh.triangles) {

@@ -57,6 +57,10 @@ Result<DesignRegistration> RegisterDesign(const Design& design, const std::vecto
                                           const std::vector<Eigen::Vector3d>& as_built,
                                           const DesignRegistrationOptions& options);
 
+// The design's elements in the world frame: each element's positions moved, its name and triangles
+// kept (no normals or colours).
+std::vector<NamedMesh> PlacedElements(const Design& design, const Sim3& world_from_design);
+
 // The design's elements joined into one mesh in the world frame, and the element of each triangle.
 struct DesignSurface {
   Mesh mesh;

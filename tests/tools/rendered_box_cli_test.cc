@@ -41,6 +41,7 @@
 #include "core/base/json_reader.h"
 #include "core/math/sim3.h"
 #include "core/mesh/glb_io.h"
+#include "core/mesh/mesh.h"
 #include "core/sfm/model_io.h"
 #include "tests/core/mvs/pmvs/textured_box_scene.h"
 #include "tests/tools/rendered_box.h"
@@ -202,12 +203,6 @@ Mesh Rectangle(const Eigen::Vector3d& centre, const Eigen::Vector3d& u, const Ei
   return mesh;
 }
 
-void Append(const Mesh& part, Mesh* mesh) {
-  const uint32_t offset = static_cast<uint32_t>(mesh->positions.size());
-  mesh->positions.insert(mesh->positions.end(), part.positions.begin(), part.positions.end());
-  for (const auto& t : part.triangles) mesh->triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-}
-
 TEST_F(RenderedBoxCli, CompareFindsEveryDesignChange) {
   const TexturedBoxScene& scene = *shared_->scene;
   const Reconstruction& model = *shared_->model;
@@ -222,13 +217,15 @@ TEST_F(RenderedBoxCli, CompareFindsEveryDesignChange) {
       {"side_north", Rectangle({0, 0.5, 0.3}, -0.5 * x, 0.3 * z)},
       {"side_south_turned", Rectangle({0, -0.5, 0.3}, turn * (0.5 * x), 0.3 * z)},  // built square
   };
-  Mesh pillar;  // never built: 0.4 x 0.4 x 0.5 m on open ground every camera looks at
+  // Never built: 0.4 x 0.4 x 0.5 m on open ground every camera looks at.
   const Eigen::Vector3d pillar_foot(1.4, -1.4, 0.0);
-  Append(Rectangle(pillar_foot + Eigen::Vector3d(0.2, 0, 0.25), 0.2 * y, 0.25 * z), &pillar);
-  Append(Rectangle(pillar_foot + Eigen::Vector3d(-0.2, 0, 0.25), -0.2 * y, 0.25 * z), &pillar);
-  Append(Rectangle(pillar_foot + Eigen::Vector3d(0, 0.2, 0.25), -0.2 * x, 0.25 * z), &pillar);
-  Append(Rectangle(pillar_foot + Eigen::Vector3d(0, -0.2, 0.25), 0.2 * x, 0.25 * z), &pillar);
-  Append(Rectangle(pillar_foot + Eigen::Vector3d(0, 0, 0.5), 0.2 * x, 0.2 * y), &pillar);
+  const Mesh pillar = JoinMeshes({
+      {"east", Rectangle(pillar_foot + Eigen::Vector3d(0.2, 0, 0.25), 0.2 * y, 0.25 * z)},
+      {"west", Rectangle(pillar_foot + Eigen::Vector3d(-0.2, 0, 0.25), -0.2 * y, 0.25 * z)},
+      {"north", Rectangle(pillar_foot + Eigen::Vector3d(0, 0.2, 0.25), -0.2 * x, 0.25 * z)},
+      {"south", Rectangle(pillar_foot + Eigen::Vector3d(0, -0.2, 0.25), 0.2 * x, 0.25 * z)},
+      {"top", Rectangle(pillar_foot + Eigen::Vector3d(0, 0, 0.5), 0.2 * x, 0.2 * y)},
+  });
   elements.push_back({"pillar_missing", pillar});
 
   // The design's own frame: 10 degrees and 1 m from the scene's.
