@@ -129,10 +129,7 @@ bool TagTracker::SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d*
     projected[k] = options_.intrinsics.Project(X);
     if (!projected[k].allFinite()) return false;
     if (in_view != nullptr) {
-      // Beyond the radius where the distortion polynomial turns back, a point far outside the
-      // field of view projects into the frame: the pixel must undistort to the point's direction.
-      const Eigen::Vector2d back = options_.intrinsics.Unproject(projected[k]);
-      *in_view = back.allFinite() && options_.intrinsics.fx * (back - X.head<2>() / X.z()).norm() < 0.5;
+      *in_view = (X.head<2>() / X.z()).squaredNorm() <= options_.intrinsics.Camera().FoldRadiusSquared();
       if (!*in_view) return false;
     }
   }

@@ -161,9 +161,9 @@ class TagTracker {
   // The search box of a tag at cam_from_tag: the box of its projected square (and of `last_corners`,
   // its last detected square, when not null) plus the margin, clipped to the frame. False when a
   // corner is not in front of the camera or the clipped box is too small to hold a tag. With
-  // in_view: also false when a corner's projection is folded back by the distortion (its pixel does
-  // not undistort to its direction), and *in_view tells whether the unclipped box lies in the
-  // frame grown by the margin.
+  // in_view: also false when a corner's projection is folded back by the distortion (it lies beyond
+  // the camera's RadialCamera::FoldRadiusSquared), and *in_view tells whether the unclipped box lies
+  // in the frame grown by the margin.
   bool SquareRegion(const Rigid3& cam_from_tag, const Eigen::Vector2d* last_corners, int width, int height,
                     int region[4], double* shortest_edge_px, bool* in_view) const;
   // quad_decimate of a region search for a tag of that shortest edge, never below min_decimate.

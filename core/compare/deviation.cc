@@ -59,16 +59,7 @@ void VoteFromViews(const Reconstruction& views, const std::vector<Eigen::Vector3
     const int columns = (camera.width + kCellPx - 1) / kCellPx, rows = (camera.height + kCellPx - 1) / kCellPx;
     Votes& mine = votes[static_cast<size_t>(worker)];
     mine.depth.assign(static_cast<size_t>(columns) * static_cast<size_t>(rows), INFINITY);
-    // Far outside the frame the distortion polynomial folds back into it: only points whose
-    // undistorted radius is within the frame's corners' are projected.
-    double max_r2 = 0.0;
-    for (const Eigen::Vector2d& corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(camera.width - 0.5, -0.5),
-                                         Eigen::Vector2d(-0.5, camera.height - 0.5),
-                                         Eigen::Vector2d(camera.width - 0.5, camera.height - 0.5)}) {
-      Eigen::Vector2d normalised((corner.x() - camera.cx) / camera.focal, (corner.y() - camera.cy) / camera.fy());
-      camera.Undistort(corner, &normalised);
-      max_r2 = std::max(max_r2, normalised.squaredNorm());
-    }
+    const double max_r2 = camera.MaxValidRadiusSquared(camera.width, camera.height);
     const auto cell_of = [&](const Eigen::Vector3d& in_camera) -> long {
       if (!(in_camera.z() > 0.0) || !((in_camera.head<2>() / in_camera.z()).squaredNorm() <= max_r2)) return -1;
       const Eigen::Vector2d pixel = camera.Project(in_camera);

@@ -12,6 +12,7 @@
 // The bundle adjuster projects through this model too (PixelFromNormalised and its Jacobian) over
 // its parameter block, in core/optim/radial_camera_model.h.
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 
 namespace reconar {
@@ -84,6 +85,30 @@ struct RadialCamera {
     if (!(std::abs(residual) <= 1e-10 * rho_d) || !(1.0 + r2 * (3.0 * k1 + 5.0 * r2 * k2) > 0.0)) return false;
     *normalised = q * (rho / rho_d);
     return true;
+  }
+
+  // The squared normalised radius r^2 at which the pixel radius r d(r^2) stops growing with r (the
+  // smallest positive root of 1 + 3 k1 r^2 + 5 k2 r^4); infinity when it never stops. Farther off
+  // the axis the distortion folds back: a point far outside the field of view projects inside it.
+  double FoldRadiusSquared() const {
+    const double discriminant = 9.0 * k1 * k1 - 20.0 * k2;
+    if (discriminant < 0.0 || (k1 >= 0.0 && k2 >= 0.0)) return INFINITY;
+    // Each branch in the form where the square root adds to 3 |k1| rather than cancelling it.
+    return k1 < 0.0 ? 2.0 / (std::sqrt(discriminant) - 3.0 * k1) : (3.0 * k1 + std::sqrt(discriminant)) / (-10.0 * k2);
+  }
+
+  // The largest squared normalised radius |X.xy / X.z|^2 of a camera point that truly projects into
+  // the frame of width x height: the undistorted radius of its farthest corner, within the fold
+  // (a corner beyond the fold does not undistort). A point farther off the axis whose pixel lands
+  // in the frame got there by the fold.
+  double MaxValidRadiusSquared(int width, int height) const {
+    double farthest_corner = 0.0;
+    for (const Eigen::Vector2d& corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(width - 0.5, -0.5),
+                                         Eigen::Vector2d(-0.5, height - 0.5), Eigen::Vector2d(width - 0.5, height - 0.5)}) {
+      Eigen::Vector2d normalised;
+      farthest_corner = std::max(farthest_corner, Undistort(corner, &normalised) ? normalised.squaredNorm() : INFINITY);
+    }
+    return std::min(farthest_corner, FoldRadiusSquared());
   }
 
   // Every parameter finite, focal and aspect positive.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
 
 #include "core/math/camera_intrinsics.h"
 
@@ -93,6 +94,40 @@ TEST(RadialCamera, JacobianMatchesCentralDifferences) {
       EXPECT_LT((analytic.col(k) - numeric).norm(), 1e-5) << p.transpose() << " column " << k;
     }
   }
+}
+
+TEST(RadialCamera, FoldRadiusIsWherePixelRadiusStopsGrowing) {
+  for (const auto& [k1, k2] : {std::pair(-0.5, 0.0), std::pair(0.1, -0.05), std::pair(-0.3, 0.02), std::pair(0.0, -0.1), std::pair(0.2, -1e-9)}) {
+    const double fold_r2 = TestCamera(k1, k2).FoldRadiusSquared();
+    ASSERT_TRUE(std::isfinite(fold_r2)) << k1 << " " << k2;
+    const double growth = 1.0 + 3.0 * k1 * fold_r2 + 5.0 * k2 * fold_r2 * fold_r2;
+    EXPECT_NEAR(growth / (1.0 + std::abs(3.0 * k1 * fold_r2)), 0.0, 1e-12) << k1 << " " << k2;
+  }
+  EXPECT_EQ(TestCamera(0.0, 0.0).FoldRadiusSquared(), INFINITY);
+  EXPECT_EQ(TestCamera(0.1, 0.0).FoldRadiusSquared(), INFINITY);
+  EXPECT_EQ(TestCamera(-0.15, 0.04).FoldRadiusSquared(), INFINITY);
+}
+
+TEST(RadialCamera, MaxValidRadiusRefusesWhatTheDistortionFoldsBackIntoTheFrame) {
+  constexpr int kWidth = 1000, kHeight = 800;
+  const auto in_frame = [](const Eigen::Vector2d& pixel) {
+    return pixel.x() >= -0.5 && pixel.y() >= -0.5 && pixel.x() < kWidth - 0.5 && pixel.y() < kHeight - 0.5;
+  };
+  // r d(r^2) = r - 0.5 r^3 turns back at r^2 = 2/3, inside the frame's corners.
+  const RadialCamera strong = TestCamera(-0.5, 0.0);
+  const double max_r2 = strong.MaxValidRadiusSquared(kWidth, kHeight);
+  EXPECT_NEAR(max_r2, 2.0 / 3.0, 1e-12);
+  const Eigen::Vector3d far_off_axis(1.3, 0.0, 1.0);
+  ASSERT_TRUE(in_frame(strong.Project(far_off_axis)));
+  EXPECT_GT(far_off_axis.head<2>().squaredNorm(), max_r2);
+  const Eigen::Vector3d ordinary(0.3, -0.2, 1.0);
+  ASSERT_TRUE(in_frame(strong.Project(ordinary)));
+  EXPECT_LE(ordinary.head<2>().squaredNorm(), max_r2);
+  // Where nothing folds the frame's farthest corner sets the bound.
+  const RadialCamera mild = TestCamera(-0.15, 0.04);
+  Eigen::Vector2d farthest_corner;
+  ASSERT_TRUE(mild.Undistort(Eigen::Vector2d(-0.5, -0.5), &farthest_corner));
+  EXPECT_DOUBLE_EQ(mild.MaxValidRadiusSquared(kWidth, kHeight), farthest_corner.squaredNorm());
 }
 
 TEST(RadialCamera, IsValidNeedsPositiveFocalAndAspect) {
