@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "core/math/point_spread.h"
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_io.h"
 #include "core/sfm/tag_layout.h"
@@ -111,13 +111,11 @@ int Run(int argc, char** argv) {
     for (const LayoutTag* tag : wall.tags) {
       for (const Eigen::Vector3d& c : TagSquareCorners(tag->size)) corners.push_back(tag->layout_from_tag * c);
     }
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& c : corners) centre += c / static_cast<double>(corners.size());
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    for (const Eigen::Vector3d& c : corners) scatter += (c - centre) * (c - centre).transpose();
+    const PointSpread spread = SpreadOfPoints(corners);
+    const Eigen::Vector3d& centre = spread.mean;
     // Walls stand upright: the normal of the tags' plane laid horizontal (a row of tags at one
     // height leaves the plane free to tilt about it).
-    Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+    Eigen::Vector3d normal = spread.ThinnestAxis();
     normal = (normal - normal.dot(up) * up).normalized();
     if (normal.dot(wall.normal) < 0.0) normal = -normal;  // into the room
     const Eigen::Vector3d along = up.cross(normal).normalized();

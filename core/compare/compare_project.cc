@@ -13,6 +13,7 @@
 #include "core/base/json_writer.h"
 #include "core/compare/report_picture.h"
 #include "core/io/image_write.h"
+#include "core/math/point_spread.h"
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_file.h"
 #include "core/mesh/mesh_io.h"
@@ -183,13 +184,7 @@ Result<CompareReport> CompareWithDesign(const Project& project, const std::strin
   // The top view looks down the world's up: the tag board's y for a project registered by tags,
   // else the points' thinnest direction (the floor's normal for a room, a wall's for a facade).
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
-  if (!report.metric) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : metric_points) mean += p / static_cast<double>(metric_points.size());
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    for (const Eigen::Vector3d& p : metric_points) scatter += (p - mean) * (p - mean).transpose();
-    up = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
-  }
+  if (!report.metric) up = SpreadOfPoints(metric_points).ThinnestAxis();
   const Image<uint8_t> picture = DrawCompareReport(report, options, metric_points, up);
   RECONAR_RETURN_IF_ERROR(WritePng(report.out_dir + "/report.png", picture.view(), 3));
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "core/compare/point_to_plane.h"
+#include "core/math/point_spread.h"
 #include "core/mesh/triangle_bvh.h"
 
 namespace reconar {
@@ -92,12 +93,8 @@ Result<DesignRegistration> RegisterDesign(const Design& design, const std::vecto
       from.push_back(pair.design);
       to.push_back(pair.world);
     }
-    // Collinear points fix no turn about their line: the second singular value of their spread.
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : from) mean += p / static_cast<double>(from.size());
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    for (const Eigen::Vector3d& p : from) scatter += (p - mean) * (p - mean).transpose();
-    const Eigen::Vector3d spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues();
+    // Collinear points fix no turn about their line: the second eigenvalue of their spread.
+    const Eigen::Vector3d spread = SpreadOfPoints(from).eigenvalues;
     if (!(spread[1] > 1e-12 * spread[2])) {
       return InvalidArgument("design registration: the control points lie on one line");
     }
