@@ -57,7 +57,8 @@ using testing::ByteMutator;
 using testing::MutationHints;
 
 constexpr unsigned kHangSeconds = 30;
-constexpr size_t kMaxRefusalKinds = 400;  // more distinct messages are counted together
+constexpr size_t kMaxRefusalKinds = 20000;  // more distinct messages are counted together
+constexpr size_t kRefusalKindsShown = 60;   // the most frequent, in the summary
 
 enum class Format { kObj, kGlb, kGltf, kPly, kControl };
 constexpr Format kAllFormats[] = {Format::kObj, Format::kGlb, Format::kGltf, Format::kPly, Format::kControl};
@@ -652,7 +653,15 @@ int Run(double seconds, uint64_t seed_value, const std::vector<Format>& formats)
     std::printf("  %-8s %8ld iterations, %8ld accepted, %8ld refused\n", FormatName(format), count.iterations,
                 count.accepted, count.refused);
   }
-  for (const auto& [kind, count] : refusals) std::printf("  %8ld  %s\n", count, kind.c_str());
+  std::vector<std::pair<std::string, long>> by_count(refusals.begin(), refusals.end());
+  std::stable_sort(by_count.begin(), by_count.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  const size_t shown = std::min(by_count.size(), kRefusalKindsShown);
+  for (size_t k = 0; k < shown; ++k) std::printf("  %8ld  %s\n", by_count[k].second, by_count[k].first.c_str());
+  if (by_count.size() > shown) {
+    long left_out = 0;
+    for (size_t k = shown; k < by_count.size(); ++k) left_out += by_count[k].second;
+    std::printf("  %zu other kinds of refusal left out (%ld refusals)\n", by_count.size() - shown, left_out);
+  }
   return 0;
 }
 
