@@ -43,6 +43,9 @@ constexpr int kTargetElementArrayBuffer = 34963;
 constexpr int kModePoints = 0;
 constexpr int kModeTriangles = 4;
 constexpr int64_t kMaxByteStride = 252;
+constexpr int kFilterLinear = 9729;
+constexpr int kFilterLinearMipmapLinear = 9987;
+constexpr int kWrapClampToEdge = 33071;
 
 size_t Align4(size_t size) { return (size + 3) & ~size_t{3}; }
 
@@ -92,6 +95,11 @@ Result<MeshLayout> AppendMeshData(const Mesh& mesh, std::string* bin, std::vecto
   if (mesh.positions.empty()) return InvalidArgument("mesh: no vertices (glTF accessors need at least one)");
   RECONAR_RETURN_IF_ERROR(CheckFinite(mesh.positions, "position"));
   RECONAR_RETURN_IF_ERROR(CheckFinite(mesh.normals, "normal"));
+  for (size_t i = 0; i < mesh.texcoords.size(); ++i) {
+    if (!mesh.texcoords[i].allFinite()) {
+      return InvalidArgument("mesh: texture coordinate " + std::to_string(i) + " is not finite");
+    }
+  }
   const size_t num_vertices = mesh.positions.size();
   // The largest value of the index type is reserved (primitive restart), so uint32 indices reach
   // 2^32 - 2 and uint16 indices 65534.
@@ -124,6 +132,14 @@ Result<MeshLayout> AppendMeshData(const Mesh& mesh, std::string* bin, std::vecto
     for (const std::array<uint8_t, 4>& c : mesh.colors) bin->append(reinterpret_cast<const char*>(c.data()), 4);
     end_view(offset, kTargetArrayBuffer);
   }
+  if (!mesh.texcoords.empty()) {
+    offset = begin_view();
+    for (const Eigen::Vector2f& uv : mesh.texcoords) {
+      AppendLittleEndian(bin, uv.x());
+      AppendLittleEndian(bin, uv.y());
+    }
+    end_view(offset, kTargetArrayBuffer);
+  }
   if (!mesh.triangles.empty()) {
     offset = begin_view();
     for (const std::array<uint32_t, 3>& triangle : mesh.triangles) {
@@ -140,14 +156,17 @@ Result<MeshLayout> AppendMeshData(const Mesh& mesh, std::string* bin, std::vecto
   return layout;
 }
 
-// The mesh's one primitive; its accessors are numbered from *accessor on.
-void WriteMeshJson(JsonWriter* json, const Mesh& mesh, int* accessor) {
+// The mesh's one primitive; its accessors are numbered from *accessor on. `textured`: it uses
+// material 0 (the base colour texture).
+void WriteMeshJson(JsonWriter* json, const Mesh& mesh, bool textured, int* accessor) {
   json->BeginObject().Key("primitives").BeginArray().BeginObject();
   json->Key("attributes").BeginObject().Key("POSITION").Int((*accessor)++);
   if (!mesh.normals.empty()) json->Key("NORMAL").Int((*accessor)++);
   if (!mesh.colors.empty()) json->Key("COLOR_0").Int((*accessor)++);
+  if (!mesh.texcoords.empty()) json->Key("TEXCOORD_0").Int((*accessor)++);
   json->EndObject();
   if (!mesh.triangles.empty()) json->Key("indices").Int((*accessor)++);
+  if (textured) json->Key("material").Int(0);
   json->Key("mode").Int(mesh.triangles.empty() ? kModePoints : kModeTriangles);
   json->EndObject().EndArray().EndObject();
 }
@@ -167,6 +186,10 @@ void WriteAccessorsJson(JsonWriter* json, const Mesh& mesh, const MeshLayout& la
     WriteAccessor(json, (*view)++, kComponentUnsignedByte, num_vertices, "VEC4");
     json->Key("normalized").Bool(true).EndObject();
   }
+  if (!mesh.texcoords.empty()) {
+    WriteAccessor(json, (*view)++, kComponentFloat, num_vertices, "VEC2");
+    json->EndObject();
+  }
   if (!mesh.triangles.empty()) {
     WriteAccessor(json, (*view)++, layout.short_indices ? kComponentUnsignedShort : kComponentUnsignedInt,
                   3 * mesh.triangles.size(), "SCALAR");
@@ -174,7 +197,9 @@ void WriteAccessorsJson(JsonWriter* json, const Mesh& mesh, const MeshLayout& la
   }
 }
 
-Result<std::string> EncodeScene(const std::vector<SceneElement>& elements) {
+// `base_color_png`: when not empty, the PNG of material 0's base colour texture, which every
+// element with texture coordinates uses.
+Result<std::string> EncodeScene(const std::vector<SceneElement>& elements, std::string_view base_color_png = {}) {
   if (elements.empty()) return InvalidArgument("glTF scene: no meshes to write");
   // BIN chunk: each mesh's positions, normals, colours, indices.
   std::string bin;
@@ -190,6 +215,15 @@ Result<std::string> EncodeScene(const std::vector<SceneElement>& elements) {
     Result<MeshLayout> layout = AppendMeshData(*elements[i].mesh, &bin, &views);
     if (!layout.ok()) return elements.size() == 1 ? layout.status() : layout.status().WithContext(element);
     layouts.push_back(*layout);
+  }
+  const bool textured = !base_color_png.empty();
+  size_t image_view = 0;
+  if (textured) {
+    image_view = views.size();
+    const size_t offset = bin.size();
+    bin.append(base_color_png.data(), base_color_png.size());
+    views.push_back({offset, base_color_png.size(), 0});
+    bin.resize(Align4(bin.size()), '\0');
   }
 
   JsonWriter json;
@@ -208,8 +242,26 @@ Result<std::string> EncodeScene(const std::vector<SceneElement>& elements) {
   json.EndArray();
   int accessor = 0;
   json.Key("meshes").BeginArray();
-  for (const SceneElement& element : elements) WriteMeshJson(&json, *element.mesh, &accessor);
+  for (const SceneElement& element : elements) {
+    WriteMeshJson(&json, *element.mesh, textured && !element.mesh->texcoords.empty(), &accessor);
+  }
   json.EndArray();
+  if (textured) {
+    // Photographs are sRGB, as glTF's base colour texture is; metallic 0, rough 1: a matte surface.
+    json.Key("materials").BeginArray().BeginObject();
+    json.Key("pbrMetallicRoughness").BeginObject();
+    json.Key("baseColorTexture").BeginObject().Key("index").Int(0).EndObject();
+    json.Key("metallicFactor").Int(0).Key("roughnessFactor").Int(1);
+    json.EndObject().EndObject().EndArray();
+    json.Key("textures").BeginArray().BeginObject().Key("sampler").Int(0).Key("source").Int(0).EndObject().EndArray();
+    json.Key("samplers").BeginArray().BeginObject();
+    json.Key("magFilter").Int(kFilterLinear).Key("minFilter").Int(kFilterLinearMipmapLinear);
+    json.Key("wrapS").Int(kWrapClampToEdge).Key("wrapT").Int(kWrapClampToEdge);
+    json.EndObject().EndArray();
+    json.Key("images").BeginArray().BeginObject();
+    json.Key("bufferView").Int(static_cast<long long>(image_view)).Key("mimeType").String("image/png");
+    json.EndObject().EndArray();
+  }
   int view = 0;
   json.Key("accessors").BeginArray();
   for (size_t i = 0; i < elements.size(); ++i) WriteAccessorsJson(&json, *elements[i].mesh, layouts[i], &view);
@@ -220,9 +272,9 @@ Result<std::string> EncodeScene(const std::vector<SceneElement>& elements) {
     json.BeginObject()
         .Key("buffer").Int(0)
         .Key("byteOffset").Int(static_cast<long long>(spec.offset))
-        .Key("byteLength").Int(static_cast<long long>(spec.length))
-        .Key("target").Int(spec.target)
-        .EndObject();
+        .Key("byteLength").Int(static_cast<long long>(spec.length));
+    if (spec.target != 0) json.Key("target").Int(spec.target);  // an image's view has none
+    json.EndObject();
   }
   json.EndArray();
   json.Key("buffers").BeginArray().BeginObject().Key("byteLength").Int(static_cast<long long>(bin.size()));
@@ -260,6 +312,18 @@ Result<std::string> EncodeGlb(const Mesh& mesh) { return EncodeScene({{std::stri
 
 Status WriteGlb(const std::string& path, const Mesh& mesh) { return WriteEncodedGlb(path, EncodeGlb(mesh)); }
 
+Result<std::string> EncodeTexturedGlb(const Mesh& mesh, std::string_view base_color_png) {
+  if (mesh.texcoords.empty()) return InvalidArgument("mesh: no texture coordinates for the texture");
+  if (base_color_png.size() < 8 || base_color_png.substr(0, 8) != std::string_view("\x89PNG\r\n\x1a\n", 8)) {
+    return InvalidArgument("mesh: the base colour texture is not a PNG");
+  }
+  return EncodeScene({{std::string_view(), &mesh}}, base_color_png);
+}
+
+Status WriteTexturedGlb(const std::string& path, const Mesh& mesh, std::string_view base_color_png) {
+  return WriteEncodedGlb(path, EncodeTexturedGlb(mesh, base_color_png));
+}
+
 Result<std::string> EncodeGlbScene(const std::vector<NamedMesh>& meshes) {
   std::vector<SceneElement> elements;
   elements.reserve(meshes.size());
@@ -278,6 +342,8 @@ namespace {
 
 constexpr int kMaxNodeDepth = 64;
 constexpr size_t kMaxSceneVertices = size_t{1} << 28;
+// Images' data: URIs are cached with the buffers', under their index plus this.
+constexpr size_t kImageUriKey = size_t{1} << 40;
 
 // The 6-bit value of a base64 character (RFC 4648, section 4), -1 for any other character.
 int Base64Value(char c) {
@@ -343,11 +409,23 @@ class GlbDecoder {
       : bytes_(bytes), name_(name), base_directory_(std::move(base_directory)) {}
 
   Result<Mesh> Decode() {
+    RECONAR_ASSIGN_OR_RETURN(TexturedGlb textured, DecodeTextured(false));
+    return std::move(textured.mesh);
+  }
+
+  // With `with_texture`, the texture coordinates and the base colour image are kept.
+  Result<TexturedGlb> DecodeTextured(bool with_texture) {
     RECONAR_RETURN_IF_ERROR(ReadContainer());
     RECONAR_RETURN_IF_ERROR(CheckAssetAndExtensions());
     const JsonValue* primitive = nullptr;
     RECONAR_RETURN_IF_ERROR(FindFirstPrimitive(&primitive));
-    return ReadPrimitive(*primitive, "meshes[0].primitives[0]");
+    read_texcoords_ = with_texture;
+    TexturedGlb textured;
+    RECONAR_ASSIGN_OR_RETURN(textured.mesh, ReadPrimitive(*primitive, "meshes[0].primitives[0]"));
+    if (!with_texture) return textured;
+    RECONAR_RETURN_IF_ERROR(ReadBaseColorImage(*primitive, &textured));
+    if (textured.base_color_image.empty()) textured.mesh.texcoords.clear();
+    return textured;
   }
 
   // A .glb, or a .gltf JSON text.
@@ -708,6 +786,86 @@ class GlbDecoder {
     return Status::Ok();
   }
 
+  // Element `index` of the root array `key`, which must be an object.
+  Status GetRootObject(const char* key, int64_t index, const JsonValue** element) const {
+    const JsonValue* array = RootArray(key);
+    if (array == nullptr || index < 0 || index >= static_cast<int64_t>(array->size()) ||
+        !(*array)[static_cast<size_t>(index)].is_object()) {
+      return Corrupt(std::string(key) + "[" + std::to_string(index) + "] missing");
+    }
+    *element = &(*array)[static_cast<size_t>(index)];
+    return Status::Ok();
+  }
+
+  Status ReadTexcoords(const AccessorView& view, std::vector<Eigen::Vector2f>* out) const {
+    if (view.components != 2) return Corrupt(view.where + " must be VEC2");
+    const bool valid_type = view.component_type == kComponentFloat ||
+                            (view.normalized && (view.component_type == kComponentUnsignedByte ||
+                                                 view.component_type == kComponentUnsignedShort));
+    if (!valid_type) return Corrupt(view.where + ": TEXCOORD_0 must be float or normalized unsigned byte/short");
+    out->resize(view.count);
+    for (size_t i = 0; i < view.count; ++i) {
+      (*out)[i] = Eigen::Vector2f(Component(view, i, 0), Component(view, i, 1));
+      if (!(*out)[i].allFinite()) return Corrupt(view.where + ": texture coordinate " + std::to_string(i) + " is not finite");
+    }
+    return Status::Ok();
+  }
+
+  // The image of the primitive's material's base colour texture, when it has one: from a buffer
+  // view, or a data: URI.
+  Status ReadBaseColorImage(const JsonValue& primitive, TexturedGlb* textured) const {
+    int64_t material_index = -1, texture_index = -1, image_index = -1;
+    RECONAR_RETURN_IF_ERROR(GetIndex(primitive, "material", "meshes[0].primitives[0]", &material_index, -1));
+    if (material_index < 0) return Status::Ok();
+    const JsonValue* material = nullptr;
+    const std::string material_where = "materials[" + std::to_string(material_index) + "]";
+    RECONAR_RETURN_IF_ERROR(GetRootObject("materials", material_index, &material));
+    const JsonValue* pbr = material->Find("pbrMetallicRoughness");
+    const JsonValue* base_color = pbr != nullptr && pbr->is_object() ? pbr->Find("baseColorTexture") : nullptr;
+    if (base_color == nullptr || !base_color->is_object()) return Status::Ok();
+    const std::string base_where = material_where + ".pbrMetallicRoughness.baseColorTexture";
+    RECONAR_RETURN_IF_ERROR(GetIndex(*base_color, "index", base_where, &texture_index));
+    int64_t texcoord_set = 0;
+    RECONAR_RETURN_IF_ERROR(GetIndex(*base_color, "texCoord", base_where, &texcoord_set, 0));
+    if (texcoord_set != 0) return Unsupported(base_where + " uses TEXCOORD_" + std::to_string(texcoord_set));
+    const JsonValue* texture = nullptr;
+    RECONAR_RETURN_IF_ERROR(GetRootObject("textures", texture_index, &texture));
+    if (texture->Find("source") == nullptr) return Status::Ok();  // an extension's image only
+    RECONAR_RETURN_IF_ERROR(
+        GetIndex(*texture, "source", "textures[" + std::to_string(texture_index) + "]", &image_index));
+    const JsonValue* image_object = nullptr;
+    RECONAR_RETURN_IF_ERROR(GetRootObject("images", image_index, &image_object));
+    const JsonValue& image = *image_object;
+    const std::string image_where = "images[" + std::to_string(image_index) + "]";
+    if (const JsonValue* uri = image.Find("uri")) {
+      if (!uri->is_string() || uri->string().rfind("data:", 0) != 0) {
+        return Unsupported(image_where + " is an external file (only embedded images are read)");
+      }
+      std::string_view data;
+      RECONAR_RETURN_IF_ERROR(LoadUriBuffer(kImageUriKey + static_cast<size_t>(image_index), *uri,
+                                            image_where + ".uri", &data));
+      textured->base_color_image = std::string(data);
+      return Status::Ok();
+    }
+    int64_t view_index = 0, buffer_index = 0, view_offset = 0, view_length = 0;
+    RECONAR_RETURN_IF_ERROR(GetIndex(image, "bufferView", image_where, &view_index));
+    const JsonValue* buffer_view_object = nullptr;
+    RECONAR_RETURN_IF_ERROR(GetRootObject("bufferViews", view_index, &buffer_view_object));
+    const JsonValue& buffer_view = *buffer_view_object;
+    const std::string view_where = "bufferViews[" + std::to_string(view_index) + "]";
+    RECONAR_RETURN_IF_ERROR(GetIndex(buffer_view, "buffer", view_where, &buffer_index));
+    RECONAR_RETURN_IF_ERROR(GetIndex(buffer_view, "byteOffset", view_where, &view_offset, 0));
+    RECONAR_RETURN_IF_ERROR(GetIndex(buffer_view, "byteLength", view_where, &view_length));
+    std::string_view buffer;
+    RECONAR_RETURN_IF_ERROR(GetBuffer(buffer_index, &buffer));
+    if (static_cast<uint64_t>(view_offset) > buffer.size() ||
+        static_cast<uint64_t>(view_length) > buffer.size() - static_cast<uint64_t>(view_offset)) {
+      return Corrupt(view_where + " lies outside buffers[" + std::to_string(buffer_index) + "]");
+    }
+    textured->base_color_image = std::string(buffer.substr(static_cast<size_t>(view_offset), static_cast<size_t>(view_length)));
+    return Status::Ok();
+  }
+
   // `where` names the primitive ("meshes[0].primitives[0]").
   Result<Mesh> ReadPrimitive(const JsonValue& primitive, const std::string& where) const {
     if (const JsonValue* extensions = primitive.Find("extensions")) {
@@ -742,6 +900,12 @@ class GlbDecoder {
       RECONAR_RETURN_IF_ERROR(GetAccessor(index, &view));
       if (view.count != num_vertices) return Corrupt(view.where + ": COLOR_0 count differs from POSITION count");
       RECONAR_RETURN_IF_ERROR(ReadColors(view, &mesh.colors));
+    }
+    if (read_texcoords_ && attributes->Find("TEXCOORD_0") != nullptr) {
+      RECONAR_RETURN_IF_ERROR(GetIndex(*attributes, "TEXCOORD_0", attributes_where, &index));
+      RECONAR_RETURN_IF_ERROR(GetAccessor(index, &view));
+      if (view.count != num_vertices) return Corrupt(view.where + ": TEXCOORD_0 count differs from POSITION count");
+      RECONAR_RETURN_IF_ERROR(ReadTexcoords(view, &mesh.texcoords));
     }
 
     const bool indexed = primitive.Find("indices") != nullptr;
@@ -1021,6 +1185,7 @@ class GlbDecoder {
   mutable std::map<size_t, std::string> uri_buffers_;  // the data of buffers with a uri, by buffer index
   std::vector<std::vector<size_t>> node_children_;
   size_t scene_vertices_ = 0;
+  bool read_texcoords_ = false;  // TEXCOORD_0 is read (and checked) only for a textured model
 };
 
 }  // namespace
@@ -1032,6 +1197,15 @@ Result<Mesh> DecodeGlb(std::string_view bytes, const std::string& name_for_error
 Result<Mesh> ReadGlb(const std::string& path) {
   RECONAR_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
   return DecodeGlb(bytes, path);
+}
+
+Result<TexturedGlb> DecodeTexturedGlb(std::string_view bytes, const std::string& name_for_errors) {
+  return GlbDecoder(bytes, name_for_errors, std::nullopt).DecodeTextured(true);
+}
+
+Result<TexturedGlb> ReadTexturedGlb(const std::string& path) {
+  RECONAR_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
+  return DecodeTexturedGlb(bytes, path);
 }
 
 Result<std::vector<NamedMesh>> DecodeGltfScene(std::string_view bytes, const std::string& name_for_errors,

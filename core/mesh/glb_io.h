@@ -13,6 +13,10 @@
 //   generator "reconar". Each buffer view starts on a 4-byte boundary, the JSON chunk is padded with
 //   spaces and the BIN chunk with zeros to 4 bytes. Written atomically.
 //
+// WriteTexturedGlb writes the same with TEXCOORD_0 (float VEC2) and one material: the given PNG as
+// its base colour texture (embedded in the BIN chunk; sampler linear, mipmapped, clamped to the
+// edge), metallic 0, roughness 1. COLOR_0, when the mesh has it, multiplies the texture (glTF's rule).
+//
 // ReadGlb reads the first primitive of the first mesh: POSITION, NORMAL and COLOR_0 (float, or
 // normalized unsigned byte/short; VEC3 colours get alpha 255) and the indices (unsigned
 // byte/short/int), in mode TRIANGLES or POINTS, in the mesh's own frame (node transforms are not
@@ -43,6 +47,22 @@ Status WriteGlb(const std::string& path, const Mesh& mesh);
 // `name_for_errors` prefixes every message.
 Result<Mesh> DecodeGlb(std::string_view bytes, const std::string& name_for_errors);
 Result<Mesh> ReadGlb(const std::string& path);
+
+// kInvalidArgument as EncodeGlb, and for a mesh without texcoords or bytes that are not a PNG.
+Result<std::string> EncodeTexturedGlb(const Mesh& mesh, std::string_view base_color_png);
+Status WriteTexturedGlb(const std::string& path, const Mesh& mesh, std::string_view base_color_png);
+
+// A mesh with its texture as a .glb holds it.
+struct TexturedGlb {
+  Mesh mesh;                     // with texcoords when base_color_image is not empty
+  std::string base_color_image;  // the encoded image (PNG or JPEG), empty without one
+};
+// ReadGlb, plus TEXCOORD_0 (float, or normalized unsigned byte/short) and the image of the first
+// primitive's material's base colour texture (from a buffer view or a data: URI; an external image
+// file is kUnsupported, as is a texture on another TEXCOORD set). Without a base colour image the
+// mesh comes back without texcoords.
+Result<TexturedGlb> DecodeTexturedGlb(std::string_view bytes, const std::string& name_for_errors);
+Result<TexturedGlb> ReadTexturedGlb(const std::string& path);
 
 // The .glb bytes of one scene with one node per element, in order. kInvalidArgument as EncodeGlb
 // (naming the element when there are several), for no element, or for a name that is not UTF-8.

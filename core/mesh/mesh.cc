@@ -19,6 +19,10 @@ Status ValidateMesh(const Mesh& mesh) {
     return InvalidArgument("mesh: " + std::to_string(mesh.colors.size()) + " colours for " +
                            std::to_string(num_vertices) + " vertices");
   }
+  if (!mesh.texcoords.empty() && mesh.texcoords.size() != num_vertices) {
+    return InvalidArgument("mesh: " + std::to_string(mesh.texcoords.size()) + " texture coordinates for " +
+                           std::to_string(num_vertices) + " vertices");
+  }
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     for (const uint32_t index : mesh.triangles[t]) {
       if (index >= num_vertices) {
@@ -57,6 +61,7 @@ Mesh SubMesh(const Mesh& mesh, const std::vector<size_t>& triangles) {
         part.positions.push_back(mesh.positions[vertex]);
         if (!mesh.normals.empty()) part.normals.push_back(mesh.normals[vertex]);
         if (!mesh.colors.empty()) part.colors.push_back(mesh.colors[vertex]);
+        if (!mesh.texcoords.empty()) part.texcoords.push_back(mesh.texcoords[vertex]);
       }
       vertex = it->second;
     }
@@ -67,17 +72,21 @@ Mesh SubMesh(const Mesh& mesh, const std::vector<size_t>& triangles) {
 
 Mesh JoinMeshes(const std::vector<NamedMesh>& parts) {
   Mesh joined;
-  bool normals = true, colours = true;
+  bool normals = true, colours = true, texcoords = true;
   for (const NamedMesh& part : parts) {
     if (part.mesh.positions.empty()) continue;
     normals = normals && part.mesh.normals.size() == part.mesh.positions.size();
     colours = colours && part.mesh.colors.size() == part.mesh.positions.size();
+    texcoords = texcoords && part.mesh.texcoords.size() == part.mesh.positions.size();
   }
   for (const NamedMesh& part : parts) {
     const uint32_t offset = static_cast<uint32_t>(joined.positions.size());
     joined.positions.insert(joined.positions.end(), part.mesh.positions.begin(), part.mesh.positions.end());
     if (normals) joined.normals.insert(joined.normals.end(), part.mesh.normals.begin(), part.mesh.normals.end());
     if (colours) joined.colors.insert(joined.colors.end(), part.mesh.colors.begin(), part.mesh.colors.end());
+    if (texcoords) {
+      joined.texcoords.insert(joined.texcoords.end(), part.mesh.texcoords.begin(), part.mesh.texcoords.end());
+    }
     for (const std::array<uint32_t, 3>& t : part.mesh.triangles) {
       joined.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
     }

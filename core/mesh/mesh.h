@@ -15,6 +15,10 @@ struct Mesh {
   std::vector<Eigen::Vector3f> positions;
   std::vector<Eigen::Vector3f> normals;             // empty, or one unit normal per vertex
   std::vector<std::array<uint8_t, 4>> colors;       // empty, or one RGBA colour per vertex
+  // Empty, or one texture coordinate per vertex: (0, 0) the texture's top-left corner, u right,
+  // v down, (1, 1) its bottom-right corner (glTF's convention). The texture itself travels beside
+  // the mesh (core/texture/texture_mesh.h's TexturedMesh).
+  std::vector<Eigen::Vector2f> texcoords;
   std::vector<std::array<uint32_t, 3>> triangles;   // counter-clockwise seen from outside
 
   bool is_point_cloud() const { return triangles.empty(); }
@@ -26,7 +30,7 @@ struct NamedMesh {
   Mesh mesh;
 };
 
-// Ok when `normals` and `colors` are empty or hold one entry per position and every triangle index
+// Ok when `normals`, `colors` and `texcoords` are empty or hold one entry per position and every triangle index
 // is below positions.size(); otherwise kInvalidArgument naming the first problem. The writers
 // (core/mesh/mesh_io.h, glb_io.h) check this before writing anything.
 Status ValidateMesh(const Mesh& mesh);
@@ -37,10 +41,12 @@ Status ValidateMesh(const Mesh& mesh);
 void ComputeVertexNormals(Mesh* mesh);
 
 // The given triangles of `mesh` (indices into mesh.triangles, each at most once, all valid) with
-// only the vertices they use, in their first-use order, and those vertices' normals and colours.
+// only the vertices they use, in their first-use order, and those vertices' normals, colours and
+// texture coordinates.
 Mesh SubMesh(const Mesh& mesh, const std::vector<size_t>& triangles);
 
-// The meshes as one, in order: normals and colours kept when every part with vertices has them.
+// The meshes as one, in order: normals, colours and texture coordinates kept when every part with
+// vertices has them.
 Mesh JoinMeshes(const std::vector<NamedMesh>& parts);
 
 }  // namespace reconar

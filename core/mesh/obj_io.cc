@@ -1,10 +1,10 @@
 #include "core/mesh/obj_io.h"
 
 #include <algorithm>
-
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <string_view>
 #include <vector>
 
@@ -26,9 +26,15 @@ void AppendIndex(std::string* out, uint64_t one_based) {
   out->append(buffer, result.ptr);
 }
 
-std::string ObjText(const Mesh& mesh) {
+// `material_library`: when not empty, the mesh's texcoords are written ("vt u 1-v") and its faces
+// use the library's material kTextureMaterial.
+constexpr const char* kTextureMaterial = "texture";
+
+std::string ObjText(const Mesh& mesh, const std::string& material_library = "") {
   std::string out = "# reconar\n# " + std::to_string(mesh.positions.size()) + " vertices, " +
                     std::to_string(mesh.triangles.size()) + " triangles\n";
+  const bool with_texcoords = !material_library.empty();
+  if (with_texcoords) out += "mtllib " + material_library + "\n";
   const bool with_colours = !mesh.colors.empty();
   const bool with_normals = !mesh.normals.empty();
   out.reserve(out.size() + mesh.positions.size() * (with_colours ? 60 : 36) * (with_normals ? 2 : 1) +
@@ -49,15 +55,29 @@ std::string ObjText(const Mesh& mesh) {
     mesh_internal::AppendShortestText(&out, normal);
     out.push_back('\n');
   }
+  if (with_texcoords) {
+    for (const Eigen::Vector2f& uv : mesh.texcoords) {
+      out += "vt ";
+      AppendShortest(&out, uv.x());
+      out.push_back(' ');
+      AppendShortest(&out, 1.0f - uv.y());  // OBJ's v runs up the image
+      out.push_back('\n');
+    }
+    out += std::string("usemtl ") + kTextureMaterial + "\n";
+  }
   for (const std::array<uint32_t, 3>& triangle : mesh.triangles) {
     out.push_back('f');
     for (const uint32_t index : triangle) {
       out.push_back(' ');
       AppendIndex(&out, uint64_t{index} + 1);
-      if (with_normals) {
-        out += "//";
+      if (with_texcoords) {
+        out.push_back('/');
         AppendIndex(&out, uint64_t{index} + 1);
+        if (with_normals) out.push_back('/');
+      } else if (with_normals) {
+        out += "//";
       }
+      if (with_normals) AppendIndex(&out, uint64_t{index} + 1);
     }
     out.push_back('\n');
   }
@@ -292,6 +312,21 @@ Status WriteObj(const std::string& path, const Mesh& mesh) {
   if (!valid.ok()) return valid.WithContext(path);
   RECONAR_RETURN_IF_ERROR(mesh_internal::CheckFiniteVertices(path, mesh));
   return WriteFileAtomically(path, ObjText(mesh));
+}
+
+Status WriteTexturedObj(const std::string& obj_path, const Mesh& mesh, const std::string& texture_file_name) {
+  const Status valid = ValidateMesh(mesh);
+  if (!valid.ok()) return valid.WithContext(obj_path);
+  RECONAR_RETURN_IF_ERROR(mesh_internal::CheckFiniteVertices(obj_path, mesh));
+  if (mesh.texcoords.empty()) return FileError(StatusCode::kInvalidArgument, obj_path, "the mesh has no texcoords");
+  const std::filesystem::path obj(obj_path);
+  const std::string library = obj.stem().string() + ".mtl";
+  const std::string library_path = (obj.parent_path() / library).string();
+  // Ka, Kd white: the texture's colours unchanged; illum 1: no specular highlight.
+  const std::string material = std::string("# reconar\nnewmtl ") + kTextureMaterial +
+                               "\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " + texture_file_name + "\n";
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(library_path, material));
+  return WriteFileAtomically(obj_path, ObjText(mesh, library));
 }
 
 Result<Mesh> ReadObj(const std::string& path) {

@@ -35,6 +35,11 @@
 namespace reconar {
 
 Status WriteObj(const std::string& path, const Mesh& mesh);
+// WriteObj with the mesh's texcoords ("vt u v", v flipped to OBJ's upward axis; corners "v/vt" or
+// "v/vt/vn") and a material library beside it (OBJ's stem + ".mtl", written first, atomically)
+// whose one material maps `texture_file_name` (relative to the OBJ, written by the caller) as
+// the diffuse colour. kInvalidArgument, nothing written, for a mesh without texcoords.
+Status WriteTexturedObj(const std::string& obj_path, const Mesh& mesh, const std::string& texture_file_name);
 Result<Mesh> ReadObj(const std::string& path);
 Result<std::vector<NamedMesh>> ReadObjGroups(const std::string& path);
 

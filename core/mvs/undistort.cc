@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/base/image_sampling.h"
 #include "core/io/gray.h"
 
 namespace reconar {
@@ -84,26 +85,12 @@ Result<DenseView> UndistortView(const Image<uint8_t>& rgb, const SfmCamera& came
         x = pixel.x();
         y = pixel.y();
       }
-      // Bilinear sample; the edge pixels extend by half a pixel, further out is black.
-      if (!(x > -0.5 && y > -0.5 && x < width - 0.5 && y < height - 0.5)) {
+      float sample[3];
+      if (!SampleBilinear(source, x, y, sample)) {
         out[0] = out[1] = out[2] = 0;
         continue;
       }
-      x = std::clamp(x, 0.0, width - 1.0);
-      y = std::clamp(y, 0.0, height - 1.0);
-      const int x0 = std::min(static_cast<int>(x), width - 2 < 0 ? 0 : width - 2);
-      const int y0 = std::min(static_cast<int>(y), height - 2 < 0 ? 0 : height - 2);
-      const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
-      const double ax = x - x0, ay = y - y0;
-      const uint8_t* p00 = source.row(y0) + 3 * x0;
-      const uint8_t* p01 = source.row(y0) + 3 * x1;
-      const uint8_t* p10 = source.row(y1) + 3 * x0;
-      const uint8_t* p11 = source.row(y1) + 3 * x1;
-      for (int c = 0; c < 3; ++c) {
-        const double top = p00[c] + ax * (p01[c] - p00[c]);
-        const double bottom = p10[c] + ax * (p11[c] - p10[c]);
-        out[c] = static_cast<uint8_t>(std::lround(top + ay * (bottom - top)));
-      }
+      for (int c = 0; c < 3; ++c) out[c] = static_cast<uint8_t>(std::lround(sample[c]));
     }
   }
   view.gray = ToGray8(view.rgb);

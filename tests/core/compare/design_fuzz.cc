@@ -535,6 +535,16 @@ std::string CheckInput(Format format, const std::string& bytes, const std::strin
     const Result<Design> design = ReadDesign(path);
     if (design.ok()) broken = BrokenInvariant(*design);
     refusal = design.status();
+    if (format == Format::kGlb && broken.empty()) {
+      // The textured model's reader (`reconar view`, `render`) on the same bytes.
+      const Result<TexturedGlb> textured = DecodeTexturedGlb(bytes, path);
+      if (textured.ok() && !ValidateMesh(textured->mesh).ok()) {
+        broken = "DecodeTexturedGlb: " + ValidateMesh(textured->mesh).ToString();
+      } else if (!textured.ok() && (!LegitimateRefusal(format, textured.status().code()) ||
+                                    textured.status().message().find(path) == std::string::npos)) {
+        broken = "DecodeTexturedGlb refused badly: " + textured.status().ToString();
+      }
+    }
   }
   alarm(0);
   refusal_kind->clear();

@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "core/base/json_reader.h"
+#include "core/io/image_write.h"
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_file.h"
 #include "core/mesh/mesh_io.h"
@@ -121,6 +122,19 @@ TEST_F(GlbDataTest, KhronosValidatorAcceptsOurFiles) {
   ASSERT_TRUE(WriteGlbScene(scene, {{"bunny", bunny}, {"floor \"A\"", grid}, {"points", *scan}, {"", bunny}}).ok());
   files += " " + scene;
   meshes.emplace_back("design_scene.glb", Mesh());
+  // The bunny textured: texcoords from its normals over a real PNG, vertex colours kept.
+  Mesh textured = bunny;
+  for (const Eigen::Vector3f& n : bunny.normals) textured.texcoords.emplace_back(0.5f + 0.5f * n.x(), 0.5f - 0.5f * n.y());
+  Image<uint8_t> checker(64, 32, 3);
+  for (int y = 0; y < checker.height(); ++y) {
+    for (int x = 0; x < checker.width() * 3; ++x) checker.row(y)[x] = ((x / 3 / 8 + y / 8) % 2) ? 230 : 40;
+  }
+  const Result<std::string> png = EncodePng(checker.view(), 3);
+  ASSERT_TRUE(png.ok());
+  const std::string textured_path = (dir_ / "bunny_textured.glb").string();
+  ASSERT_TRUE(WriteTexturedGlb(textured_path, textured, *png).ok());
+  files += " " + textured_path;
+  meshes.emplace_back("bunny_textured.glb", Mesh());
   const testing::CommandRun run = testing::RunCommand("node " + std::string(RECONAR_SOURCE_DIR) +
                                                       "/tests/core/mesh/validate_glb.js " + validator_dir + files,
                                                       testing::StderrMode::kSeparate);

@@ -88,6 +88,51 @@ TEST(GlbTest, RoundTripsAreExact) {
   }
 }
 
+TEST(GlbTest, TexturedRoundTripKeepsTexcoordsAndTheImage) {
+  Mesh mesh = testing::RandomMesh(301, 700, true, true, 5);
+  for (size_t i = 0; i < mesh.positions.size(); ++i) mesh.texcoords.emplace_back(i / 301.0f, 1.0f - i / 602.0f);
+  const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + "image bytes";
+  const Result<std::string> glb = EncodeTexturedGlb(mesh, png);
+  ASSERT_TRUE(glb.ok()) << glb.status().ToString();
+  const GlbParts parts = Split(*glb);
+  const JsonValue* material = parts.json.Find("materials");
+  ASSERT_NE(material, nullptr);
+  EXPECT_EQ((*parts.json.Find("images"))[0].Find("mimeType")->string(), "image/png");
+  EXPECT_EQ((*parts.json.Find("meshes"))[0].Find("primitives")->operator[](0).Find("material")->AsInteger(), 0);
+
+  const Result<TexturedGlb> read = DecodeTexturedGlb(*glb, "textured.glb");
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  EXPECT_EQ(read->base_color_image, png);
+  ASSERT_EQ(read->mesh.texcoords.size(), mesh.texcoords.size());
+  for (size_t i = 0; i < mesh.texcoords.size(); ++i) EXPECT_EQ(read->mesh.texcoords[i], mesh.texcoords[i]);
+  Mesh without_texcoords = read->mesh;
+  without_texcoords.texcoords.clear();
+  Mesh expected = mesh;
+  expected.texcoords.clear();
+  testing::ExpectMeshesEqual(without_texcoords, expected);
+  // The plain reader leaves the texture out, so that code unaware of texcoords never meets them.
+  const Result<Mesh> plain = DecodeGlb(*glb, "textured.glb");
+  ASSERT_TRUE(plain.ok());
+  EXPECT_TRUE(plain->texcoords.empty());
+  // An untextured file reads as a TexturedGlb without image or texcoords.
+  const Result<TexturedGlb> untextured = DecodeTexturedGlb(*EncodeGlb(expected), "plain.glb");
+  ASSERT_TRUE(untextured.ok());
+  EXPECT_TRUE(untextured->base_color_image.empty());
+  EXPECT_TRUE(untextured->mesh.texcoords.empty());
+}
+
+TEST(GlbTest, TexturedWritingRefusesWhatCannotBeATexturedModel) {
+  Mesh mesh = testing::RandomMesh(10, 5, false, false, 5);
+  const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + "x";
+  EXPECT_EQ(EncodeTexturedGlb(mesh, png).status().code(), StatusCode::kInvalidArgument);  // no texcoords
+  mesh.texcoords.assign(10, Eigen::Vector2f(0.5f, 0.5f));
+  EXPECT_EQ(EncodeTexturedGlb(mesh, "GIF89a").status().code(), StatusCode::kInvalidArgument);
+  mesh.texcoords[3].x() = NAN;
+  EXPECT_EQ(EncodeTexturedGlb(mesh, png).status().code(), StatusCode::kInvalidArgument);
+  mesh.texcoords.resize(4);
+  EXPECT_EQ(EncodeTexturedGlb(mesh, png).status().code(), StatusCode::kInvalidArgument);
+}
+
 TEST(GlbTest, IndexTypeFollowsTheVertexCount) {
   // 65535 vertices: the largest index is 65534, below the reserved 65535, so uint16 suffices.
   for (const int num_vertices : {65535, 65536}) {

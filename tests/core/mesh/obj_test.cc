@@ -74,6 +74,37 @@ TEST_F(ObjTest, WritesTheDocumentedLines) {
             "f 1//1 2//2 3//3\n");
 }
 
+TEST_F(ObjTest, TexturedWritesTexcoordsAndItsMaterialLibrary) {
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0.5f, -2.25f}};
+  mesh.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+  mesh.texcoords = {{0, 0}, {1, 0.25f}, {0.5f, 1}};
+  mesh.triangles = {{0, 1, 2}};
+  const std::string path = dir_ + "/textured.obj";
+  ASSERT_TRUE(WriteTexturedObj(path, mesh, "textured.png").ok());
+  const Result<std::string> text = ReadFileToString(path);
+  ASSERT_TRUE(text.ok());
+  EXPECT_EQ(*text,
+            "# reconar\n# 3 vertices, 1 triangles\nmtllib textured.mtl\n"
+            "v 0 0 0\nv 1 0 0\nv 0 0.5 -2.25\n"
+            "vn 0 0 1\nvn 0 0 1\nvn 0 0 1\n"
+            "vt 0 1\nvt 1 0.75\nvt 0.5 0\nusemtl texture\n"
+            "f 1/1/1 2/2/2 3/3/3\n");
+  const Result<std::string> library = ReadFileToString(dir_ + "/textured.mtl");
+  ASSERT_TRUE(library.ok());
+  EXPECT_NE(library->find("newmtl texture\n"), std::string::npos);
+  EXPECT_NE(library->find("map_Kd textured.png\n"), std::string::npos);
+  // Our reader (and every other) takes it back.
+  const Result<Mesh> read = ReadObj(path);
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  EXPECT_EQ(read->positions, mesh.positions);
+  EXPECT_EQ(read->triangles, mesh.triangles);
+
+  mesh.texcoords.clear();
+  EXPECT_EQ(WriteTexturedObj(dir_ + "/none.obj", mesh, "none.png").code(), StatusCode::kInvalidArgument);
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/none.obj"));
+}
+
 // The corner forms of the OBJ specification (Wavefront, Appendix B1): v, v/vt, v//vn, v/vt/vn,
 // with negative (relative) indices, a quad, comments and statements we skip.
 TEST_F(ObjTest, ReadsEveryCornerFormAndRelativeIndices) {

@@ -1,0 +1,90 @@
+#pragma once
+// Step 4 of texturing (texture_mesh.h): the charts, their packing and their texels.
+//
+// A chart is a patch's faces as its photo sees them (a patch that fills little of its bounding
+// box is cut into pieces that fill more): its vertices' full-resolution pixels, scaled
+// by one factor for the whole atlas (at most 1: never finer than the photos), offset to the
+// chart's rectangle, with `padding` texels around. The rectangles are packed, tallest first, each
+// where it sits lowest on the skyline of those before it (bottom-left skyline packing), into the
+// narrowest power-of-two width whose height fits it; when even
+// atlas_size does not hold them at full resolution, the largest scale that fits is found by
+// bisection. A texel whose centre lies in a face takes the photo's colour of the face's point
+// there (through the camera model, so the lens distortion is followed inside the face) times the
+// photo's gain plus the seam correction; then each chart's covered texels are grown into its padding, so that bilinear
+// filtering and mipmaps down to log2(padding) levels read the chart's own colours.
+// Faces no photo sees share a small white chart and keep their vertex colour.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/base/image.h"
+#include "core/base/status.h"
+#include "core/mesh/mesh.h"
+#include "core/texture/face_views.h"
+#include "core/texture/seam_levelling.h"
+#include "core/texture/view_labelling.h"
+
+namespace reconar {
+
+struct TextureChart {
+  int patch = -1;  // -1: the white chart of the faces without a photo
+  int photo = -1;
+  std::vector<uint32_t> vertices;                    // mesh vertices; a local index is a position here
+  std::vector<int> faces;                            // mesh triangles
+  std::vector<std::array<uint32_t, 3>> triangles;    // local indices, one per face
+  std::vector<Eigen::Vector2d> pixels;               // per local vertex: full-resolution photo pixel
+  Eigen::Vector2d pixel_min = Eigen::Vector2d::Zero(), pixel_max = Eigen::Vector2d::Zero();
+  int x = 0, y = 0, width = 0, height = 0;           // rectangle in the atlas, padding included
+};
+
+struct AtlasLayout {
+  int width = 0, height = 0;
+  double scale = 1.0;  // texels per photo pixel
+  int padding = 0;
+  std::vector<TextureChart> charts;
+
+  // Texel coordinates (continuous: texel i spans [i, i + 1)) of a chart's local vertex.
+  Eigen::Vector2d Texel(const TextureChart& chart, size_t local_vertex) const;
+};
+
+// The charts of every patch, plus the white chart when some face has no patch.
+std::vector<TextureChart> MakeCharts(const Mesh& mesh, const TexturePatches& patches,
+                                     const std::vector<PhotoProjector>& projectors);
+
+// Places the charts. kResourceExhausted when even a tiny scale does not fit (more charts than
+// the atlas holds with their padding).
+Result<AtlasLayout> PackCharts(std::vector<TextureChart> charts, int atlas_size, int padding);
+
+// A photo's full-resolution pixels for the filling: *photo points to them (kept elsewhere, or
+// loaded into `storage`).
+using PhotoAccess = std::function<Status(size_t photo, Image<uint8_t>* storage, const Image<uint8_t>** photo_pixels)>;
+
+struct AtlasFill {
+  Image<uint8_t> atlas;  // RGB
+  double covered_fraction = 0.0;
+};
+
+// `gains`: per photo, multiplying its colours (view_labelling.h).
+Result<AtlasFill> FillAtlas(const Mesh& mesh, const AtlasLayout& layout, const std::vector<PhotoProjector>& projectors,
+                            const std::vector<Eigen::Vector3f>& gains, const PatchColourCorrection& correction,
+                            const PhotoAccess& access, int num_threads);
+
+// The colour step a viewer sees across the seams: for every seam edge, the atlas's colours of
+// its two faces at the edge's midpoint, one point seen through two charts (mean absolute
+// difference over the channels, 0..255), averaged; `before` the same without the levelling (the
+// photos' colours as they are: no exposure gain, no seam correction).
+struct SeamSteps {
+  double before = 0.0, after = 0.0;
+  size_t edges = 0;  // measured
+};
+SeamSteps MeasureSeamSteps(const Mesh& mesh, const AtlasLayout& layout, const Image<uint8_t>& atlas,
+                           const std::vector<Eigen::Vector3f>& gains, const PatchColourCorrection& correction,
+                           const std::vector<SeamEdge>& edges);
+
+// The output mesh: one vertex per chart vertex, texcoords over the atlas (u right, v down).
+Mesh TexturedChartsMesh(const Mesh& mesh, const AtlasLayout& layout);
+
+}  // namespace reconar
