@@ -12,7 +12,7 @@
 namespace reconar {
 namespace {
 
-enum AttributeLocation : GLuint { kPosition = 0, kNormal = 1, kColor = 2 };
+enum AttributeLocation : GLuint { kPosition = 0, kNormal = 1, kColor = 2, kTexcoord = 3 };
 
 // Shading modes of the fragment shader.
 enum ShadingMode : GLint { kVertexNormals = 0, kFlatNormals = 1, kUnlit = 2 };
@@ -21,6 +21,7 @@ constexpr const char* kVertexShader = R"(#version 300 es
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_color;
+layout(location = 3) in vec2 a_texcoord;
 uniform mat4 u_clip_from_model;
 uniform mat4 u_cam_from_model;
 uniform mat3 u_cam_normal_from_model;
@@ -28,7 +29,9 @@ uniform float u_point_size;
 out vec3 v_cam_position;
 out vec3 v_cam_normal;
 out vec4 v_color;
+out vec2 v_texcoord;
 void main() {
+  v_texcoord = a_texcoord;
   v_cam_position = (u_cam_from_model * vec4(a_position, 1.0)).xyz;
   v_cam_normal = u_cam_normal_from_model * a_normal;
   v_color = a_color;
@@ -41,11 +44,15 @@ constexpr const char* kFragmentShader = R"(#version 300 es
 precision highp float;
 uniform int u_shading_mode;
 uniform float u_opacity;
+uniform bool u_textured;
+uniform sampler2D u_base_color;
 in vec3 v_cam_position;
 in vec3 v_cam_normal;
 in vec4 v_color;
+in vec2 v_texcoord;
 out vec4 o_color;
 void main() {
+  vec3 color = u_textured ? v_color.rgb * texture(u_base_color, v_texcoord).rgb : v_color.rgb;
   float shade = 1.0;
   if (u_shading_mode != 2) {
     vec3 normal = u_shading_mode == 0 ? v_cam_normal
@@ -54,7 +61,7 @@ void main() {
     vec3 to_eye = normalize(-v_cam_position);
     shade = length_n > 0.0 ? 0.2 + 0.8 * abs(dot(normal / length_n, to_eye)) : 1.0;
   }
-  o_color = vec4(v_color.rgb * shade, u_opacity);
+  o_color = vec4(color * shade, u_opacity);
 }
 )";
 
@@ -73,7 +80,7 @@ void ToGl(const Eigen::Matrix4d& m, float out[16]) {
 
 }  // namespace
 
-Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh) {
+Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh, const Image<uint8_t>* base_color) {
   const size_t n = mesh.positions.size();
   if (n == 0) return InvalidArgument("MeshDrawable::Upload: the mesh has no vertices");
   if (n > static_cast<size_t>(INT32_MAX)) return InvalidArgument("MeshDrawable::Upload: too many vertices");
@@ -81,6 +88,21 @@ Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh) {
   for (size_t i = 0; i < n; ++i) {
     if (!mesh.positions[i].allFinite()) {
       return InvalidArgument("MeshDrawable::Upload: vertex " + std::to_string(i) + " is not finite");
+    }
+  }
+
+  const bool textured = base_color != nullptr;
+  if (textured) {
+    if (mesh.texcoords.empty()) return InvalidArgument("MeshDrawable::Upload: a texture for a mesh without texcoords");
+    if (base_color->channels() != 3 || base_color->empty()) {
+      return InvalidArgument("MeshDrawable::Upload: the texture must be RGB");
+    }
+    GLint max_size = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+    if (base_color->width() > max_size || base_color->height() > max_size) {
+      return InvalidArgument("MeshDrawable::Upload: a " + std::to_string(base_color->width()) + " x " +
+                             std::to_string(base_color->height()) + " texture exceeds the GPU's " +
+                             std::to_string(max_size) + " texels");
     }
   }
 
@@ -106,6 +128,26 @@ Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh) {
     drawable.colors_ = MakeArrayBuffer(GL_ARRAY_BUFFER, mesh.colors.data(), n);
     glEnableVertexAttribArray(kColor);
     glVertexAttribPointer(kColor, 4, GL_UNSIGNED_BYTE, GL_TRUE, 0, nullptr);
+  }
+  if (textured) {
+    static_assert(sizeof(Eigen::Vector2f) == 2 * sizeof(float), "packed texcoords");
+    drawable.texcoords_ = MakeArrayBuffer(GL_ARRAY_BUFFER, mesh.texcoords.data(), n);
+    glEnableVertexAttribArray(kTexcoord);
+    glVertexAttribPointer(kTexcoord, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    // Row 0 first: texcoord v = 0 is the image's top row, as glTF has it.
+    drawable.texture_ = MakeGlTexture();
+    glBindTexture(GL_TEXTURE_2D, drawable.texture_.get());
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, base_color->width(), base_color->height(), 0, GL_RGB, GL_UNSIGNED_BYTE,
+                 base_color->data());
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    drawable.has_texture_ = true;
   }
   if (!mesh.triangles.empty()) {
     static_assert(sizeof(std::array<uint32_t, 3>) == 12, "packed triangles");
@@ -138,6 +180,8 @@ Result<MeshPipeline> MeshPipeline::Create() {
   pipeline.point_size_ = pipeline.program_.Uniform("u_point_size");
   pipeline.shading_mode_ = pipeline.program_.Uniform("u_shading_mode");
   pipeline.opacity_ = pipeline.program_.Uniform("u_opacity");
+  pipeline.textured_ = pipeline.program_.Uniform("u_textured");
+  pipeline.base_color_ = pipeline.program_.Uniform("u_base_color");
   return pipeline;
 }
 
@@ -176,16 +220,24 @@ Status MeshPipeline::Draw(const MeshDrawable& mesh, const Eigen::Matrix4d& clip_
   glUniform1f(point_size_, style.point_size_px);
   glUniform1i(shading_mode_, mode);
   glUniform1f(opacity_, std::clamp(style.opacity, 0.0f, 1.0f));
+  glUniform1i(textured_, mesh.has_texture_ ? 1 : 0);
+  glUniform1i(base_color_, 0);
+  if (mesh.has_texture_) {
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, mesh.texture_.get());
+  }
   glBindVertexArray(mesh.vertex_array_.get());
   // Attributes without an array take the current generic value (context state, not VAO state).
   if (!mesh.has_colors_) glVertexAttrib4f(kColor, style.color[0], style.color[1], style.color[2], 1.0f);
   if (!mesh.has_normals_) glVertexAttrib3f(kNormal, 0.0f, 0.0f, 0.0f);
+  if (!mesh.has_texture_) glVertexAttrib2f(kTexcoord, 0.0f, 0.0f);
   if (mesh.is_point_cloud()) {
     glDrawArrays(GL_POINTS, 0, mesh.vertex_count_);
   } else {
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.index_count_), mesh.index_type_, nullptr);
   }
   glBindVertexArray(0);
+  if (mesh.has_texture_) glBindTexture(GL_TEXTURE_2D, 0);
   if (blended) {
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);

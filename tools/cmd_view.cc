@@ -188,7 +188,7 @@ int RunView(int argc, char** argv, int first) {
       return Fail(InvalidArgument("--layer: '" + layer + "' is not as-built, design or deviation"));
     }
   }
-  auto view = ArView::Open(options, model->mesh, design ? &*design : nullptr);
+  auto view = ArView::Open(options, *model, design ? &*design : nullptr);
   if (!view.ok()) return Fail(view.status());
   std::fprintf(stderr, "reconar view: %s\n", (*view)->Describe(model_path).c_str());
   if (project && !project->has_tags) {

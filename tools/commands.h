@@ -10,10 +10,12 @@ int RunSfm(int argc, char** argv, int first);
 int RunTags(int argc, char** argv, int first);
 int RunTrack(int argc, char** argv, int first);
 int RunCalibrate(int argc, char** argv, int first);
-int RunView(int argc, char** argv, int first);  // defined only with RECONAR_HAVE_VIEW
+int RunView(int argc, char** argv, int first);    // defined only with RECONAR_HAVE_VIEW
+int RunRender(int argc, char** argv, int first);  // defined only with RECONAR_HAVE_VIEW
 int RunExport(int argc, char** argv, int first);
 int RunMesh(int argc, char** argv, int first);
 int RunDense(int argc, char** argv, int first);
+int RunTexture(int argc, char** argv, int first);
 int RunReconstruct(int argc, char** argv, int first);
 int RunMap(int argc, char** argv, int first);
 int RunLocalize(int argc, char** argv, int first);

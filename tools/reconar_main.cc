@@ -26,6 +26,7 @@ constexpr char kUsage[] =
     "  measure PROJECT_DIR --distance A B [--json]        distances, areas, heights with their +- (sigma)\n"
     "  compare PROJECT_DIR DESIGN [--control FILE]         as built against its design, element by element\n"
     "  dense PROJECT_DIR                                   dense oriented points (multi-view stereo)\n"
+    "  texture PROJECT_DIR [--exclude NAMES]               the mesh textured from the photos (textured.glb)\n"
     "  mesh POINTS.ply OUT.{ply,obj,glb,wrl} [--depth N]   Poisson surface from oriented points\n"
     "  export IN.{ply,glb,obj} OUT.{ply,obj,glb,wrl}       convert a mesh or point cloud between formats\n"
     "  bundle-adjust --bal FILE [--json]                   solve a BAL bundle adjustment problem\n"
@@ -34,6 +35,7 @@ constexpr char kUsage[] =
     "  track SOURCE --intrinsics K --tag-size M [--json]   6-DoF tag tracking, one line per frame\n"
     "  capture SOURCE PROJECT_DIR [--max-keyframes N]      keyframes from a camera, with advice\n"
     "  view --model M (--camera DEV | --frames DIR) ...    AR overlay: live window or PNGs (--out)\n"
+    "  render PROJECT_DIR IMAGE_NAME... --out DIR          the model drawn from photos' viewpoints\n"
     "  calibrate IMAGES... --tag-size M --out FILE         camera intrinsics from photos of tags\n"
     "\n"
     "exit codes: 0 ok, 1 failed run, 2 bad usage or input\n";
@@ -75,15 +77,16 @@ int main(int argc, char** argv) {
   if (command == "measure") return reconar::tools::RunMeasure(argc, argv, 2);
   if (command == "compare") return reconar::tools::RunCompare(argc, argv, 2);
   if (command == "dense") return reconar::tools::RunDense(argc, argv, 2);
+  if (command == "texture") return reconar::tools::RunTexture(argc, argv, 2);
   if (command == "reconstruct") return reconar::tools::RunReconstruct(argc, argv, 2);
   if (command == "map") return reconar::tools::RunMap(argc, argv, 2);
   if (command == "localize") return reconar::tools::RunLocalize(argc, argv, 2);
   if (command == "capture") return reconar::tools::RunCapture(argc, argv, 2);
-  if (command == "view") {
+  if (command == "view" || command == "render") {
 #ifdef RECONAR_HAVE_VIEW
-    return reconar::tools::RunView(argc, argv, 2);
+    return command == "view" ? reconar::tools::RunView(argc, argv, 2) : reconar::tools::RunRender(argc, argv, 2);
 #else
-    std::fputs("reconar: view needs the GLES renderer; this build has RECONAR_WITH_GLES=OFF\n", stderr);
+    std::fprintf(stderr, "reconar: %s needs the GLES renderer; this build has RECONAR_WITH_GLES=OFF\n", command.c_str());
     return 2;
 #endif
   }

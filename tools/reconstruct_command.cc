@@ -29,7 +29,7 @@ std::set<std::string> ValuedOptions() {
 
 Status ReadStages(const Args& args, ReconstructOptions* options) {
   if (!args.Has("stages")) return Status::Ok();
-  options->run_sparse = options->run_dense = options->run_mesh = false;
+  options->run_sparse = options->run_dense = options->run_mesh = options->run_texture = false;
   for (const std::string& stage : SplitCommas(args.Get("stages"))) {
     if (stage == "sparse") {
       options->run_sparse = true;
@@ -37,8 +37,10 @@ Status ReadStages(const Args& args, ReconstructOptions* options) {
       options->run_dense = true;
     } else if (stage == "mesh") {
       options->run_mesh = true;
+    } else if (stage == "texture") {
+      options->run_mesh = options->run_texture = true;
     } else {
-      return InvalidArgument("--stages: unknown stage '" + stage + "' (sparse, dense, mesh)");
+      return InvalidArgument("--stages: unknown stage '" + stage + "' (sparse, dense, mesh, texture)");
     }
   }
   return Status::Ok();
@@ -175,7 +177,7 @@ int RunReconstructCommand(int argc, char** argv, int first, const char* help, bo
   auto options = ReconstructOptionsFromArgs(args);
   if (!options.ok()) return Fail(options.status());
   if (sparse_only) {
-    options->run_dense = options->run_mesh = false;
+    options->run_dense = options->run_mesh = options->run_texture = false;
     options->render_preview = nullptr;
   }
   auto paths = CollectImagePaths(inputs);

@@ -235,6 +235,7 @@ Status ReconstructOptions::Check() const {
     return InvalidArgument("the maximum reprojection error must be positive");
   RECONAR_RETURN_IF_ERROR(map.Check());
   RECONAR_RETURN_IF_ERROR(dense.Check());
+  RECONAR_RETURN_IF_ERROR(texture.Check());
   return mesh.Check();
 }
 
@@ -432,6 +433,28 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       return Status::Ok();
     };
     RECONAR_RETURN_IF_ERROR(runner.Run("mesh", MeshStageSettings(mesh), Exists(project.MeshDir() + "/report.json"), runner.redone(), run_mesh));
+  }
+
+  if (options.run_mesh && options.run_texture) {
+    TextureStageOptions texture = options.texture;
+    texture.memory_budget_bytes = budget;
+    texture.num_threads = threads;
+    texture.show_progress = options.show_progress;
+    const auto run_texture = [&](StageSummary* summary) -> Status {
+      const Result<TextureStageReport> r = RunTextureStage(project, texture);
+      if (!r.ok()) {
+        summary->note = "not textured: " + r.status().message();
+        std::fprintf(stderr, "warning: the model is not textured: %s\n", r.status().ToString().c_str());
+        return Status::Ok();
+      }
+      summary->peak_rss_bytes = r->peak_rss_bytes;
+      summary->note = std::to_string(r->texture.faces) + " faces, " + std::to_string(r->texture.patches) +
+                      " patches from " + std::to_string(r->texture.photos_used) + " photos";
+      return Status::Ok();
+    };
+    RECONAR_RETURN_IF_ERROR(runner.Run("texture", TextureStageSettings(texture),
+                                       Exists(project.MeshDir() + "/texture_report.json"), runner.redone(),
+                                       run_texture));
   }
 
   // Scale: what tags.json says.

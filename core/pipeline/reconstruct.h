@@ -3,7 +3,7 @@
 // -> tags (AprilTags in the photos, when a tag size is given) -> mapping (incremental SfM with the
 // tag corners in bundle adjustment, then metric registration to the world tag) -> map (the
 // localisation map for markerless AR, map_stage.h; part of the sparse stages) -> dense (CMVS +
-// PMVS) -> mesh (screened Poisson, exports). Every stage writes its outputs atomically and is then
+// PMVS) -> mesh (screened Poisson, exports) -> texture (the mesh textured from the photos). Every stage writes its outputs atomically and is then
 // recorded in PROJECT/stages.txt (stage_record.h) with its settings, so a re-run after an
 // interruption (even SIGKILL) redoes only the stages that had not finished, and gives the same
 // files: every stage is deterministic for any thread count.
@@ -32,6 +32,7 @@
 #include "core/pipeline/mesh_stage.h"
 #include "core/pipeline/project.h"
 #include "core/pipeline/sfm_stage.h"
+#include "core/pipeline/texture_stage.h"
 #include "core/sfm/tag_observations.h"
 
 namespace reconar {
@@ -57,6 +58,10 @@ struct ReconstructOptions {
   ReconstructOptions();
 
   bool run_sparse = true, run_dense = true, run_mesh = true;  // --stages; a stage needs the ones before
+  // After the mesh: the textured model (texture_stage.h). A run that cannot texture (no photo sees
+  // the mesh, a photo that does not decode) says why in the stage's note and keeps the untextured
+  // mesh; it does not fail the run.
+  bool run_texture = true;
   FeatureStageOptions features;
   MatchStageOptions matching;
   // mapper.principal_point, refine_distortion and max_reprojection_error_px (with the equal
@@ -65,6 +70,7 @@ struct ReconstructOptions {
   MapStageOptions map;  // part of the sparse stages
   DenseStageOptions dense;
   MeshStageOptions mesh;
+  TextureStageOptions texture;
   double tag_size_m = 0.0;  // 0: no tags, the model keeps an arbitrary scale
   std::string tag_family = "tag36h11";
   TagDetectorFunction detect_tags;  // required when tag_size_m > 0

@@ -28,7 +28,7 @@ struct StageInputs {
 inline constexpr StageInputs kStageInputs[] = {
     {"features", {nullptr, nullptr}}, {"tags", {"features", nullptr}}, {"matching", {"features", nullptr}},
     {"mapping", {"tags", "matching"}},  {"dense", {"mapping", nullptr}}, {"mesh", {"dense", nullptr}},
-    {"map", {"mapping", nullptr}},
+    {"texture", {"mesh", nullptr}}, {"map", {"mapping", nullptr}},
 };
 
 // A stage off the chain: no other stage reads it (the localisation map).

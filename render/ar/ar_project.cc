@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "core/base/json_reader.h"
+#include "core/io/image_io.h"
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_file.h"
 #include "core/pipeline/project.h"
@@ -41,15 +42,21 @@ bool Exists(const std::string& path) {
 
 }  // namespace
 
+std::string ProjectModelPath(const std::string& dir) {
+  const Project project(dir);
+  const std::string candidates[] = {project.MeshDir() + "/textured.glb", project.MeshDir() + "/mesh.ply",
+                                    project.DensePointsPath(), project.SparseDir() + "/points.ply"};
+  for (const std::string& path : candidates) {
+    if (Exists(path)) return path;
+  }
+  return candidates[std::size(candidates) - 1];
+}
+
 Result<ArProject> LoadArProject(const std::string& dir, const ArProjectOptions& options) {
   const Project project(dir);
   if (!Exists(dir)) return NotFound(dir + ": no such project folder");
   ArProject scene;
-  for (const std::string& path :
-       {project.MeshDir() + "/mesh.ply", project.DensePointsPath(), project.SparseDir() + "/points.ply"}) {
-    scene.model_path = path;
-    if (Exists(path)) break;
-  }
+  scene.model_path = ProjectModelPath(dir);
   std::string no_tags_reason = "no " + project.TagsJsonPath() + ": reconstructed without --tag-size";
   if (Exists(project.TagsJsonPath())) {
     RECONAR_ASSIGN_OR_RETURN(const JsonValue tags, ReadJsonFile(project.TagsJsonPath()));
@@ -119,10 +126,15 @@ Result<CameraIntrinsics> PhotoCameraForFrame(const std::vector<CameraIntrinsics>
 
 namespace {
 
-bool IsGltf(const std::string& path) {
+std::string LowercaseExtensionOf(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+bool IsGltf(const std::string& path) {
+  const std::string extension = LowercaseExtensionOf(path);
   return extension == ".glb" || extension == ".gltf";
 }
 
@@ -130,6 +142,16 @@ bool IsGltf(const std::string& path) {
 
 Result<ArModel> LoadArModel(const std::string& path, size_t max_faces) {
   ArModel model;
+  if (LowercaseExtensionOf(path) == ".glb") {
+    RECONAR_ASSIGN_OR_RETURN(TexturedGlb textured, ReadTexturedGlb(path));
+    if (!textured.base_color_image.empty()) {
+      auto decoded = ReadImageFromMemory(textured.base_color_image, path + ": base colour texture");
+      if (!decoded.ok()) return decoded.status();
+      model.mesh = std::move(textured.mesh);
+      model.base_color = std::move(decoded->rgb);
+      return model;
+    }
+  }
   if (IsGltf(path)) {
     RECONAR_ASSIGN_OR_RETURN(const std::vector<NamedMesh> nodes, ReadGltfScene(path));
     model.mesh = JoinMeshes(nodes);

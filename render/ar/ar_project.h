@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base/image.h"
 #include "core/base/status.h"
 #include "core/math/camera_intrinsics.h"
 #include "core/mesh/mesh.h"
@@ -22,7 +23,8 @@ namespace reconar {
 // the world is then the world tag's frame in metres. Without tags the world is the model's own
 // frame, in its arbitrary units, and the map alone poses the camera.
 struct ArProject {
-  std::string model_path;  // the mesh, else the dense points, else the sparse points
+  // The textured mesh (mesh/textured.glb), else the mesh, else the dense points, else the sparse points.
+  std::string model_path;
   bool has_tags = false;   // tags.json says the model is metric: layout, tag_size and family are set
   // Without tags: why not, and what that means for the poses (one line for the commands to print).
   std::string no_tags_note;
@@ -34,6 +36,10 @@ struct ArProject {
   std::vector<CameraIntrinsics> photo_cameras;
   std::shared_ptr<const LocalizationMap> map;  // PROJECT/map/map.rmap; nullptr when absent or not asked for
 };
+
+// The model a project shows: mesh/textured.glb, else mesh/mesh.ply, else the dense points, else
+// the sparse points (the last when none exists, for the error to name).
+std::string ProjectModelPath(const std::string& dir);
 
 struct ArProjectOptions {
   bool load_map = true;
@@ -54,11 +60,14 @@ Result<CameraIntrinsics> PhotoCameraForFrame(const std::vector<CameraIntrinsics>
 
 struct ArModel {
   Mesh mesh;
+  Image<uint8_t> base_color;  // RGB: the texture of a textured model (mesh.texcoords set); else empty
   std::optional<SimplifyReport> simplified;  // set when the mesh was over the face budget
 };
 
 // The model file (core/mesh/mesh_file.h formats; a glTF scene of several nodes whole, each node
-// in its place), simplified to at most max_faces triangles (0: as it is).
+// in its place), simplified to at most max_faces triangles (0: as it is). A .glb whose first
+// primitive has a base colour texture (mesh/textured.glb) comes with its texture and is not
+// simplified (texturing already sized it; simplifying would tear its charts).
 Result<ArModel> LoadArModel(const std::string& path, size_t max_faces);
 
 // A registered design and the as-built points coloured by their deviation, in the model's frame.

@@ -96,7 +96,7 @@ const char* ArLayerName(ArLayer layer) {
   return "?";
 }
 
-Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const Mesh& model, const ArDesign* design) {
+Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const ArModel& model, const ArDesign* design) {
   if (design == nullptr && options.layer != ArLayer::kAsBuilt) {
     return InvalidArgument(std::string("the ") + ArLayerName(options.layer) + " layer needs a design (reconar compare)");
   }
@@ -120,7 +120,8 @@ Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const
   render_options.height = session->height();
   render_options.samples = options.samples;
   RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<OverlayRenderer> renderer, OverlayRenderer::Create(render_options));
-  RECONAR_ASSIGN_OR_RETURN(MeshDrawable drawable, MeshDrawable::Upload(model));
+  RECONAR_ASSIGN_OR_RETURN(MeshDrawable drawable,
+                           MeshDrawable::Upload(model.mesh, model.base_color.empty() ? nullptr : &model.base_color));
   std::optional<MeshDrawable> design_drawable, deviation_drawable;
   if (design != nullptr) {
     RECONAR_ASSIGN_OR_RETURN(design_drawable, MeshDrawable::Upload(design->design));
@@ -171,8 +172,10 @@ Status ArView::Draw(bool* drawn_model) {
   const Eigen::Matrix4d cam_from_model =
       options_.placement ? CamFromModel(pose.cam_from_world, *options_.placement) : pose.cam_from_world.Matrix();
   const bool deviation_layer = options_.layer == ArLayer::kDeviation && deviation_;
+  MeshStyle model_style = options_.style;
+  if (!deviation_layer && model_.has_texture()) model_style.shading = false;
   RECONAR_RETURN_IF_ERROR(
-      renderer_->DrawMesh(deviation_layer ? *deviation_ : model_, intrinsics, cam_from_model, options_.style));
+      renderer_->DrawMesh(deviation_layer ? *deviation_ : model_, intrinsics, cam_from_model, model_style));
   if (options_.layer != ArLayer::kAsBuilt && design_) {
     MeshStyle design_style = options_.style;
     design_style.opacity = options_.design_opacity;

@@ -72,8 +72,9 @@ class ArView {
   // Creates out_dir, opens the session, the EGL context (surfaceless for PNGs, else a window; no
   // display is FailedPrecondition saying to use --out) and the renderer, and uploads the model.
   // `design` (may be null): the layers kDesign and kDeviation; InvalidArgument when options.layer
-  // asks for one without it.
-  static Result<std::unique_ptr<ArView>> Open(const ArViewOptions& options, const Mesh& model,
+  // asks for one without it. A textured model is drawn with its texture, unlit (the photos
+  // already hold the light).
+  static Result<std::unique_ptr<ArView>> Open(const ArViewOptions& options, const ArModel& model,
                                               const ArDesign* design = nullptr);
   ~ArView();
 

@@ -40,7 +40,10 @@ std::map<std::string, std::string> ProjectFiles(const std::string& project) {
     if (!entry.is_regular_file()) continue;
     const std::string relative = fs::relative(entry.path(), project).string();
     const std::string name = entry.path().filename().string();
-    if (name == "report.json" || name == "preview.png" || name == "stages.txt") continue;
+    // Reports hold seconds; texture_report.json is the texture stage's.
+    if (name == "report.json" || name == "texture_report.json" || name == "preview.png" || name == "stages.txt") {
+      continue;
+    }
     auto text = ReadFileToString(entry.path().string());
     files[relative] = text.ok() ? *text : "(unreadable)";
   }
@@ -58,7 +61,8 @@ TEST(ReconstructCli, KilledRunsResumeToTheSameFiles) {
   ASSERT_EQ(reference.exit_code, 0) << reference.output;
   const auto expected = ProjectFiles(dir + "/reference");
   ASSERT_TRUE(expected.count("mesh/mesh.glb") && expected.count("dense/points.ply") &&
-              expected.count("sparse/points3D.txt"));
+              expected.count("sparse/points3D.txt") && expected.count("mesh/textured.glb") &&
+              expected.count("mesh/textured.png"));
   auto mesh_report = ReadJsonFile(dir + "/reference/mesh/report.json");
   ASSERT_TRUE(mesh_report.ok()) << mesh_report.status().ToString();
   EXPECT_TRUE(mesh_report->Find("simplified")->bool_value());

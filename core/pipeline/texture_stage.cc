@@ -1,0 +1,183 @@
+#include "core/pipeline/texture_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "core/base/atomic_file.h"
+#include "core/base/fnv_hash.h"
+#include "core/base/json_writer.h"
+#include "core/base/memory_usage.h"
+#include "core/io/image_io.h"
+#include "core/io/image_write.h"
+#include "core/mesh/glb_io.h"
+#include "core/mesh/mesh_file.h"
+#include "core/mesh/obj_io.h"
+#include "core/mesh/simplify.h"
+#include "core/pipeline/project_lock.h"
+#include "core/pipeline/stage_record.h"
+#include "core/sfm/model_io.h"
+
+namespace reconar {
+namespace {
+
+double Mib(size_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
+
+// The mesh stage's mesh in the first readable format it wrote.
+Result<std::string> ProjectMeshPath(const Project& project) {
+  for (const char* format : {"ply", "glb", "obj"}) {
+    const std::string path = project.MeshDir() + "/mesh." + format;
+    if (std::filesystem::exists(path)) return path;
+  }
+  return FailedPrecondition(project.MeshDir() + ": no mesh (mesh.ply, .glb or .obj); run the mesh stage first");
+}
+
+}  // namespace
+
+Status TextureStageOptions::Check() const {
+  RECONAR_RETURN_IF_ERROR(texture.Check());
+  if (memory_budget_bytes == 0) return InvalidArgument("texture: the memory budget must be positive");
+  return Status::Ok();
+}
+
+std::string TextureStageSettings(const TextureStageOptions& options) {
+  std::vector<std::string> exclude = options.exclude;
+  std::sort(exclude.begin(), exclude.end());
+  Fnv1a64 hash;
+  for (const std::string& name : exclude) {
+    hash.Add(name);
+    hash.Add("/");
+  }
+  // 40 bits of the digest: exact in the record's 12 significant digits.
+  return StageRecord::Settings({{"version", 1},
+                                {"max_faces", static_cast<double>(options.max_faces)},
+                                {"atlas_size", options.texture.atlas_size},
+                                {"exclude", static_cast<double>(hash.value() >> 24)}});
+}
+
+Result<TextureStageReport> RunTextureStage(const Project& project, const TextureStageOptions& options) {
+  RECONAR_RETURN_IF_ERROR(options.Check());
+  RECONAR_ASSIGN_OR_RETURN(const ProjectLock lock, LockProject(project));
+  const auto start = std::chrono::steady_clock::now();
+  ResetPeakResidentBytes();
+  TextureStageReport report;
+  RECONAR_ASSIGN_OR_RETURN(report.mesh_path, ProjectMeshPath(project));
+  RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(project.SparseDir()));
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<ProjectImage> list, project.ReadImageList());
+  std::map<std::string, std::string> path_of;
+  for (const ProjectImage& image : list) path_of[image.name] = image.path;
+
+  std::set<std::string> registered;
+  for (const SfmImage& image : model.images) {
+    if (image.registered) registered.insert(image.name);
+  }
+  for (const std::string& name : options.exclude) {
+    if (registered.count(name) == 0) {
+      return InvalidArgument("texture: --exclude " + name + " is not a registered photo of " + project.root());
+    }
+  }
+  report.excluded = options.exclude;
+  const std::set<std::string> excluded(options.exclude.begin(), options.exclude.end());
+
+  std::vector<TexturePhoto> photos;
+  std::vector<std::string> paths;
+  for (const SfmImage& image : model.images) {
+    if (!image.registered || excluded.count(image.name) != 0) continue;
+    const auto it = path_of.find(image.name);
+    if (it == path_of.end() || !ReadImageHeader(it->second).ok()) {
+      const std::string reason = it == path_of.end() ? "not in " + project.ImageListPath()
+                                                     : ReadImageHeader(it->second).status().ToString();
+      std::fprintf(stderr, "warning: texture: photo %s left out: %s\n", image.name.c_str(), reason.c_str());
+      report.unreadable.push_back(image.name);
+      continue;
+    }
+    TexturePhoto photo;
+    photo.name = image.name;
+    photo.camera = model.cameras[static_cast<size_t>(image.camera_id)];
+    photo.cam_from_world = image.cam_from_world;
+    photos.push_back(photo);
+    paths.push_back(it->second);
+  }
+  if (photos.empty()) return FailedPrecondition("texture: no registered photo to texture from");
+
+  RECONAR_ASSIGN_OR_RETURN(Mesh mesh, ReadMeshFile(report.mesh_path));
+  if (mesh.triangles.empty()) return FailedPrecondition(report.mesh_path + ": no triangles to texture");
+  report.faces_in = mesh.triangles.size();
+  RECONAR_ASSIGN_OR_RETURN(const SimplifyReport simplify, SimplifyToFaceBudget(options.max_faces, &mesh));
+  report.simplified = simplify.simplified;
+
+  TextureOptions texture = options.texture;
+  texture.memory_budget_bytes = options.memory_budget_bytes;
+  texture.num_threads = options.num_threads;
+  texture.show_progress = options.show_progress;
+  const PhotoLoader load = [&](size_t index) -> Result<Image<uint8_t>> {
+    RECONAR_ASSIGN_OR_RETURN(DecodedImage decoded, ReadImage(paths[index]));
+    return std::move(decoded.rgb);
+  };
+  RECONAR_ASSIGN_OR_RETURN(const TexturedMesh textured, TextureMesh(mesh, photos, load, texture, &report.texture));
+
+  RECONAR_RETURN_IF_ERROR(CreateDirectories(project.MeshDir()));
+  const std::string png_path = project.MeshDir() + "/textured.png";
+  RECONAR_ASSIGN_OR_RETURN(const std::string png, EncodePng(textured.atlas.view(), 3));
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(png_path, png));
+  const std::string obj_path = project.MeshDir() + "/textured.obj";
+  RECONAR_RETURN_IF_ERROR(WriteTexturedObj(obj_path, textured.mesh, "textured.png"));
+  const std::string glb_path = TexturedModelPath(project);
+  RECONAR_RETURN_IF_ERROR(WriteTexturedGlb(glb_path, textured.mesh, png));
+  report.paths = {glb_path, obj_path, project.MeshDir() + "/textured.mtl", png_path};
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.peak_rss_bytes = PeakResidentBytes();
+  report.report_path = project.MeshDir() + "/texture_report.json";
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, TextureReportJson(report)));
+  return report;
+}
+
+std::string TextureReportJson(const TextureStageReport& report) {
+  const TextureReport& t = report.texture;
+  JsonWriter json(2);
+  json.BeginObject();
+  json.Key("mesh").String(report.mesh_path);
+  json.Key("faces_in").Int(static_cast<long long>(report.faces_in));
+  json.Key("simplified").Bool(report.simplified);
+  json.Key("faces").Int(static_cast<long long>(t.faces));
+  json.Key("photos").Int(static_cast<long long>(t.photos));
+  json.Key("photos_used").Int(static_cast<long long>(t.photos_used));
+  json.Key("excluded").BeginArray();
+  for (const std::string& name : report.excluded) json.String(name);
+  json.EndArray();
+  json.Key("unreadable").BeginArray();
+  for (const std::string& name : report.unreadable) json.String(name);
+  json.EndArray();
+  json.Key("candidates").Int(static_cast<long long>(t.candidates));
+  json.Key("inconsistent_candidates").Int(static_cast<long long>(t.inconsistent_candidates));
+  json.Key("exposure_gain_min").Double(t.min_gain).Key("exposure_gain_max").Double(t.max_gain);
+  json.Key("textured_faces").Int(static_cast<long long>(t.textured_faces));
+  json.Key("untextured_faces").Int(static_cast<long long>(t.untextured_faces));
+  json.Key("patches").Int(static_cast<long long>(t.patches));
+  json.Key("labelling_sweeps").Int(t.labelling_sweeps);
+  json.Key("labelling_energy_start").Double(t.labelling_energy_start);
+  json.Key("labelling_energy_end").Double(t.labelling_energy_end);
+  json.Key("seam_edges").Int(static_cast<long long>(t.seam_edges));
+  json.Key("seam_step_before").Double(t.seam_step_before);
+  json.Key("seam_step_after").Double(t.seam_step_after);
+  json.Key("atlas_width").Int(t.atlas_width).Key("atlas_height").Int(t.atlas_height);
+  json.Key("texels_per_pixel").Double(t.texels_per_pixel);
+  json.Key("atlas_fill").Double(t.atlas_fill);
+  json.Key("photos_kept_decoded").Bool(t.photos_kept_decoded);
+  json.Key("seconds_candidates").Double(t.seconds_candidates);
+  json.Key("seconds_labelling").Double(t.seconds_labelling);
+  json.Key("seconds_seams").Double(t.seconds_seams);
+  json.Key("seconds_atlas").Double(t.seconds_atlas);
+  json.Key("seconds").Double(report.seconds);
+  json.Key("peak_rss_mib").Double(Mib(report.peak_rss_bytes));
+  json.Key("files").BeginArray();
+  for (const std::string& path : report.paths) json.String(path);
+  json.EndArray();
+  json.EndObject();
+  return json.str();
+}
+
+}  // namespace reconar

@@ -1,0 +1,38 @@
+#pragma once
+// `reconar render PROJECT IMAGE_NAME... --out DIR [--model PATH]`: a model drawn alone from the
+// viewpoint of registered photos, for reports and for measuring a texture against the photos.
+//
+// For each named photo, with its camera undistorted (the same focal, principal point and size,
+// no radial distortion): DIR/NAME.png, the model drawn unlit (its texture or vertex colours as
+// they are) on black; DIR/NAME.mask.png, white where the model covers the pixel (the pixels whose
+// colour does not change with the background's: no anti-aliasing, so the mask is exact);
+// DIR/NAME.photo.png, the photo itself undistorted to that camera (core/mvs/undistort.h), to
+// compare with. Every file is written atomically.
+#include <string>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/base/status.h"
+
+namespace reconar {
+
+struct PhotoRenderOptions {
+  std::vector<std::string> image_names;
+  std::string out_dir;
+  std::string model_path;  // empty: the project's (mesh/textured.glb, else mesh/mesh.ply)
+  bool write_photos = true;
+};
+
+struct PhotoRenderReport {
+  std::string model_path;
+  bool textured = false;
+  size_t faces = 0;
+  std::vector<std::string> written;  // NAME.png of each photo
+  std::vector<double> coverage;      // per photo: the fraction of its pixels the model covers
+};
+
+// InvalidArgument naming a photo that is not a registered photo of the project; file errors of
+// the project, the model and the photos; FailedPrecondition without a display driver (EGL).
+Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const PhotoRenderOptions& options);
+
+}  // namespace reconar
