@@ -18,6 +18,8 @@ constexpr char kHelp[] =
     "  .ply   Stanford PLY, binary little-endian (ASCII with --ascii)\n"
     "  .obj   Wavefront OBJ, colours as 'v x y z r g b' (no alpha)\n"
     "  .glb   glTF 2.0 binary (normals must be unit length)\n"
+    "A textured .glb (mesh/textured.glb of `reconar texture`) keeps its texture into .glb, and into\n"
+    "  .obj with .mtl and the texture as OUTPUT's name with .png; .ply and .wrl drop it.\n"
     "  .wrl   VRML 2.0 IndexedFaceSet, or PointSet for a point cloud (write only)\n"
     "The output is written atomically; missing parent directories are created.\n"
     "  --max-faces N  simplify a mesh of more triangles to N (quadric edge collapse; borders and\n"
@@ -50,6 +52,7 @@ int RunExport(int argc, char** argv, int first) {
     json.Key("triangles_read").Int(static_cast<long long>(r.triangles_read));
     json.Key("seconds_simplify").Double(r.simplify.seconds);
     json.Key("normals").Bool(r.normals).Key("colors").Bool(r.colors);
+    json.Key("textured").Bool(r.textured && !r.texture_dropped);
     json.Key("bytes").Int(static_cast<long long>(r.bytes));
     json.Key("seconds_read").Double(r.seconds_read).Key("seconds_write").Double(r.seconds_write);
     json.EndObject();
@@ -63,6 +66,8 @@ int RunExport(int argc, char** argv, int first) {
   }
   std::printf("wrote %s: %ju bytes (read %.2fs, write %.2fs)\n", output.c_str(), r.bytes, r.seconds_read,
               r.seconds_write);
+  if (!r.texture_path.empty()) std::printf("wrote %s: its texture\n", r.texture_path.c_str());
+  if (r.texture_dropped) std::printf("note: %s holds no texture; the texture was left out\n", output.c_str());
   return 0;
 }
 

@@ -4,6 +4,8 @@
 #include <filesystem>
 
 #include "core/base/atomic_file.h"
+#include "core/mesh/glb_io.h"
+#include "core/mesh/obj_io.h"
 
 namespace reconar {
 namespace {
@@ -12,29 +14,62 @@ double SecondsBetween(std::chrono::steady_clock::time_point a, std::chrono::stea
   return std::chrono::duration<double>(b - a).count();
 }
 
+bool IsPng(const std::string& bytes) { return bytes.rfind(std::string("\x89PNG\r\n\x1a\n", 8), 0) == 0; }
+
 }  // namespace
 
 Result<MeshConversionReport> ConvertMeshFile(const std::string& input, const std::string& output,
                                              const MeshConversionOptions& options) {
-  RECONAR_RETURN_IF_ERROR(ReadableMeshFileFormatOf(input).status());
+  RECONAR_ASSIGN_OR_RETURN(const MeshFileFormat input_format, ReadableMeshFileFormatOf(input));
   RECONAR_ASSIGN_OR_RETURN(const MeshFileFormat output_format, MeshFileFormatOf(output));
   if (options.file.ply_ascii && output_format != MeshFileFormat::kPly) {
     return InvalidArgument(output + ": --ascii applies only to .ply output");
   }
   MeshConversionReport report;
   const auto start = std::chrono::steady_clock::now();
-  RECONAR_ASSIGN_OR_RETURN(Mesh mesh, ReadMeshFile(input));
+  Mesh mesh;
+  std::string texture_png;
+  if (input_format == MeshFileFormat::kGlb) {
+    RECONAR_ASSIGN_OR_RETURN(TexturedGlb textured, ReadTexturedGlb(input));
+    mesh = std::move(textured.mesh);
+    if (IsPng(textured.base_color_image)) {
+      texture_png = std::move(textured.base_color_image);
+    } else {
+      mesh.texcoords.clear();  // a JPEG texture (another tool's) is not carried over
+    }
+  } else {
+    RECONAR_ASSIGN_OR_RETURN(mesh, ReadMeshFile(input));
+  }
   const auto read = std::chrono::steady_clock::now();
   report.seconds_read = SecondsBetween(start, read);
   report.vertices_read = mesh.positions.size();
   report.triangles_read = mesh.triangles.size();
+  report.textured = !texture_png.empty();
+  if (report.textured && options.max_faces > 0 && mesh.triangles.size() > options.max_faces) {
+    return FileError(StatusCode::kInvalidArgument, input,
+                     "a textured model is not simplified (its texture charts would tear): export it without "
+                     "--max-faces, or texture the project again with `reconar texture PROJECT --max-faces N`");
+  }
   Result<SimplifyReport> simplified = SimplifyToFaceBudget(options.max_faces, &mesh);
   if (!simplified.ok()) return simplified.status().WithContext(input);
   report.simplify = *simplified;
   const auto write = std::chrono::steady_clock::now();
   const std::string parent = std::filesystem::path(output).parent_path().string();
   if (!parent.empty()) RECONAR_RETURN_IF_ERROR(CreateDirectories(parent));
-  RECONAR_RETURN_IF_ERROR(WriteMeshFile(output, mesh, options.file));
+  if (report.textured && output_format == MeshFileFormat::kGlb) {
+    RECONAR_RETURN_IF_ERROR(WriteTexturedGlb(output, mesh, texture_png));
+  } else if (report.textured && output_format == MeshFileFormat::kObj) {
+    // The texture beside the OBJ, named after it, as its material library names it.
+    const std::filesystem::path obj(output);
+    const std::string texture_name = obj.stem().string() + ".png";
+    report.texture_path = (obj.parent_path() / texture_name).string();
+    RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.texture_path, texture_png));
+    RECONAR_RETURN_IF_ERROR(WriteTexturedObj(output, mesh, texture_name));
+  } else {
+    report.texture_dropped = report.textured;
+    mesh.texcoords.clear();
+    RECONAR_RETURN_IF_ERROR(WriteMeshFile(output, mesh, options.file));
+  }
   report.seconds_write = SecondsBetween(write, std::chrono::steady_clock::now());
   report.vertices = mesh.positions.size();
   report.triangles = mesh.triangles.size();

@@ -126,15 +126,10 @@ Result<CameraIntrinsics> PhotoCameraForFrame(const std::vector<CameraIntrinsics>
 
 namespace {
 
-std::string LowercaseExtensionOf(const std::string& path) {
+bool IsGltf(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
-}
-
-bool IsGltf(const std::string& path) {
-  const std::string extension = LowercaseExtensionOf(path);
   return extension == ".glb" || extension == ".gltf";
 }
 
@@ -142,7 +137,7 @@ bool IsGltf(const std::string& path) {
 
 Result<ArModel> LoadArModel(const std::string& path, size_t max_faces) {
   ArModel model;
-  if (LowercaseExtensionOf(path) == ".glb") {
+  if (const auto format = MeshFileFormatOf(path); format.ok() && *format == MeshFileFormat::kGlb) {
     RECONAR_ASSIGN_OR_RETURN(TexturedGlb textured, ReadTexturedGlb(path));
     if (!textured.base_color_image.empty()) {
       auto decoded = ReadImageFromMemory(textured.base_color_image, path + ": base colour texture");
