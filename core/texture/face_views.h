@@ -64,6 +64,7 @@ struct FaceCandidate {
   float sharpness = 0.0f;  // the photo's mean smoothed gradient magnitude at the face
   float quality = 0.0f;    // the data term's (view_labelling.h); the area until weighed
   std::array<float, 3> colour = {0.0f, 0.0f, 0.0f};
+  float colour_distance = 0.0f;  // from the median colour of the face's candidates (view_labelling.h)
 };
 
 // Buffers one thread reuses from photo to photo.

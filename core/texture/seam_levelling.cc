@@ -12,7 +12,7 @@
 namespace reconar {
 namespace {
 
-constexpr double kOffsetPrior = 0.1;  // against one sample's unit weight
+constexpr double kConsensusWeight = 0.1;  // per face, against one seam sample's unit weight
 constexpr double kHuberColour = 10.0; // RGB levels
 constexpr float kMaxVertexMove = 64.0f;
 
@@ -47,16 +47,21 @@ struct SeamSample {
   Eigen::Vector3f colour_a, colour_b;
 };
 
-std::vector<Eigen::Vector3f> SolvePatchOffsets(size_t num_patches, const std::vector<SeamSample>& samples) {
+std::vector<Eigen::Vector3f> SolvePatchOffsets(size_t num_patches, const std::vector<SeamSample>& samples,
+                                               const PatchConsensus& consensus) {
   std::vector<Eigen::Vector3f> offsets(num_patches, Eigen::Vector3f::Zero());
-  if (samples.empty()) return offsets;
   std::vector<double> weights(samples.size(), 1.0);
   const int n = static_cast<int>(num_patches);
   for (int round = 0; round < 3; ++round) {
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(4 * samples.size() + num_patches);
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 3);
-    for (int p = 0; p < n; ++p) triplets.emplace_back(p, p, kOffsetPrior);
+    for (int p = 0; p < n; ++p) {
+      const size_t faces = std::max<size_t>(1, consensus.faces[static_cast<size_t>(p)]);
+      const double weight = kConsensusWeight * static_cast<double>(faces);
+      triplets.emplace_back(p, p, weight);
+      rhs.row(p) += weight * consensus.offset[static_cast<size_t>(p)].cast<double>().transpose();
+    }
     for (size_t k = 0; k < samples.size(); ++k) {
       const SeamSample& s = samples[k];
       const double w = weights[k];
@@ -133,7 +138,7 @@ std::vector<SeamEdge> FindSeamEdges(const Mesh& mesh, const TexturePatches& patc
 PatchColourCorrection LevelSeams(const Mesh& mesh, const TexturePatches& patches, const std::vector<SeamEdge>& edges,
                                  const std::vector<PhotoProjector>& projectors,
                                  const std::vector<ReducedPhoto>& reduced, const std::vector<Eigen::Vector3f>& gains,
-                                 int blend_rings) {
+                                 const PatchConsensus& consensus, int blend_rings) {
   const size_t num_patches = patches.photo.size();
   PatchColourCorrection correction = NoCorrection(num_patches);
   const ColourSampler sampler(projectors, reduced, gains);
@@ -163,7 +168,7 @@ PatchColourCorrection LevelSeams(const Mesh& mesh, const TexturePatches& patches
   }
 
   {
-    correction.patch_offset = SolvePatchOffsets(num_patches, samples);
+    correction.patch_offset = SolvePatchOffsets(num_patches, samples, consensus);
     // Local: each seam vertex's patches meet at their mean corrected colour.
     std::unordered_map<uint32_t, std::vector<std::pair<int, Eigen::Vector3f>>> at_vertex;
     for (const SeamSample& s : samples) {

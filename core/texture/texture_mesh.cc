@@ -139,7 +139,8 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
   phase = std::chrono::steady_clock::now();
   const std::vector<SeamEdge> seam_edges = FindSeamEdges(mesh, patches, neighbours);
   const PatchColourCorrection correction =
-      options.level_seams ? LevelSeams(mesh, patches, seam_edges, projectors, reduced, gains, options.blend_rings)
+      options.level_seams ? LevelSeams(mesh, patches, seam_edges, projectors, reduced, gains,
+                                       FindPatchConsensus(table, patches), options.blend_rings)
                           : NoCorrection(patches.photo.size());
   reduced.clear();
   report->seconds_seams = SecondsSince(phase);

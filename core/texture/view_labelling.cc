@@ -61,18 +61,26 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
     }
   }
   std::vector<Eigen::Vector3f> gains(num_photos, Eigen::Vector3f::Ones());
-  Eigen::Vector3d log_sum = Eigen::Vector3d::Zero();
   for (size_t p = 0; p < num_photos; ++p) {
     for (size_t c = 0; c < 3; ++c) {
       if (ratios[p][c].empty()) continue;
       const float ratio = MedianInPlace(ratios[p][c].data(), ratios[p][c].size());
       if (ratio > 0.0f) gains[p][static_cast<int>(c)] = 1.0f / ratio;
     }
-    log_sum += gains[p].cast<double>().array().log().matrix();
   }
-  if (num_photos > 0) {
-    const Eigen::Vector3f scale = (-log_sum / static_cast<double>(num_photos)).array().exp().matrix().cast<float>();
-    for (Eigen::Vector3f& gain : gains) gain = gain.cwiseProduct(scale);
+  // One common scale keeps the mean colour of all the candidates as the photos show it.
+  Eigen::Vector3d observed = Eigen::Vector3d::Zero(), levelled = Eigen::Vector3d::Zero();
+  for (const FaceCandidate& candidate : table.candidates) {
+    const Eigen::Vector3f& gain = gains[static_cast<size_t>(candidate.photo)];
+    for (int c = 0; c < 3; ++c) {
+      observed[c] += candidate.colour[static_cast<size_t>(c)];
+      levelled[c] += gain[c] * candidate.colour[static_cast<size_t>(c)];
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (levelled[c] <= 0.0) continue;
+    const float scale = static_cast<float>(observed[c] / levelled[c]);
+    for (Eigen::Vector3f& gain : gains) gain[c] *= scale;
   }
   return gains;
 }
@@ -93,7 +101,8 @@ void WeighCandidates(FaceCandidateTable* table) {
     for (size_t k = table->begin[f]; k < table->begin[f + 1]; ++k) {
       FaceCandidate& candidate = table->candidates[k];
       const float ratio = median > 0.0f ? std::min(1.0f, candidate.sharpness / median) : 1.0f;
-      candidate.quality = candidate.area * ratio;
+      const float off_consensus = candidate.colour_distance / kMinColourDistance;
+      candidate.quality = candidate.area * ratio / (1.0f + off_consensus * off_consensus);
     }
   }
 }
@@ -126,13 +135,14 @@ size_t DropInconsistentCandidates(FaceCandidateTable* table) {
       limit = std::max(kMinColourDistance, 3.0f * spread);
     }
     for (size_t k = begin; k < end; ++k) {
-      const FaceCandidate candidate = table->candidates[k];
+      FaceCandidate candidate = table->candidates[k];
       const auto& colour = candidate.colour;
       const float distance = count >= 3 ? std::sqrt((colour[0] - median[0]) * (colour[0] - median[0]) +
                                                     (colour[1] - median[1]) * (colour[1] - median[1]) +
                                                     (colour[2] - median[2]) * (colour[2] - median[2]))
                                         : 0.0f;
       if (distance <= limit) {
+        candidate.colour_distance = distance;
         table->candidates[kept++] = candidate;
       } else {
         ++dropped;
@@ -262,6 +272,33 @@ size_t MergeSmallPatches(const FaceCandidateTable& table, const std::vector<std:
     }
   }
   return changed;
+}
+
+PatchConsensus FindPatchConsensus(const FaceCandidateTable& table, const TexturePatches& patches) {
+  PatchConsensus consensus;
+  consensus.offset.assign(patches.photo.size(), Eigen::Vector3f::Zero());
+  consensus.faces.assign(patches.photo.size(), 0);
+  std::vector<float> channel;
+  for (size_t p = 0; p < patches.photo.size(); ++p) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const int face : patches.faces[p]) {
+      const size_t begin = table.begin[static_cast<size_t>(face)], end = table.begin[static_cast<size_t>(face) + 1];
+      if (end - begin < 3) continue;
+      const FaceCandidate* chosen = nullptr;
+      for (size_t k = begin; k < end; ++k) {
+        if (table.candidates[k].photo == patches.photo[p]) chosen = &table.candidates[k];
+      }
+      if (chosen == nullptr) continue;
+      for (size_t c = 0; c < 3; ++c) {
+        channel.clear();
+        for (size_t k = begin; k < end; ++k) channel.push_back(table.candidates[k].colour[c]);
+        sum[static_cast<int>(c)] += MedianInPlace(channel.data(), channel.size()) - chosen->colour[c];
+      }
+      ++consensus.faces[p];
+    }
+    if (consensus.faces[p] > 0) consensus.offset[p] = (sum / static_cast<double>(consensus.faces[p])).cast<float>();
+  }
+  return consensus;
 }
 
 }  // namespace reconar

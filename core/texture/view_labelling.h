@@ -12,6 +12,11 @@
 // face the texture is the same, so a gradient that differs comes from blur (lower) or from an
 // occlusion edge or a highlight crossing the face (higher): the ratio, capped at 1, penalises a
 // blurred view without rewarding a face seen against its silhouette.
+// It is divided by 1 + (d / kMinColourDistance)^2, d the distance of the candidate's colour from
+// the median of the face's candidates: where the photos disagree about a face (the mesh is not
+// where the surface is: Poisson's skirts past a wall's edge, thin parts inflated), each photo
+// shows whatever lies behind, and the one nearest to what most show is the least wrong from a
+// viewpoint no photo had.
 //
 // Labelling: minimises E = sum over faces of (1 - quality / the face's best quality) plus
 // `smoothness` for every edge whose two faces take different photos, by iterated conditional
@@ -45,8 +50,7 @@ FaceCandidateTable GroupByFace(size_t num_faces, const std::vector<std::vector<F
 // which a texture made of several photos shows as patches of another brightness. Each photo gets
 // a gain per channel: the inverse of the median, over the faces it sees with others, of its
 // colour there over the median colour of the face's candidates (faces darker than
-// kMinGainColour left out), scaled so that the gains' geometric mean is 1 (the photos' mean
-// exposure is kept). Candidate colours are multiplied by their photo's gain; so are the seam
+// kMinGainColour left out), scaled so that the mean colour of all the candidates is kept. Candidate colours are multiplied by their photo's gain; so are the seam
 // samples and the texels.
 inline constexpr float kMinGainColour = 16.0f;
 std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table, size_t num_photos);
@@ -85,5 +89,16 @@ TexturePatches FindPatches(const std::vector<int>& labels, const std::vector<std
 // padding in the atlas and a seam. Returns how many faces changed.
 size_t MergeSmallPatches(const FaceCandidateTable& table, const std::vector<std::array<int, 3>>& neighbours,
                          size_t min_faces, std::vector<int>* labels);
+
+// How far each patch's photo stands from what all the photos that see the patch agree on: per
+// patch, the mean over its faces seen by three photos or more of (the median of the face's
+// candidate colours - the colour of the face in the patch's photo), and how many faces that is.
+// One photo's colour is its exposure and its tone mapping of the moment; the median of several is
+// closer to what another photo of the place shows (seam_levelling.h pulls the patch towards it).
+struct PatchConsensus {
+  std::vector<Eigen::Vector3f> offset;  // per patch
+  std::vector<size_t> faces;            // per patch
+};
+PatchConsensus FindPatchConsensus(const FaceCandidateTable& table, const TexturePatches& patches);
 
 }  // namespace reconar
