@@ -3,8 +3,9 @@
 // rendered offscreen (surfaceless EGL, GLES 3), tiled into one image. Used for the picture that
 // `reconar reconstruct` leaves in the project, and for looking at reconstructions in bench/.
 //
-// WriteModelPreview is the picture of a project: five views on a ring and one from above, 480 x 360
-// each, tiled three to a row into a PNG.
+// WritePreview is the picture of a project: five views on a ring and one from above, 480 x 360
+// each, tiled three to a row into a PNG. A textured model is drawn unlit (the photos' light is in
+// its texture), any other with a headlight.
 //
 // Framing: the 1st..99th percentile box of the vertices per axis (a few stray points do not shrink
 // the object to a dot); its bounding sphere fills 90 % of the shorter side of each view.
@@ -34,14 +35,16 @@ struct PreviewOptions {
   Status Check() const;
 };
 
-// One RGB image per direction. Errors: bad options, an empty mesh, no EGL display or GLES context.
-Result<std::vector<Image<uint8_t>>> RenderPreviewViews(const Mesh& mesh, const PreviewOptions& options);
+// One RGB image per direction. `base_color`: the texture of a mesh with texcoords, or null.
+// Errors: bad options, an empty mesh, no EGL display or GLES context.
+Result<std::vector<Image<uint8_t>>> RenderPreviewViews(const Mesh& mesh, const PreviewOptions& options,
+                                                       const Image<uint8_t>* base_color = nullptr);
 
 // The views side by side, `columns` per row (all the same size), black where a row is short.
 Image<uint8_t> TileImages(const std::vector<Image<uint8_t>>& views, int columns);
 
-// The mesh or points of `model_path` (.ply, .obj, .glb) seen around `up`, written to `png_path`
-// (the PreviewFunction of core/pipeline/reconstruct.h). Errors name the file.
-Status WriteModelPreview(const std::string& model_path, const Eigen::Vector3d& up, const std::string& png_path);
+// The mesh or points (with their texture, or null) seen around `up`, written to `png_path`.
+Status WritePreview(const Mesh& mesh, const Image<uint8_t>* base_color, const Eigen::Vector3d& up,
+                    const std::string& png_path);
 
 }  // namespace reconar

@@ -4,6 +4,7 @@
 #include <set>
 #include <string>
 
+#include "core/base/memory_usage.h"
 #include "core/pipeline/dense_stage.h"
 #include "tools/args.h"
 #include "tools/commands.h"
@@ -42,7 +43,6 @@ bool IsDirectory(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-double Mib(size_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
 
 void PrintSummary(const DenseStageReport& r) {
   std::printf("dense: level %d (%s), %d of %d images kept (%d redundant), %d clusters of at most %d images%s\n",

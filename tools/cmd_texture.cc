@@ -2,6 +2,7 @@
 #include <set>
 #include <string>
 
+#include "core/base/memory_usage.h"
 #include "core/pipeline/texture_stage.h"
 #include "tools/args.h"
 #include "tools/commands.h"
@@ -40,7 +41,7 @@ void PrintSummary(const TextureStageReport& r) {
               t.texels_per_pixel, 100.0 * t.atlas_fill);
   std::printf("texture: %.1fs (views %.1fs, labels %.1fs, seams %.1fs, atlas %.1fs), peak %.0f MiB\n", r.seconds,
               t.seconds_candidates, t.seconds_labelling, t.seconds_seams, t.seconds_atlas,
-              static_cast<double>(r.peak_rss_bytes) / (1 << 20));
+              Mib(r.peak_rss_bytes));
   std::printf("texture: written %s and %s\n", r.paths.empty() ? "" : r.paths[0].c_str(), r.report_path.c_str());
 }
 

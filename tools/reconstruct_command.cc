@@ -4,11 +4,12 @@
 #include <string>
 
 #include "core/base/atomic_file.h"
+#include "core/base/memory_usage.h"
 #include "core/sfm/tag_layout.h"
 #include "tools/commands.h"
 #include "tracker/photo_tags.h"
 #ifdef RECONAR_HAVE_VIEW
-#include "render/preview.h"
+#include "render/ar/photo_render.h"
 #endif
 
 namespace reconar::tools {
@@ -147,7 +148,7 @@ namespace {
 void PrintReport(const ReconstructReport& report, const Project& project) {
   for (const StageSummary& stage : report.stages) {
     std::printf("%-9s %s %7.1fs  peak %6.0f MiB%s%s\n", stage.name.c_str(), stage.reused ? "reused " : "done   ",
-                stage.seconds, static_cast<double>(stage.peak_rss_bytes) / (1 << 20), stage.note.empty() ? "" : "  ",
+                stage.seconds, Mib(stage.peak_rss_bytes), stage.note.empty() ? "" : "  ",
                 stage.note.c_str());
   }
   const Table1& t = report.table1;

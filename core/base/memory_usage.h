@@ -27,4 +27,7 @@ bool ResetPeakResidentBytes();
 // allocates. No-op elsewhere.
 void ReleaseFreeHeapMemory();
 
+// Bytes in MiB, as reports print them.
+inline double Mib(size_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
+
 }  // namespace reconar

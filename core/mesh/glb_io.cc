@@ -312,9 +312,13 @@ Result<std::string> EncodeGlb(const Mesh& mesh) { return EncodeScene({{std::stri
 
 Status WriteGlb(const std::string& path, const Mesh& mesh) { return WriteEncodedGlb(path, EncodeGlb(mesh)); }
 
+bool IsPngSignature(std::string_view bytes) {
+  return bytes.substr(0, 8) == std::string_view("\x89PNG\r\n\x1a\n", 8);
+}
+
 Result<std::string> EncodeTexturedGlb(const Mesh& mesh, std::string_view base_color_png) {
   if (mesh.texcoords.empty()) return InvalidArgument("mesh: no texture coordinates for the texture");
-  if (base_color_png.size() < 8 || base_color_png.substr(0, 8) != std::string_view("\x89PNG\r\n\x1a\n", 8)) {
+  if (!IsPngSignature(base_color_png)) {
     return InvalidArgument("mesh: the base colour texture is not a PNG");
   }
   return EncodeScene({{std::string_view(), &mesh}}, base_color_png);

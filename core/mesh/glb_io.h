@@ -48,6 +48,9 @@ Status WriteGlb(const std::string& path, const Mesh& mesh);
 Result<Mesh> DecodeGlb(std::string_view bytes, const std::string& name_for_errors);
 Result<Mesh> ReadGlb(const std::string& path);
 
+// Whether `bytes` start with the PNG signature.
+bool IsPngSignature(std::string_view bytes);
+
 // kInvalidArgument as EncodeGlb, and for a mesh without texcoords or bytes that are not a PNG.
 Result<std::string> EncodeTexturedGlb(const Mesh& mesh, std::string_view base_color_png);
 Status WriteTexturedGlb(const std::string& path, const Mesh& mesh, std::string_view base_color_png);

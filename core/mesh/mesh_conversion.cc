@@ -14,8 +14,6 @@ double SecondsBetween(std::chrono::steady_clock::time_point a, std::chrono::stea
   return std::chrono::duration<double>(b - a).count();
 }
 
-bool IsPng(const std::string& bytes) { return bytes.rfind(std::string("\x89PNG\r\n\x1a\n", 8), 0) == 0; }
-
 }  // namespace
 
 Result<MeshConversionReport> ConvertMeshFile(const std::string& input, const std::string& output,
@@ -32,7 +30,7 @@ Result<MeshConversionReport> ConvertMeshFile(const std::string& input, const std
   if (input_format == MeshFileFormat::kGlb) {
     RECONAR_ASSIGN_OR_RETURN(TexturedGlb textured, ReadTexturedGlb(input));
     mesh = std::move(textured.mesh);
-    if (IsPng(textured.base_color_image)) {
+    if (IsPngSignature(textured.base_color_image)) {
       texture_png = std::move(textured.base_color_image);
     } else {
       mesh.texcoords.clear();  // a JPEG texture (another tool's) is not carried over

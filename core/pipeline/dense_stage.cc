@@ -158,7 +158,7 @@ Mesh ToPointCloud(const OrientedPoints& points) {
 void PhaseJson(const char* name, const DensePhase& phase, JsonWriter* json) {
   json->Key(name).BeginObject();
   json->Key("seconds").Double(phase.seconds);
-  json->Key("peak_rss_mib").Double(static_cast<double>(phase.peak_rss_bytes) / (1 << 20));
+  json->Key("peak_rss_mib").Double(Mib(phase.peak_rss_bytes));
   json->EndObject();
 }
 
@@ -189,7 +189,7 @@ std::string DenseStageSettings(const DenseStageOptions& options) {
       StageRecord::Settings({{"level", options.level},
                              {"max_image_size", options.max_image_size},
                              {"max_cluster_size", options.clustering.max_cluster_size},
-                             {"budget_mib", static_cast<double>(options.memory_budget_bytes) / (1 << 20)},
+                             {"budget_mib", Mib(options.memory_budget_bytes)},
                              {"remove_outliers", options.remove_outliers ? 1.0 : 0.0}});
   // PMVS records no method, so that the projects made before the choice existed stay finished.
   if (options.method != DenseMethod::kPmvs) {
@@ -212,9 +212,7 @@ Result<DenseStageReport> RunDenseStage(const Project& project, const DenseStageO
   {
     PhaseTimer timer(&report.load);
     RECONAR_ASSIGN_OR_RETURN(model, ReadColmapTextModel(project.SparseDir()));
-    RECONAR_ASSIGN_OR_RETURN(const std::vector<ProjectImage> list, project.ReadImageList());
-    std::map<std::string, std::string> path_of;
-    for (const ProjectImage& image : list) path_of[image.name] = image.path;
+    RECONAR_ASSIGN_OR_RETURN(const auto path_of, project.PhotoPathsByName());
     paths.resize(model.images.size());
     for (size_t i = 0; i < model.images.size(); ++i) {
       const SfmImage& image = model.images[i];
@@ -413,7 +411,7 @@ std::string DenseReportJson(const DenseStageReport& report) {
   json.Key("level").Int(report.level);
   json.Key("level_chosen_from_memory_budget").Bool(report.level_auto);
   json.Key("finest_level_within_max_image_size").Int(report.finest_level_within_size);
-  json.Key("estimated_cluster_mib").Double(static_cast<double>(report.estimated_bytes) / (1 << 20));
+  json.Key("estimated_cluster_mib").Double(Mib(report.estimated_bytes));
   json.Key("max_cluster_size").Int(report.max_cluster_size);
   json.Key("cluster_size_reduced_for_budget").Bool(report.cluster_size_reduced);
   json.Key("images").Int(report.images);
@@ -447,7 +445,7 @@ std::string DenseReportJson(const DenseStageReport& report) {
   json.Key("views").Int(static_cast<long long>(report.patchmatch.views));
   json.Key("depth_pixels").Int(static_cast<long long>(report.patchmatch.depth_pixels));
   json.Key("consistent_pixels").Int(static_cast<long long>(report.patchmatch.consistent_pixels));
-  json.Key("map_mib").Double(static_cast<double>(report.patchmatch.map_bytes) / (1 << 20));
+  json.Key("map_mib").Double(Mib(report.patchmatch.map_bytes));
   json.Key("fused_points").Int(static_cast<long long>(report.patchmatch.fused_points));
   json.Key("seconds_selection").Double(report.patchmatch.seconds_selection);
   json.Key("seconds_propagation").Double(report.patchmatch.seconds_propagation);

@@ -9,6 +9,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/log.h"
+#include "core/base/memory_usage.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/features/sift/sift_io.h"
@@ -76,7 +77,7 @@ std::string FeatureStageSettings(const FeatureStageOptions& options) {
   return StageRecord::Settings({{"first_octave", sift.first_octave},
                                 {"max_features", sift.max_features},
                                 {"contrast_threshold", sift.contrast_threshold},
-                                {"arena_mib", static_cast<double>(sift.arena_bytes) / (1 << 20)}});
+                                {"arena_mib", Mib(sift.arena_bytes)}});
 }
 
 Result<FeatureStageReport> RunFeatureStage(const std::vector<std::string>& image_paths, const Project* project,
@@ -149,7 +150,12 @@ bool FeaturesUpToDate(const Project& project, const std::vector<std::string>& pa
   if (!list.ok() || list->size() != paths.size()) return false;
   for (size_t i = 0; i < paths.size(); ++i) {
     std::error_code error;
-    if ((*list)[i].path != paths[i] || !std::filesystem::exists(project.FeaturePath((*list)[i].name), error)) return false;
+    // A project made before paths were kept absolute lists them as they were given.
+    const std::filesystem::path listed = std::filesystem::absolute((*list)[i].path, error).lexically_normal();
+    if (listed.string() != std::filesystem::path(paths[i]).lexically_normal().string() ||
+        !std::filesystem::exists(project.FeaturePath((*list)[i].name), error)) {
+      return false;
+    }
   }
   return true;
 }

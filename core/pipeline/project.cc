@@ -61,6 +61,13 @@ Result<std::vector<ProjectImage>> Project::ReadImageList() const {
   return images;
 }
 
+Result<std::map<std::string, std::string>> Project::PhotoPathsByName() const {
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<ProjectImage> list, ReadImageList());
+  std::map<std::string, std::string> path_of;
+  for (const ProjectImage& image : list) path_of[image.name] = image.path;
+  return path_of;
+}
+
 Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string>& arguments) {
   std::vector<std::string> paths;
   for (const std::string& argument : arguments) {
@@ -85,6 +92,12 @@ Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string
     }
   }
   if (paths.empty()) return InvalidArgument("no images (.jpg, .jpeg, .png) found in the given arguments");
+  for (std::string& path : paths) {
+    std::error_code ec;
+    const fs::path absolute = fs::absolute(path, ec);
+    if (ec) return FileError(StatusCode::kIoError, path, "cannot make the path absolute: " + ec.message());
+    path = absolute.lexically_normal().string();
+  }
   std::set<std::string> names;
   for (const std::string& path : paths) {
     const std::string name = fs::path(path).filename().string();

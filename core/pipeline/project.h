@@ -5,6 +5,7 @@
 // images.txt lists, one image per line, "name width height focal_px focal_source path"; names are
 // unique within a project and key every other file.
 #include <cstddef>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,7 @@ inline constexpr size_t kDefaultMemoryBudgetBytes = 2560ull << 20;
 
 struct ProjectImage {
   std::string name;   // file name, e.g. "0004.jpg"
-  std::string path;   // as given on the command line
+  std::string path;   // absolute (CollectImagePaths), so that the project works from any directory
   int width = 0;      // after EXIF orientation
   int height = 0;
   double focal_px = 0;
@@ -56,6 +57,8 @@ class Project {
 
   Status WriteImageList(const std::vector<ProjectImage>& images) const;
   Result<std::vector<ProjectImage>> ReadImageList() const;
+  // The image list as name -> path.
+  Result<std::map<std::string, std::string>> PhotoPathsByName() const;
 
  private:
   std::string root_;
@@ -63,7 +66,8 @@ class Project {
 
 // Expands arguments into image files: a directory contributes its .jpg/.jpeg/.png files (any case,
 // in name order with numbers by value: FileNameLess), a file is taken as is. NotFound for a missing
-// argument; InvalidArgument when two images share a file name or nothing is left.
+// argument; InvalidArgument when two images share a file name or nothing is left. The paths come
+// back absolute and normalised.
 Result<std::vector<std::string>> CollectImagePaths(const std::vector<std::string>& arguments);
 
 // Removes a file when it exists; IoError naming the file when it cannot be removed.

@@ -25,7 +25,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double Mib(size_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
 
 bool Exists(const std::string& path) {
   std::error_code error;
@@ -481,6 +480,10 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
         model = project.MeshDir() + "/mesh." + format;
         break;
       }
+    }
+    std::error_code error;
+    if (options.run_mesh && options.run_texture && std::filesystem::exists(TexturedModelPath(project), error)) {
+      model = TexturedModelPath(project);
     }
     const std::string png = project.root() + "/preview.png";
     if (Status s = options.render_preview(model, UpFromCameras(project), png); s.ok()) {

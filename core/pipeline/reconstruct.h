@@ -41,8 +41,8 @@ namespace reconar {
 // libapriltag). Its result is stored as PROJECT/tags/detections.txt.
 using TagDetectorFunction = std::function<Result<TagDetectionsFile>(const std::vector<std::string>& paths)>;
 
-// Renders PROJECT/preview.png from a mesh or point file seen around `up` (render/preview.h; injected
-// so that core stays free of the renderer).
+// Renders PROJECT/preview.png from a model file seen around `up` (render/ar/photo_render.h's
+// WriteModelPreview; injected so that core stays free of the renderer).
 using PreviewFunction =
     std::function<Status(const std::string& model_path, const Eigen::Vector3d& up, const std::string& png_path)>;
 
@@ -109,8 +109,8 @@ struct ReconstructReport {
   std::string report_path;
   bool metric = false;     // tags.json says the model is in metres
   std::string scale_note;  // why not, when not
-  // PROJECT/preview.png of what the run made last (the mesh, else the dense points, else the
-  // sparse points), seen around the cameras' mean up direction; empty when not rendered, and then
+  // PROJECT/preview.png of what the run made last (the textured model, else the mesh, else the
+  // dense points, else the sparse points), seen around the cameras' mean up direction; empty when not rendered, and then
   // preview_error says why (a missing renderer or display does not fail the run).
   std::string preview_path, preview_error;
 };

@@ -202,6 +202,7 @@ std::vector<TextureChart> MakeCharts(const Mesh& mesh, const TexturePatches& pat
                                      const std::vector<PhotoProjector>& projectors) {
   std::vector<TextureChart> charts;
   std::unordered_map<uint32_t, uint32_t> local_of;
+  std::vector<Eigen::Vector2d> pixel_of_vertex(mesh.positions.size());  // in the current patch's photo
   auto add_chart = [&](int patch, int photo, const std::vector<int>& faces) {
     TextureChart chart;
     chart.patch = patch;
@@ -223,10 +224,7 @@ std::vector<TextureChart> MakeCharts(const Mesh& mesh, const TexturePatches& pat
       chart.pixel_min = Eigen::Vector2d::Constant(INFINITY);
       chart.pixel_max = Eigen::Vector2d::Constant(-INFINITY);
       for (size_t k = 0; k < chart.vertices.size(); ++k) {
-        double depth;
-        // Every vertex of a candidate face projected when the face was found.
-        projectors[static_cast<size_t>(photo)].Project(mesh.positions[chart.vertices[k]].cast<double>(),
-                                                      &chart.pixels[k], &depth);
+        chart.pixels[k] = pixel_of_vertex[chart.vertices[k]];
         chart.pixel_min = chart.pixel_min.cwiseMin(chart.pixels[k] + Eigen::Vector2d::Constant(0.5));
         chart.pixel_max = chart.pixel_max.cwiseMax(chart.pixels[k] + Eigen::Vector2d::Constant(0.5));
       }
@@ -242,9 +240,7 @@ std::vector<TextureChart> MakeCharts(const Mesh& mesh, const TexturePatches& pat
     face_pixels.resize(faces.size());
     for (size_t k = 0; k < faces.size(); ++k) {
       for (size_t i = 0; i < 3; ++i) {
-        double depth;
-        projectors[static_cast<size_t>(photo)].Project(
-            mesh.positions[mesh.triangles[static_cast<size_t>(faces[k])][i]].cast<double>(), &face_pixels[k][i], &depth);
+        face_pixels[k][i] = pixel_of_vertex[mesh.triangles[static_cast<size_t>(faces[k])][i]];
         low = low.cwiseMin(face_pixels[k][i]);
         high = high.cwiseMax(face_pixels[k][i]);
       }
@@ -271,7 +267,17 @@ std::vector<TextureChart> MakeCharts(const Mesh& mesh, const TexturePatches& pat
     add_pieces(patch, photo, std::move(first));
     add_pieces(patch, photo, std::move(second));
   };
-  for (size_t p = 0; p < patches.photo.size(); ++p) add_pieces(static_cast<int>(p), patches.photo[p], patches.faces[p]);
+  for (size_t p = 0; p < patches.photo.size(); ++p) {
+    // Every vertex of a candidate face projected when the face was found.
+    const PhotoProjector& projector = projectors[static_cast<size_t>(patches.photo[p])];
+    for (const int f : patches.faces[p]) {
+      for (const uint32_t v : mesh.triangles[static_cast<size_t>(f)]) {
+        double depth;
+        projector.Project(mesh.positions[v].cast<double>(), &pixel_of_vertex[v], &depth);
+      }
+    }
+    add_pieces(static_cast<int>(p), patches.photo[p], patches.faces[p]);
+  }
   std::vector<int> untextured;
   for (size_t f = 0; f < patches.patch_of_face.size(); ++f) {
     if (patches.patch_of_face[f] < 0) untextured.push_back(static_cast<int>(f));

@@ -14,6 +14,7 @@
 #include "render/ar/ar_project.h"
 #include "render/mesh_drawable.h"
 #include "render/overlay_renderer.h"
+#include "render/preview.h"
 
 namespace reconar {
 namespace {
@@ -60,9 +61,7 @@ Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const
   if (options.out_dir.empty()) return InvalidArgument("render: no output directory (--out)");
   const Project project(project_dir);
   RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(project.SparseDir()));
-  RECONAR_ASSIGN_OR_RETURN(const std::vector<ProjectImage> list, project.ReadImageList());
-  std::map<std::string, std::string> path_of;
-  for (const ProjectImage& image : list) path_of[image.name] = image.path;
+  RECONAR_ASSIGN_OR_RETURN(const auto path_of, project.PhotoPathsByName());
   std::map<std::string, const SfmImage*> registered;
   for (const SfmImage& image : model.images) {
     if (image.registered) registered[image.name] = &image;
@@ -123,6 +122,12 @@ Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const
     report.coverage.push_back(coverage);
   }
   return report;
+}
+
+Status WriteModelPreview(const std::string& model_path, const Eigen::Vector3d& up, const std::string& png_path) {
+  RECONAR_ASSIGN_OR_RETURN(const ArModel model, LoadArModel(model_path, 0));
+  Status written = WritePreview(model.mesh, model.base_color.empty() ? nullptr : &model.base_color, up, png_path);
+  return written.ok() ? written : written.WithContext(model_path);
 }
 
 }  // namespace reconar

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "core/base/image.h"
 #include "core/base/status.h"
 
@@ -34,5 +36,10 @@ struct PhotoRenderReport {
 // InvalidArgument naming a photo that is not a registered photo of the project; file errors of
 // the project, the model and the photos; FailedPrecondition without a display driver (EGL).
 Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const PhotoRenderOptions& options);
+
+// The model of `model_path` (any LoadArModel reads: a textured .glb with its texture) seen from
+// around `up` (render/preview.h's WritePreview), written to `png_path`: the PreviewFunction of
+// core/pipeline/reconstruct.h. Errors name the file.
+Status WriteModelPreview(const std::string& model_path, const Eigen::Vector3d& up, const std::string& png_path);
 
 }  // namespace reconar
