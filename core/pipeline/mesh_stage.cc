@@ -16,13 +16,13 @@
 #include "core/mesh/poisson/point_kdtree.h"
 #include "core/mesh/poisson/point_normals.h"
 #include "core/pipeline/stage_record.h"
+#include "core/pipeline/texture_stage.h"
 
 namespace reconar {
 namespace {
 
 constexpr int kMinDepth = 5;
 
-double Mib(size_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
 
 // Median over (at most 20,000 evenly strided) points of the mean distance to their 8 nearest.
 double MedianSpacing(const std::vector<Eigen::Vector3f>& positions) {
@@ -151,7 +151,7 @@ std::string MeshStageSettings(const MeshStageOptions& options) {
                                 {"depth", options.poisson.depth},
                                 {"trim", options.poisson.trim},
                                 {"point_weight", options.poisson.point_weight},
-                                {"budget_mib", static_cast<double>(options.memory_budget_bytes) / (1 << 20)},
+                                {"budget_mib", Mib(options.memory_budget_bytes)},
                                 {"max_faces", static_cast<double>(options.max_faces)}}) +
          " formats=" + formats;
 }
@@ -164,6 +164,7 @@ Result<MeshStageReport> RunMeshStage(const Project& project, const MeshStageOpti
   std::vector<std::string> paths;
   for (const std::string& format : options.formats) paths.push_back(project.MeshDir() + "/mesh." + format);
   RECONAR_ASSIGN_OR_RETURN(MeshStageReport report, MeshPointsFile(project.DensePointsPath(), paths, options));
+  RECONAR_RETURN_IF_ERROR(RemoveTexturedModel(project));
   report.report_path = project.MeshDir() + "/report.json";
   RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, MeshReportJson(report)));
   return report;

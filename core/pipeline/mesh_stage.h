@@ -1,6 +1,7 @@
 #pragma once
 // Mesh stage: PROJECT/dense/points.ply -> screened Poisson (core/mesh/poisson) -> PROJECT/mesh/
-// mesh.{ply,obj,glb,wrl} and mesh/report.json, every file atomically, report.json last.
+// mesh.{ply,obj,glb,wrl} and mesh/report.json, every file atomically, report.json last. A textured
+// model of the previous mesh (texture_stage.h) is removed once the new mesh is written.
 //
 // Depth: at most the requested one, and no finer than the points: the depth whose cells are as
 // small as the median distance between neighbouring points (finer cells only add unknowns that

@@ -24,7 +24,6 @@
 namespace reconar {
 namespace {
 
-double Mib(size_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
 
 // The mesh stage's mesh in the first readable format it wrote.
 Result<std::string> ProjectMeshPath(const Project& project) {
@@ -66,9 +65,7 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
   TextureStageReport report;
   RECONAR_ASSIGN_OR_RETURN(report.mesh_path, ProjectMeshPath(project));
   RECONAR_ASSIGN_OR_RETURN(const Reconstruction model, ReadColmapTextModel(project.SparseDir()));
-  RECONAR_ASSIGN_OR_RETURN(const std::vector<ProjectImage> list, project.ReadImageList());
-  std::map<std::string, std::string> path_of;
-  for (const ProjectImage& image : list) path_of[image.name] = image.path;
+  RECONAR_ASSIGN_OR_RETURN(const auto path_of, project.PhotoPathsByName());
 
   std::set<std::string> registered;
   for (const SfmImage& image : model.images) {
@@ -84,12 +81,18 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
 
   std::vector<TexturePhoto> photos;
   std::vector<std::string> paths;
+  std::string first_reason;
   for (const SfmImage& image : model.images) {
     if (!image.registered || excluded.count(image.name) != 0) continue;
     const auto it = path_of.find(image.name);
-    if (it == path_of.end() || !ReadImageHeader(it->second).ok()) {
-      const std::string reason = it == path_of.end() ? "not in " + project.ImageListPath()
-                                                     : ReadImageHeader(it->second).status().ToString();
+    std::string reason;
+    if (it == path_of.end()) {
+      reason = "not in " + project.ImageListPath();
+    } else if (const auto header = ReadImageHeader(it->second); !header.ok()) {
+      reason = header.status().ToString();
+    }
+    if (!reason.empty()) {
+      if (first_reason.empty()) first_reason = reason;
       std::fprintf(stderr, "warning: texture: photo %s left out: %s\n", image.name.c_str(), reason.c_str());
       report.unreadable.push_back(image.name);
       continue;
@@ -101,7 +104,13 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
     photos.push_back(photo);
     paths.push_back(it->second);
   }
-  if (photos.empty()) return FailedPrecondition("texture: no registered photo to texture from");
+  if (photos.empty()) {
+    std::string why = "texture: no registered photo to texture from";
+    if (!report.unreadable.empty()) {
+      why += ": none of the " + std::to_string(report.unreadable.size()) + " could be read (" + first_reason + ")";
+    }
+    return FailedPrecondition(why);
+  }
 
   RECONAR_ASSIGN_OR_RETURN(Mesh mesh, ReadMeshFile(report.mesh_path));
   if (mesh.triangles.empty()) return FailedPrecondition(report.mesh_path + ": no triangles to texture");
@@ -133,6 +142,13 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
   report.report_path = project.MeshDir() + "/texture_report.json";
   RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, TextureReportJson(report)));
   return report;
+}
+
+Status RemoveTexturedModel(const Project& project) {
+  for (const char* name : {"texture_report.json", "textured.glb", "textured.obj", "textured.mtl", "textured.png"}) {
+    RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.MeshDir() + "/" + name));
+  }
+  return Status::Ok();
 }
 
 std::string TextureReportJson(const TextureStageReport& report) {

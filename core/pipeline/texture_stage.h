@@ -59,4 +59,8 @@ std::string TextureReportJson(const TextureStageReport& report);
 // PROJECT/mesh/textured.glb, the stage's main output.
 inline std::string TexturedModelPath(const Project& project) { return project.MeshDir() + "/textured.glb"; }
 
+// Removes the stage's outputs and report: the mesh stage does when it replaces the mesh they were
+// made from, so that no view or render shows a textured model of a mesh that is gone.
+Status RemoveTexturedModel(const Project& project);
+
 }  // namespace reconar

@@ -1,15 +1,22 @@
 // `reconar texture` and `reconar render` end to end on the temple (data/templeSparseRing, 16
-// photos of a plaster temple on a dark floor): the textured model reconstruct leaves, a texture
-// made again without photos, the errors for names that are no registered photo, a photo gone from
+// photos of a plaster temple on a dark floor): the textured model reconstruct leaves, the same
+// files after a reconstruct killed in its texture stage is run again, a texture made again without
+// photos, the errors for names that are no registered photo, a photo gone from
 // disk (left out with a warning), a mesh no photo sees (an error, the untextured mesh kept), the
 // model drawn from a photo's viewpoint against that photo, and `reconar export` keeping the texture.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "core/base/atomic_file.h"
@@ -51,6 +58,44 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   ASSERT_TRUE(report.ok());
   EXPECT_GT(ReportNumber(*report, "textured_faces"), 0.9 * ReportNumber(*report, "faces"));
   EXPECT_LT(ReportNumber(*report, "seam_step_after"), ReportNumber(*report, "seam_step_before"));
+
+  // A reconstruct killed in its texture stage (the stage's record gone, as a kill before it is
+  // written leaves it) does the texture again when run again, reusing the rest, to the same files.
+  const char* kTexturedFiles[] = {"textured.glb", "textured.obj", "textured.mtl", "textured.png"};
+  std::map<std::string, std::string> reference;
+  for (const char* file : kTexturedFiles) {
+    Result<std::string> bytes = ReadFileToString(project + "/mesh/" + file);
+    ASSERT_TRUE(bytes.ok()) << file;
+    reference[file] = std::move(*bytes);
+  }
+  const std::string stages_path = project + "/stages.txt";
+  Result<std::string> stages = ReadFileToString(stages_path);
+  ASSERT_TRUE(stages.ok());
+  const size_t texture_line = stages->find("texture ");
+  ASSERT_NE(texture_line, std::string::npos) << *stages;
+  const std::string without_texture = stages->substr(0, texture_line) + stages->substr(stages->find('\n', texture_line) + 1);
+  ASSERT_TRUE(WriteFileAtomically(stages_path, without_texture).ok());
+  const std::string again = "reconstruct " + data + " " + project + " --threads 2 --no-preview --formats ply";
+  const auto texture_start = std::chrono::steady_clock::now();
+  const CommandRun texture_only = RunReconar(again);
+  ASSERT_EQ(texture_only.exit_code, 0) << texture_only.output;
+  const double texture_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - texture_start).count();
+  ASSERT_TRUE(WriteFileAtomically(stages_path, without_texture).ok());
+  const pid_t pid = testing::SpawnCommand(std::string(RECONAR_BINARY) + " " + again);
+  ASSERT_GT(pid, 0);
+  std::this_thread::sleep_for(std::chrono::duration<double>(0.5 * texture_seconds));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  EXPECT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed (" << texture_seconds << " s uninterrupted)";
+  const CommandRun resumed = RunReconar(again);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("reused"), std::string::npos) << resumed.output;
+  for (const char* file : kTexturedFiles) {
+    Result<std::string> bytes = ReadFileToString(project + "/mesh/" + file);
+    ASSERT_TRUE(bytes.ok()) << file;
+    EXPECT_TRUE(*bytes == reference[file]) << file << " differs after the killed texture stage was done again";
+  }
 
   // Export keeps the texture into .obj (with its .mtl and .png) and .glb; .ply says it drops it.
   const std::string exported = (root / "exported").string();
