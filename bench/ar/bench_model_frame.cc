@@ -2,11 +2,12 @@
 // vertex-coloured (mesh/mesh.ply, at most kHandheldMaxFaces as `reconar view` loads it): on a
 // surfaceless EGL context, at 640x480 and 1280x720, the frame being a registered photo resized to
 // that size (uploaded as the video background each frame, as a live frame is) and the model drawn
-// from that photo's pose (its camera scaled to the frame, ScaleIntrinsicsToFrame, undistorted),
+// from that photo's pose (its camera scaled to the frame's width, rows cropped evenly, undistorted),
 // then read back (which waits for the GPU). Photos are decoded up front.
 //   bench_model_frame PROJECT [frames=12] [repeats=3]
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -26,6 +27,16 @@ namespace reconar {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The photo's camera scaled to the frame's width, its principal point moved by the rows cropped
+// evenly above and below (a 4:3 photo seen as a 16:9 frame, as a sensor mode crops it).
+CameraIntrinsics CroppedToFrame(const CameraIntrinsics& photo, int width, int height) {
+  const double scale = static_cast<double>(width) / photo.width;
+  CameraIntrinsics frame = ScaledIntrinsics(photo, width, static_cast<int>(std::lround(photo.height * scale)));
+  frame.cy -= 0.5 * (frame.height - height);
+  frame.height = height;
+  return frame;
+}
 
 bool Check(const Status& status) {
   if (!status.ok()) std::fprintf(stderr, "bench_model_frame: %s\n", status.ToString().c_str());
@@ -85,7 +96,15 @@ int Run(const std::string& project_dir, int frames, int repeats) {
   std::printf("%-10s %-16s %12s %12s %12s\n", "size", "model", "median ms", "p90 ms", "fps");
   for (const auto& [width, height] : {std::pair<int, int>(640, 480), std::pair<int, int>(1280, 720)}) {
     std::vector<Image<uint8_t>> frames_rgb;
-    for (const Image<uint8_t>& photo : photos) frames_rgb.push_back(bench::ResizeBilinear(photo, width, height));
+    for (const Image<uint8_t>& photo : photos) {
+      // Scaled to the frame's width, the rows beyond its height cropped evenly (as CroppedToFrame).
+      const int scaled_height = static_cast<int>(std::lround(static_cast<double>(photo.height()) * width / photo.width()));
+      const Image<uint8_t> scaled = bench::ResizeBilinear(photo, width, std::max(height, scaled_height));
+      Image<uint8_t> frame(width, height, 3);
+      const int top = (scaled.height() - height) / 2;
+      for (int y = 0; y < height; ++y) std::copy(scaled.row(top + y), scaled.row(top + y) + 3 * width, frame.row(y));
+      frames_rgb.push_back(std::move(frame));
+    }
     OverlayRendererOptions render_options;
     render_options.width = width;
     render_options.height = height;
@@ -105,11 +124,10 @@ int Run(const std::string& project_dir, int frames, int repeats) {
           const SfmCamera& camera = model->cameras[static_cast<size_t>(chosen[i]->camera_id)];
           CameraIntrinsics photo_camera = camera.Intrinsics();
           photo_camera.k1 = photo_camera.k2 = 0.0;
-          auto intrinsics = ScaleIntrinsicsToFrame(photo_camera, width, height);
-          if (!Check(intrinsics.ok() ? Status::Ok() : intrinsics.status())) return 1;
+          const CameraIntrinsics intrinsics = CroppedToFrame(photo_camera, width, height);
           const Clock::time_point start = Clock::now();
           if (!Check((*renderer)->BeginFrame()) || !Check((*renderer)->DrawBackground(frames_rgb[i].view(), 3)) ||
-              !Check((*renderer)->DrawMesh(*drawable, *intrinsics, chosen[i]->cam_from_world.Matrix(), style)) ||
+              !Check((*renderer)->DrawMesh(*drawable, intrinsics, chosen[i]->cam_from_world.Matrix(), style)) ||
               !Check((*renderer)->ReadRgb(&overlay))) {
             return 1;
           }
