@@ -182,7 +182,7 @@ std::string TextureReportJson(const TextureStageReport& report) {
   json.Key("atlas_width").Int(t.atlas_width).Key("atlas_height").Int(t.atlas_height);
   json.Key("texels_per_pixel").Double(t.texels_per_pixel);
   json.Key("atlas_fill").Double(t.atlas_fill);
-  json.Key("photos_kept_decoded").Bool(t.photos_kept_decoded);
+  json.Key("photos_kept_decoded").Int(static_cast<long long>(t.photos_kept_decoded));
   json.Key("seconds_candidates").Double(t.seconds_candidates);
   json.Key("seconds_labelling").Double(t.seconds_labelling);
   json.Key("seconds_seams").Double(t.seconds_seams);

@@ -2,8 +2,10 @@
 
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <set>
 
+#include "core/base/memory_usage.h"
 #include "core/base/progress.h"
 #include "core/base/thread_pool.h"
 #include "core/texture/face_adjacency.h"
@@ -61,24 +63,29 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
   const int num_threads = ThreadPool::ResolveThreadCount(options.num_threads);
 
   std::vector<PhotoProjector> projectors;
-  size_t photo_bytes = 0;
   for (const TexturePhoto& photo : photos) {
     if (!photo.camera.IsValid() || photo.camera.width <= 0 || photo.camera.height <= 0) {
       return InvalidArgument("texture: photo " + photo.name + " has no valid camera");
     }
     projectors.emplace_back(photo);
-    photo_bytes += static_cast<size_t>(photo.camera.width) * photo.camera.height * 3;
   }
-  // Keep the decoded photos for the atlas when half the budget holds them; else decode again.
-  const bool keep = options.memory_budget_bytes == 0 || photo_bytes <= options.memory_budget_bytes / 2;
-  report->photos_kept_decoded = keep;
+  // Decoded photos are kept for the atlas while the process stays under the budget less the atlas's
+  // own share (RGB texels, coverage, the PNG), measured as each photo is done.
+  const size_t atlas_texels = static_cast<size_t>(options.atlas_size) * static_cast<size_t>(options.atlas_size);
+  const size_t atlas_bytes = atlas_texels * (3 + 1 + 3);
+  std::mutex keep_mutex;
+  auto may_keep = [&]() {
+    if (options.memory_budget_bytes == 0) return true;
+    const std::lock_guard<std::mutex> lock(keep_mutex);
+    return CurrentMemoryUsage().resident_bytes + atlas_bytes <= options.memory_budget_bytes;
+  };
 
   // 1. Candidates.
   auto phase = std::chrono::steady_clock::now();
   const FaceGeometry geometry(mesh);
   std::vector<std::vector<FaceCandidate>> per_photo(photos.size());
   std::vector<ReducedPhoto> reduced(photos.size());
-  std::vector<Image<uint8_t>> kept(keep ? photos.size() : 0);
+  std::vector<Image<uint8_t>> kept(photos.size());
   std::vector<CandidateScratch> scratch(static_cast<size_t>(num_threads));
   std::vector<Status> errors(photos.size());
   {
@@ -92,12 +99,13 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
       } else {
         FindFaceCandidates(mesh, geometry, static_cast<int>(i), projectors[i], *rgb, options,
                            &scratch[static_cast<size_t>(thread)], &per_photo[i], &reduced[i]);
-        if (keep) kept[i] = std::move(*rgb);
+        if (may_keep()) kept[i] = std::move(*rgb);
       }
       if (progress) progress->Advance();
     });
   }
   for (const Status& status : errors) RECONAR_RETURN_IF_ERROR(status);
+  for (const Image<uint8_t>& image : kept) report->photos_kept_decoded += !image.empty();
   scratch.clear();
   FaceCandidateTable table = GroupByFace(mesh.triangles.size(), per_photo);
   per_photo.clear();
@@ -150,7 +158,7 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
   RECONAR_ASSIGN_OR_RETURN(const AtlasLayout layout,
                            PackCharts(MakeCharts(mesh, patches, projectors), options.atlas_size, options.padding_texels));
   const PhotoAccess access = [&](size_t photo, Image<uint8_t>* storage, const Image<uint8_t>** pixels) -> Status {
-    if (keep) {
+    if (!kept[photo].empty()) {
       *pixels = &kept[photo];
       return Status::Ok();
     }

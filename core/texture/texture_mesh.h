@@ -60,7 +60,10 @@ struct TextureOptions {
   bool level_exposure = true;  // a gain per photo and channel (view_labelling.h)
   bool level_seams = true;
   int blend_rings = 6;  // how far into a patch the local seam correction fades
-  size_t memory_budget_bytes = 0;  // 0: keep every photo decoded once
+  // A photo stays decoded from the views to the atlas while the process, with it, stays under this
+  // less what the atlas will take (texels, coverage, PNG); the others are decoded again for their
+  // charts. 0: all kept.
+  size_t memory_budget_bytes = 0;
   int num_threads = 0;             // 0: one per core
   bool show_progress = false;
 
@@ -86,7 +89,7 @@ struct TextureReport {
   int atlas_width = 0, atlas_height = 0;
   double texels_per_pixel = 0.0;  // the charts' scale against the photos' full resolution
   double atlas_fill = 0.0;        // fraction of the texels that some face covers
-  bool photos_kept_decoded = false;
+  size_t photos_kept_decoded = 0;  // from the views to the atlas (memory_budget_bytes)
   double seconds_candidates = 0.0, seconds_labelling = 0.0, seconds_seams = 0.0, seconds_atlas = 0.0;
   double seconds = 0.0;
 };
