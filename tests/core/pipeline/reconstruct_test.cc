@@ -1,12 +1,15 @@
 // RunReconstruct (core/pipeline/reconstruct.h) on four photos of the bundled templeSparseRing, sparse
 // stages only: a second run reuses every stage and leaves the files as they were; a changed
 // matching setting redoes matching and mapping but keeps the features; the preview is asked of
-// what the run made; bad options are refused before anything runs.
+// what the run made; bad options are refused before anything runs. Also the photo paths a project
+// keeps and the removal of a textured model.
 #include "core/pipeline/reconstruct.h"
 
 #include <gtest/gtest.h>
+
 #include <unistd.h>
 
+#include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
@@ -60,6 +63,36 @@ TEST(CollectImagePaths, AFolderIsListedInItsNumbersOrder) {
   ASSERT_TRUE(paths.ok()) << paths.status().ToString();
   EXPECT_EQ(*paths, (std::vector<std::string>{folder + "/img1.jpg", folder + "/img9.png", folder + "/img10.png",
                                               folder + "/img100.PNG"}));
+}
+
+// A project lists its photos by absolute path, so that its later stages (texture, render) find
+// them from any directory.
+TEST(CollectImagePaths, ARelativeArgumentComesBackAbsolute) {
+  const std::string folder = testing::MakeTestDirectory("reconar_collect_relative");
+  ASSERT_TRUE(CreateDirectories(folder + "/photos").ok());
+  ASSERT_TRUE(WriteFileAtomically(folder + "/photos/a.jpg", "x").ok());
+  const std::filesystem::path before = std::filesystem::current_path();
+  std::filesystem::current_path(folder);
+  auto paths = CollectImagePaths({"photos/../photos"});
+  std::filesystem::current_path(before);
+  ASSERT_TRUE(paths.ok()) << paths.status().ToString();
+  EXPECT_EQ(*paths, (std::vector<std::string>{folder + "/photos/a.jpg"}));
+}
+
+// What the texture stage made of a mesh goes with it; the mesh stays.
+TEST(RemoveTexturedModel, TakesTheTextureStagesFilesAndLeavesTheMesh) {
+  const Project project(testing::MakeTestDirectory("reconar_remove_textured") + "/project");
+  ASSERT_TRUE(CreateDirectories(project.MeshDir()).ok());
+  for (const char* name : {"mesh.ply", "textured.glb", "textured.obj", "textured.mtl", "textured.png",
+                           "texture_report.json"}) {
+    ASSERT_TRUE(WriteFileAtomically(project.MeshDir() + "/" + name, "x").ok());
+  }
+  ASSERT_TRUE(RemoveTexturedModel(project).ok());
+  EXPECT_TRUE(std::filesystem::exists(project.MeshDir() + "/mesh.ply"));
+  for (const char* name : {"textured.glb", "textured.obj", "textured.mtl", "textured.png", "texture_report.json"}) {
+    EXPECT_FALSE(std::filesystem::exists(project.MeshDir() + "/" + name)) << name;
+  }
+  EXPECT_TRUE(RemoveTexturedModel(project).ok());  // nothing left to remove is no error
 }
 
 TEST(RunReconstruct, ProductDefaultsDifferFromTheStagesOwn) {
