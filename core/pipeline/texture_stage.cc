@@ -24,7 +24,6 @@
 namespace reconar {
 namespace {
 
-
 // The mesh stage's mesh in the first readable format it wrote.
 Result<std::string> ProjectMeshPath(const Project& project) {
   for (const char* format : {"ply", "glb", "obj"}) {

@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <memory>
-#include <mutex>
 #include <set>
 
 #include "core/base/memory_usage.h"
@@ -70,14 +69,13 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
     projectors.emplace_back(photo);
   }
   // Decoded photos are kept for the atlas while the process stays under the budget less the atlas's
-  // own share (RGB texels, coverage, the PNG), measured as each photo is done.
+  // own share (RGB texels, coverage, the PNG), measured as each photo is done: the resident set then
+  // holds every photo being worked on, so photos decided at once cannot together overshoot.
   const size_t atlas_texels = static_cast<size_t>(options.atlas_size) * static_cast<size_t>(options.atlas_size);
   const size_t atlas_bytes = atlas_texels * (3 + 1 + 3);
-  std::mutex keep_mutex;
   auto may_keep = [&]() {
-    if (options.memory_budget_bytes == 0) return true;
-    const std::lock_guard<std::mutex> lock(keep_mutex);
-    return CurrentMemoryUsage().resident_bytes + atlas_bytes <= options.memory_budget_bytes;
+    return options.memory_budget_bytes == 0 ||
+           CurrentMemoryUsage().resident_bytes + atlas_bytes <= options.memory_budget_bytes;
   };
 
   // 1. Candidates.
