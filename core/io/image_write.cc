@@ -46,9 +46,10 @@ int ColorType(int channels) {
 
 // Returns false after a libpng error (message in ctx->message).
 bool Encode(png_structp png, png_infop info, ImageView<const uint8_t> interleaved, int channels,
-            png_bytep* rows, PngWriteContext* ctx) {
+            int compression_level, png_bytep* rows, PngWriteContext* ctx) {
   if (setjmp(png_jmpbuf(png))) return false;
   png_set_write_fn(png, ctx, OnWrite, OnFlush);
+  png_set_compression_level(png, compression_level);
   png_set_IHDR(png, info, static_cast<png_uint_32>(interleaved.width / channels),
                static_cast<png_uint_32>(interleaved.height), 8, ColorType(channels), PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -60,7 +61,10 @@ bool Encode(png_structp png, png_infop info, ImageView<const uint8_t> interleave
 
 }  // namespace
 
-Result<std::string> EncodePng(ImageView<const uint8_t> interleaved, int channels) {
+Result<std::string> EncodePng(ImageView<const uint8_t> interleaved, int channels, int compression_level) {
+  if (compression_level < 0 || compression_level > 9) {
+    return InvalidArgument("PNG: compression level " + std::to_string(compression_level) + " (expected 0..9)");
+  }
   if (channels != 1 && channels != 3 && channels != 4) {
     return InvalidArgument("PNG: " + std::to_string(channels) + " channels (expected 1, 3 or 4)");
   }
@@ -81,7 +85,7 @@ Result<std::string> EncodePng(ImageView<const uint8_t> interleaved, int channels
     png_destroy_write_struct(&png, nullptr);
     return Internal("PNG: png_create_info_struct failed");
   }
-  const bool ok = Encode(png, info, interleaved, channels, rows.data(), &ctx);
+  const bool ok = Encode(png, info, interleaved, channels, compression_level, rows.data(), &ctx);
   png_destroy_write_struct(&png, &info);
   if (!ok) return Internal(std::string("PNG: libpng: ") + ctx.message);
   return out;

@@ -129,7 +129,7 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
 
   RECONAR_RETURN_IF_ERROR(CreateDirectories(project.MeshDir()));
   const std::string png_path = project.MeshDir() + "/textured.png";
-  RECONAR_ASSIGN_OR_RETURN(const std::string png, EncodePng(textured.atlas.view(), 3));
+  RECONAR_ASSIGN_OR_RETURN(const std::string png, EncodePng(textured.atlas.view(), 3, kPngFastCompression));
   RECONAR_RETURN_IF_ERROR(WriteFileAtomically(png_path, png));
   const std::string obj_path = project.MeshDir() + "/textured.obj";
   RECONAR_RETURN_IF_ERROR(WriteTexturedObj(obj_path, textured.mesh, "textured.png"));

@@ -7,7 +7,9 @@
 #include <signal.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "core/io/image_io.h"
@@ -156,7 +158,27 @@ TEST(EncodePngTest, RejectsBadArguments) {
   EXPECT_EQ(EncodePng(view, 3).status().code(), StatusCode::kInvalidArgument);  // 10 % 3 != 0
   EXPECT_EQ(EncodePng(ImageView<const uint8_t>(), 1).status().code(), StatusCode::kInvalidArgument);
   EXPECT_TRUE(EncodePng(view, 1).ok());
+  EXPECT_EQ(EncodePng(view, 1, 10).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(EncodePng(view, 1, -1).status().code(), StatusCode::kInvalidArgument);
   EXPECT_EQ(WritePng("/tmp/never_written.png", view, 3).code(), StatusCode::kInvalidArgument);
+}
+
+
+// Every compression level is lossless; the fast one only costs bytes.
+TEST(EncodePngTest, EveryLevelDecodesToTheSamePixels) {
+  Image<uint8_t> image(64, 48, 3);
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < 3 * image.width(); ++x) image.row(y)[x] = static_cast<uint8_t>((x * 37 + y * 11) ^ (x * y));
+  }
+  for (const int level : {0, kPngFastCompression, kPngDefaultCompression, 9}) {
+    const Result<std::string> png = EncodePng(image.view(), 3, level);
+    ASSERT_TRUE(png.ok()) << level;
+    const Result<DecodedImage> decoded = ReadImageFromMemory(*png, "level " + std::to_string(level));
+    ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+    for (int y = 0; y < image.height(); ++y) {
+      ASSERT_TRUE(std::equal(image.row(y), image.row(y) + 3 * image.width(), decoded->rgb.row(y))) << level;
+    }
+  }
 }
 
 }  // namespace
