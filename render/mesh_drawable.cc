@@ -80,7 +80,7 @@ void ToGl(const Eigen::Matrix4d& m, float out[16]) {
 
 }  // namespace
 
-Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh, const Image<uint8_t>* base_color) {
+Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh, const std::vector<TexturePage>* texture) {
   const size_t n = mesh.positions.size();
   if (n == 0) return InvalidArgument("MeshDrawable::Upload: the mesh has no vertices");
   if (n > static_cast<size_t>(INT32_MAX)) return InvalidArgument("MeshDrawable::Upload: too many vertices");
@@ -91,18 +91,21 @@ Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh, const Image<uint8_t>
     }
   }
 
-  const bool textured = base_color != nullptr;
+  const bool textured = texture != nullptr;
   if (textured) {
     if (mesh.texcoords.empty()) return InvalidArgument("MeshDrawable::Upload: a texture for a mesh without texcoords");
-    if (base_color->channels() != 3 || base_color->empty()) {
-      return InvalidArgument("MeshDrawable::Upload: the texture must be RGB");
-    }
+    RECONAR_RETURN_IF_ERROR(ValidateTexturePages(*texture, mesh.triangles.size()).WithContext("MeshDrawable::Upload"));
     GLint max_size = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
-    if (base_color->width() > max_size || base_color->height() > max_size) {
-      return InvalidArgument("MeshDrawable::Upload: a " + std::to_string(base_color->width()) + " x " +
-                             std::to_string(base_color->height()) + " texture exceeds the GPU's " +
-                             std::to_string(max_size) + " texels");
+    for (const TexturePage& page : *texture) {
+      if (page.image.channels() != 3 || page.image.empty()) {
+        return InvalidArgument("MeshDrawable::Upload: the texture must be RGB");
+      }
+      if (page.image.width() > max_size || page.image.height() > max_size) {
+        return InvalidArgument("MeshDrawable::Upload: a " + std::to_string(page.image.width()) + " x " +
+                               std::to_string(page.image.height()) + " texture exceeds the GPU's " +
+                               std::to_string(max_size) + " texels");
+      }
     }
   }
 
@@ -134,20 +137,23 @@ Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh, const Image<uint8_t>
     drawable.texcoords_ = MakeArrayBuffer(GL_ARRAY_BUFFER, mesh.texcoords.data(), n);
     glEnableVertexAttribArray(kTexcoord);
     glVertexAttribPointer(kTexcoord, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
-    // Row 0 first: texcoord v = 0 is the image's top row, as glTF has it.
-    drawable.texture_ = MakeGlTexture();
-    glBindTexture(GL_TEXTURE_2D, drawable.texture_.get());
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, base_color->width(), base_color->height(), 0, GL_RGB, GL_UNSIGNED_BYTE,
-                 base_color->data());
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glGenerateMipmap(GL_TEXTURE_2D);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    for (size_t k = 0; k < texture->size(); ++k) {
+      const Image<uint8_t>& image = (*texture)[k].image;
+      // Row 0 first: texcoord v = 0 is the image's top row, as glTF has it.
+      drawable.pages_.push_back(
+          {MakeGlTexture(), static_cast<int64_t>((*texture)[k].first_triangle) * 3,
+           static_cast<int64_t>(PageTrianglesEnd(*texture, k, mesh.triangles.size()) - (*texture)[k].first_triangle) * 3});
+      glBindTexture(GL_TEXTURE_2D, drawable.pages_.back().texture.get());
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, image.width(), image.height(), 0, GL_RGB, GL_UNSIGNED_BYTE, image.data());
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      glGenerateMipmap(GL_TEXTURE_2D);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
     glBindTexture(GL_TEXTURE_2D, 0);
-    drawable.has_texture_ = true;
   }
   if (!mesh.triangles.empty()) {
     static_assert(sizeof(std::array<uint32_t, 3>) == 12, "packed triangles");
@@ -220,24 +226,28 @@ Status MeshPipeline::Draw(const MeshDrawable& mesh, const Eigen::Matrix4d& clip_
   glUniform1f(point_size_, style.point_size_px);
   glUniform1i(shading_mode_, mode);
   glUniform1f(opacity_, std::clamp(style.opacity, 0.0f, 1.0f));
-  glUniform1i(textured_, mesh.has_texture_ ? 1 : 0);
+  glUniform1i(textured_, mesh.has_texture() ? 1 : 0);
   glUniform1i(base_color_, 0);
-  if (mesh.has_texture_) {
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, mesh.texture_.get());
-  }
+  glActiveTexture(GL_TEXTURE0);
   glBindVertexArray(mesh.vertex_array_.get());
   // Attributes without an array take the current generic value (context state, not VAO state).
   if (!mesh.has_colors_) glVertexAttrib4f(kColor, style.color[0], style.color[1], style.color[2], 1.0f);
   if (!mesh.has_normals_) glVertexAttrib3f(kNormal, 0.0f, 0.0f, 0.0f);
-  if (!mesh.has_texture_) glVertexAttrib2f(kTexcoord, 0.0f, 0.0f);
+  if (!mesh.has_texture()) glVertexAttrib2f(kTexcoord, 0.0f, 0.0f);
   if (mesh.is_point_cloud()) {
     glDrawArrays(GL_POINTS, 0, mesh.vertex_count_);
-  } else {
+  } else if (!mesh.has_texture()) {
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.index_count_), mesh.index_type_, nullptr);
+  } else {
+    const size_t index_bytes = mesh.index_type_ == GL_UNSIGNED_SHORT ? 2 : 4;
+    for (const MeshDrawable::Page& page : mesh.pages_) {
+      glBindTexture(GL_TEXTURE_2D, page.texture.get());
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(page.index_count), mesh.index_type_,
+                     reinterpret_cast<const void*>(static_cast<uintptr_t>(page.first_index) * index_bytes));
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
   }
   glBindVertexArray(0);
-  if (mesh.has_texture_) glBindTexture(GL_TEXTURE_2D, 0);
   if (blended) {
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);

@@ -1,14 +1,15 @@
 #pragma once
 // MeshDrawable: a Mesh uploaded once to GL buffers (positions, optional normals and RGBA colours,
 // triangle indices, 16-bit when the mesh has at most 65536 vertices), and with a base colour
-// texture its texcoords and the texture (mipmapped once at upload; the colour is the vertex
-// colour, or white, times the texture, as glTF has it). MeshPipeline: the program that draws it with a
+// texture its texcoords and the texture's pages (each mipmapped once at upload, and drawn with its
+// triangles; the colour is the vertex colour, or white, times the texture, as glTF has it). MeshPipeline: the program that draws it with a
 // headlight Lambert shade (light at the camera, two-sided): vertex normals when the mesh has them, otherwise the flat
 // normal of each triangle from screen-space derivatives of the camera-frame position. A mesh without triangles is drawn
 // as GL_POINTS of MeshStyle::point_size_px (unlit without normals).
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "core/base/image.h"
 #include "core/base/status.h"
@@ -22,13 +23,14 @@ class MeshDrawable {
  public:
   // Needs a current GLES 3 context. InvalidArgument for an empty mesh, normals or colours whose
   // count differs from the positions', a triangle index out of range, non-finite positions, a
-  // texture (RGB) for a mesh without texcoords or larger than the GPU takes.
-  static Result<MeshDrawable> Upload(const Mesh& mesh, const Image<uint8_t>* base_color = nullptr);
+  // texture (RGB pages) for a mesh without texcoords, with pages out of order or larger than the
+  // GPU takes.
+  static Result<MeshDrawable> Upload(const Mesh& mesh, const std::vector<TexturePage>* texture = nullptr);
 
   bool is_point_cloud() const { return index_count_ == 0; }
   bool has_normals() const { return has_normals_; }
   bool has_colors() const { return has_colors_; }
-  bool has_texture() const { return has_texture_; }
+  bool has_texture() const { return !pages_.empty(); }
   int vertex_count() const { return vertex_count_; }
   int64_t triangle_count() const { return index_count_ / 3; }
 
@@ -40,13 +42,16 @@ class MeshDrawable {
   GlBuffer colors_;
   GlBuffer indices_;
   GlBuffer texcoords_;
-  GlTexture texture_;
+  struct Page {
+    GlTexture texture;
+    int64_t first_index, index_count;
+  };
+  std::vector<Page> pages_;
   int vertex_count_ = 0;
   int64_t index_count_ = 0;
   GLenum index_type_ = GL_UNSIGNED_INT;  // GL_UNSIGNED_SHORT for meshes of <= 65536 vertices
   bool has_normals_ = false;
   bool has_colors_ = false;
-  bool has_texture_ = false;
 };
 
 struct MeshStyle {

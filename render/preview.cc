@@ -30,7 +30,7 @@ Status PreviewOptions::Check() const {
 }
 
 Result<std::vector<Image<uint8_t>>> RenderPreviewViews(const Mesh& mesh, const PreviewOptions& options,
-                                                       const Image<uint8_t>* base_color) {
+                                                       const std::vector<TexturePage>* texture) {
   RECONAR_RETURN_IF_ERROR(options.Check());
   if (mesh.positions.empty()) return InvalidArgument("preview: the mesh has no vertices");
   Eigen::Vector3d lo, hi;
@@ -67,10 +67,10 @@ Result<std::vector<Image<uint8_t>>> RenderPreviewViews(const Mesh& mesh, const P
   renderer_options.depth.near_m = std::max(1e-6, 0.05 * (distance - radius));
   renderer_options.depth.far_m = 2.0 * (distance + radius);
   RECONAR_ASSIGN_OR_RETURN(auto renderer, OverlayRenderer::Create(renderer_options));
-  RECONAR_ASSIGN_OR_RETURN(const MeshDrawable drawable, MeshDrawable::Upload(mesh, base_color));
+  RECONAR_ASSIGN_OR_RETURN(const MeshDrawable drawable, MeshDrawable::Upload(mesh, texture));
   MeshStyle style;
   style.point_size_px = options.point_size_px;
-  style.shading = base_color == nullptr;
+  style.shading = texture == nullptr;
 
   const Eigen::Vector3d up = options.up.normalized();
   const Eigen::Vector3d side = up.unitOrthogonal();
@@ -104,14 +104,14 @@ Image<uint8_t> TileImages(const std::vector<Image<uint8_t>>& views, int columns)
   return tiled;
 }
 
-Status WritePreview(const Mesh& mesh, const Image<uint8_t>* base_color, const Eigen::Vector3d& up,
+Status WritePreview(const Mesh& mesh, const std::vector<TexturePage>* texture, const Eigen::Vector3d& up,
                     const std::string& png_path) {
   PreviewOptions preview;
   preview.width = 480;
   preview.height = 360;
   preview.up = up;
   preview.directions = PreviewOptions::Ring(5, 20.0);
-  RECONAR_ASSIGN_OR_RETURN(const std::vector<Image<uint8_t>> views, RenderPreviewViews(mesh, preview, base_color));
+  RECONAR_ASSIGN_OR_RETURN(const std::vector<Image<uint8_t>> views, RenderPreviewViews(mesh, preview, texture));
   return WritePng(png_path, TileImages(views, 3).view(), 3);
 }
 

@@ -35,16 +35,16 @@ struct PreviewOptions {
   Status Check() const;
 };
 
-// One RGB image per direction. `base_color`: the texture of a mesh with texcoords, or null.
+// One RGB image per direction. `texture`: the texture pages of a mesh with texcoords, or null.
 // Errors: bad options, an empty mesh, no EGL display or GLES context.
 Result<std::vector<Image<uint8_t>>> RenderPreviewViews(const Mesh& mesh, const PreviewOptions& options,
-                                                       const Image<uint8_t>* base_color = nullptr);
+                                                       const std::vector<TexturePage>* texture = nullptr);
 
 // The views side by side, `columns` per row (all the same size), black where a row is short.
 Image<uint8_t> TileImages(const std::vector<Image<uint8_t>>& views, int columns);
 
 // The mesh or points (with their texture, or null) seen around `up`, written to `png_path`.
-Status WritePreview(const Mesh& mesh, const Image<uint8_t>* base_color, const Eigen::Vector3d& up,
+Status WritePreview(const Mesh& mesh, const std::vector<TexturePage>* texture, const Eigen::Vector3d& up,
                     const std::string& png_path);
 
 }  // namespace reconar

@@ -66,7 +66,7 @@ int RunExport(int argc, char** argv, int first) {
   }
   std::printf("wrote %s: %ju bytes (read %.2fs, write %.2fs)\n", output.c_str(), r.bytes, r.seconds_read,
               r.seconds_write);
-  if (!r.texture_path.empty()) std::printf("wrote %s: its texture\n", r.texture_path.c_str());
+  for (const std::string& path : r.texture_paths) std::printf("wrote %s: its texture\n", path.c_str());
   if (r.texture_dropped) std::printf("note: %s holds no texture; the texture was left out\n", output.c_str());
   return 0;
 }

@@ -87,10 +87,11 @@ int Run(const std::string& project_dir, int frames, int repeats) {
   for (size_t k = 0; k < models.size(); ++k) {
     std::printf("  %-16s %s: %zu triangles%s\n", variants[k].label, variants[k].path.c_str(),
                 models[k].mesh.triangles.size(),
-                models[k].base_color.empty()
+                models[k].texture.empty()
                     ? ""
-                    : (", texture " + std::to_string(models[k].base_color.width()) + " x " +
-                       std::to_string(models[k].base_color.height()))
+                    : (", texture " + std::to_string(models[k].texture.size()) + " page(s), the first " +
+                       std::to_string(models[k].texture[0].image.width()) + " x " +
+                       std::to_string(models[k].texture[0].image.height()))
                           .c_str());
   }
   std::printf("%-10s %-16s %12s %12s %12s\n", "size", "model", "median ms", "p90 ms", "fps");
@@ -113,10 +114,10 @@ int Run(const std::string& project_dir, int frames, int repeats) {
     double medians[2] = {0.0, 0.0};
     for (size_t k = 0; k < models.size(); ++k) {
       const ArModel& ar_model = models[k];
-      auto drawable = MeshDrawable::Upload(ar_model.mesh, ar_model.base_color.empty() ? nullptr : &ar_model.base_color);
+      auto drawable = MeshDrawable::Upload(ar_model.mesh, ar_model.texture.empty() ? nullptr : &ar_model.texture);
       if (!Check(drawable.ok() ? Status::Ok() : drawable.status())) return 1;
       MeshStyle style;
-      style.shading = ar_model.base_color.empty();  // as the AR view draws each
+      style.shading = ar_model.texture.empty();  // as the AR view draws each
       std::vector<double> ms;
       Image<uint8_t> overlay;
       for (int run = 0; run < repeats; ++run) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -156,22 +157,22 @@ Result<MeshLayout> AppendMeshData(const Mesh& mesh, std::string* bin, std::vecto
   return layout;
 }
 
-// The mesh's one primitive; its accessors are numbered from *accessor on. `textured`: it uses
-// material 0 (the base colour texture).
-void WriteMeshJson(JsonWriter* json, const Mesh& mesh, bool textured, int* accessor) {
-  json->BeginObject().Key("primitives").BeginArray().BeginObject();
+// One primitive of `mesh`; its accessors are numbered from *accessor on. `material`: its
+// material's index, or -1 for none.
+void WritePrimitiveJson(JsonWriter* json, const Mesh& mesh, int material, int* accessor) {
+  json->BeginObject();
   json->Key("attributes").BeginObject().Key("POSITION").Int((*accessor)++);
   if (!mesh.normals.empty()) json->Key("NORMAL").Int((*accessor)++);
   if (!mesh.colors.empty()) json->Key("COLOR_0").Int((*accessor)++);
   if (!mesh.texcoords.empty()) json->Key("TEXCOORD_0").Int((*accessor)++);
   json->EndObject();
   if (!mesh.triangles.empty()) json->Key("indices").Int((*accessor)++);
-  if (textured) json->Key("material").Int(0);
+  if (material >= 0) json->Key("material").Int(material);
   json->Key("mode").Int(mesh.triangles.empty() ? kModePoints : kModeTriangles);
-  json->EndObject().EndArray().EndObject();
+  json->EndObject();
 }
 
-// The accessors of WriteMeshJson's primitive, on the buffer views numbered from *view on.
+// The accessors of WritePrimitiveJson's primitive, on the buffer views numbered from *view on.
 void WriteAccessorsJson(JsonWriter* json, const Mesh& mesh, const MeshLayout& layout, int* view) {
   const size_t num_vertices = mesh.positions.size();
   WriteAccessor(json, (*view)++, kComponentFloat, num_vertices, "VEC3");
@@ -197,16 +198,22 @@ void WriteAccessorsJson(JsonWriter* json, const Mesh& mesh, const MeshLayout& la
   }
 }
 
-// `base_color_png`: when not empty, the PNG of material 0's base colour texture, which every
-// element with texture coordinates uses.
-Result<std::string> EncodeScene(const std::vector<SceneElement>& elements, std::string_view base_color_png = {}) {
+// `base_color_pngs`: empty, or one PNG per element: then the elements are the primitives of one
+// mesh (of one unnamed node), element i with material i, whose base colour texture is PNG i.
+Result<std::string> EncodeScene(const std::vector<SceneElement>& elements,
+                                const std::vector<std::string_view>& base_color_pngs = {}) {
   if (elements.empty()) return InvalidArgument("glTF scene: no meshes to write");
+  const bool textured = !base_color_pngs.empty();
+  if (textured && base_color_pngs.size() != elements.size()) {
+    return InvalidArgument("glTF scene: " + std::to_string(base_color_pngs.size()) + " textures for " +
+                           std::to_string(elements.size()) + " primitives");
+  }
   // BIN chunk: each mesh's positions, normals, colours, indices.
   std::string bin;
   std::vector<BufferViewSpec> views;
   std::vector<MeshLayout> layouts;
   for (size_t i = 0; i < elements.size(); ++i) {
-    const std::string element = "element " + std::to_string(i) +
+    const std::string element = (textured ? "page " : "element ") + std::to_string(i) +
                                 (elements[i].name.empty() ? "" : " '" + std::string(elements[i].name) + "'");
     // Our JSON reader, like the glTF specification, accepts UTF-8 strings only.
     if (!ParseJson(JsonQuote(std::string(elements[i].name)), element).ok()) {
@@ -216,13 +223,11 @@ Result<std::string> EncodeScene(const std::vector<SceneElement>& elements, std::
     if (!layout.ok()) return elements.size() == 1 ? layout.status() : layout.status().WithContext(element);
     layouts.push_back(*layout);
   }
-  const bool textured = !base_color_png.empty();
-  size_t image_view = 0;
-  if (textured) {
-    image_view = views.size();
+  const size_t first_image_view = views.size();
+  for (const std::string_view png : base_color_pngs) {
     const size_t offset = bin.size();
-    bin.append(base_color_png.data(), base_color_png.size());
-    views.push_back({offset, base_color_png.size(), 0});
+    bin.append(png.data(), png.size());
+    views.push_back({offset, png.size(), 0});
     bin.resize(Align4(bin.size()), '\0');
   }
 
@@ -230,37 +235,52 @@ Result<std::string> EncodeScene(const std::vector<SceneElement>& elements, std::
   json.BeginObject();
   json.Key("asset").BeginObject().Key("version").String("2.0").Key("generator").String("reconar").EndObject();
   json.Key("scene").Int(0);
+  const size_t num_nodes = textured ? 1 : elements.size();
   json.Key("scenes").BeginArray().BeginObject().Key("nodes").BeginArray();
-  for (size_t i = 0; i < elements.size(); ++i) json.Int(static_cast<long long>(i));
+  for (size_t i = 0; i < num_nodes; ++i) json.Int(static_cast<long long>(i));
   json.EndArray().EndObject().EndArray();
   json.Key("nodes").BeginArray();
-  for (size_t i = 0; i < elements.size(); ++i) {
+  for (size_t i = 0; i < num_nodes; ++i) {
     json.BeginObject();
-    if (!elements[i].name.empty()) json.Key("name").String(std::string(elements[i].name));
+    if (!textured && !elements[i].name.empty()) json.Key("name").String(std::string(elements[i].name));
     json.Key("mesh").Int(static_cast<long long>(i)).EndObject();
   }
   json.EndArray();
   int accessor = 0;
   json.Key("meshes").BeginArray();
-  for (const SceneElement& element : elements) {
-    WriteMeshJson(&json, *element.mesh, textured && !element.mesh->texcoords.empty(), &accessor);
+  if (textured) json.BeginObject().Key("primitives").BeginArray();
+  for (size_t i = 0; i < elements.size(); ++i) {
+    if (!textured) json.BeginObject().Key("primitives").BeginArray();
+    WritePrimitiveJson(&json, *elements[i].mesh, textured ? static_cast<int>(i) : -1, &accessor);
+    if (!textured) json.EndArray().EndObject();
   }
+  if (textured) json.EndArray().EndObject();
   json.EndArray();
   if (textured) {
     // Photographs are sRGB, as glTF's base colour texture is; metallic 0, rough 1: a matte surface.
-    json.Key("materials").BeginArray().BeginObject();
-    json.Key("pbrMetallicRoughness").BeginObject();
-    json.Key("baseColorTexture").BeginObject().Key("index").Int(0).EndObject();
-    json.Key("metallicFactor").Int(0).Key("roughnessFactor").Int(1);
-    json.EndObject().EndObject().EndArray();
-    json.Key("textures").BeginArray().BeginObject().Key("sampler").Int(0).Key("source").Int(0).EndObject().EndArray();
+    json.Key("materials").BeginArray();
+    for (size_t i = 0; i < elements.size(); ++i) {
+      json.BeginObject().Key("pbrMetallicRoughness").BeginObject();
+      json.Key("baseColorTexture").BeginObject().Key("index").Int(static_cast<long long>(i)).EndObject();
+      json.Key("metallicFactor").Int(0).Key("roughnessFactor").Int(1);
+      json.EndObject().EndObject();
+    }
+    json.EndArray();
+    json.Key("textures").BeginArray();
+    for (size_t i = 0; i < elements.size(); ++i) {
+      json.BeginObject().Key("sampler").Int(0).Key("source").Int(static_cast<long long>(i)).EndObject();
+    }
+    json.EndArray();
     json.Key("samplers").BeginArray().BeginObject();
     json.Key("magFilter").Int(kFilterLinear).Key("minFilter").Int(kFilterLinearMipmapLinear);
     json.Key("wrapS").Int(kWrapClampToEdge).Key("wrapT").Int(kWrapClampToEdge);
     json.EndObject().EndArray();
-    json.Key("images").BeginArray().BeginObject();
-    json.Key("bufferView").Int(static_cast<long long>(image_view)).Key("mimeType").String("image/png");
-    json.EndObject().EndArray();
+    json.Key("images").BeginArray();
+    for (size_t i = 0; i < elements.size(); ++i) {
+      json.BeginObject().Key("bufferView").Int(static_cast<long long>(first_image_view + i));
+      json.Key("mimeType").String("image/png").EndObject();
+    }
+    json.EndArray();
   }
   int view = 0;
   json.Key("accessors").BeginArray();
@@ -316,16 +336,32 @@ bool IsPngSignature(std::string_view bytes) {
   return bytes.substr(0, 8) == std::string_view("\x89PNG\r\n\x1a\n", 8);
 }
 
-Result<std::string> EncodeTexturedGlb(const Mesh& mesh, std::string_view base_color_png) {
+Result<std::string> EncodeTexturedGlb(const Mesh& mesh, const std::vector<EncodedTexturePage>& pages) {
   if (mesh.texcoords.empty()) return InvalidArgument("mesh: no texture coordinates for the texture");
-  if (!IsPngSignature(base_color_png)) {
-    return InvalidArgument("mesh: the base colour texture is not a PNG");
+  RECONAR_RETURN_IF_ERROR(ValidateTexturePages(pages, mesh.triangles.size()));
+  std::vector<std::string_view> pngs;
+  for (size_t k = 0; k < pages.size(); ++k) {
+    if (!IsPngSignature(pages[k].image)) {
+      return InvalidArgument("mesh: the base colour texture" + (pages.size() > 1 ? " page " + std::to_string(k) : "") +
+                             " is not a PNG");
+    }
+    pngs.push_back(pages[k].image);
   }
-  return EncodeScene({{std::string_view(), &mesh}}, base_color_png);
+  if (pages.size() == 1) return EncodeScene({{std::string_view(), &mesh}}, pngs);
+  RECONAR_RETURN_IF_ERROR(ValidateMesh(mesh));
+  std::vector<Mesh> parts;
+  for (size_t k = 0; k < pages.size(); ++k) {
+    std::vector<size_t> triangles(PageTrianglesEnd(pages, k, mesh.triangles.size()) - pages[k].first_triangle);
+    std::iota(triangles.begin(), triangles.end(), pages[k].first_triangle);
+    parts.push_back(SubMesh(mesh, triangles));
+  }
+  std::vector<SceneElement> elements;
+  for (const Mesh& part : parts) elements.push_back({std::string_view(), &part});
+  return EncodeScene(elements, pngs);
 }
 
-Status WriteTexturedGlb(const std::string& path, const Mesh& mesh, std::string_view base_color_png) {
-  return WriteEncodedGlb(path, EncodeTexturedGlb(mesh, base_color_png));
+Status WriteTexturedGlb(const std::string& path, const Mesh& mesh, const std::vector<EncodedTexturePage>& pages) {
+  return WriteEncodedGlb(path, EncodeTexturedGlb(mesh, pages));
 }
 
 Result<std::string> EncodeGlbScene(const std::vector<NamedMesh>& meshes) {
@@ -417,7 +453,7 @@ class GlbDecoder {
     return std::move(textured.mesh);
   }
 
-  // With `with_texture`, the texture coordinates and the base colour image are kept.
+  // With `with_texture`, the texture coordinates and the base colour images are kept.
   Result<TexturedGlb> DecodeTextured(bool with_texture) {
     RECONAR_RETURN_IF_ERROR(ReadContainer());
     RECONAR_RETURN_IF_ERROR(CheckAssetAndExtensions());
@@ -427,9 +463,48 @@ class GlbDecoder {
     TexturedGlb textured;
     RECONAR_ASSIGN_OR_RETURN(textured.mesh, ReadPrimitive(*primitive, "meshes[0].primitives[0]"));
     if (!with_texture) return textured;
-    RECONAR_RETURN_IF_ERROR(ReadBaseColorImage(*primitive, &textured));
-    if (textured.base_color_image.empty()) textured.mesh.texcoords.clear();
-    return textured;
+    int64_t image_index = -1;
+    std::string image;
+    RECONAR_RETURN_IF_ERROR(ReadBaseColorImage(*primitive, "meshes[0].primitives[0]", &image_index, &image));
+    if (image.empty()) {
+      textured.mesh.texcoords.clear();
+      return textured;
+    }
+    textured.pages.push_back({0, std::move(image)});
+    // The other TRIANGLES primitives, when every one has a base colour image.
+    const JsonValue& primitives = *(*RootArray("meshes"))[0].Find("primitives");
+    TexturedGlb pages = textured;
+    for (size_t p = 1; p < primitives.size(); ++p) {
+      const std::string where = "meshes[0].primitives[" + std::to_string(p) + "]";
+      if (!primitives[p].is_object()) return Corrupt(where + " is not an object");
+      int64_t mode = kModeTriangles, index = -1;
+      RECONAR_RETURN_IF_ERROR(GetIndex(primitives[p], "mode", where, &mode, kModeTriangles));
+      if (mode != kModeTriangles) continue;
+      RECONAR_RETURN_IF_ERROR(ReadBaseColorImage(primitives[p], where, &index, &image));
+      if (image.empty()) return textured;
+      RECONAR_ASSIGN_OR_RETURN(const Mesh part, ReadPrimitive(primitives[p], where));
+      if (part.triangles.empty()) continue;
+      if (part.texcoords.size() != part.positions.size()) return Unsupported(where + " has no TEXCOORD_0 for its texture");
+      if (part.positions.size() > kMaxSceneVertices - pages.mesh.positions.size()) {
+        return FileError(StatusCode::kResourceExhausted, name_,
+                         "more than " + std::to_string(kMaxSceneVertices) + " vertices in the mesh");
+      }
+      if (pages.mesh.normals.empty() != part.normals.empty() || pages.mesh.colors.empty() != part.colors.empty()) {
+        return Unsupported(where + " has other vertex attributes than meshes[0].primitives[0]");
+      }
+      if (index != image_index) pages.pages.push_back({pages.mesh.triangles.size(), std::move(image)});
+      image_index = index;
+      const uint32_t first_vertex = static_cast<uint32_t>(pages.mesh.positions.size());
+      Mesh& mesh = pages.mesh;
+      mesh.positions.insert(mesh.positions.end(), part.positions.begin(), part.positions.end());
+      mesh.normals.insert(mesh.normals.end(), part.normals.begin(), part.normals.end());
+      mesh.colors.insert(mesh.colors.end(), part.colors.begin(), part.colors.end());
+      mesh.texcoords.insert(mesh.texcoords.end(), part.texcoords.begin(), part.texcoords.end());
+      for (const std::array<uint32_t, 3>& triangle : part.triangles) {
+        mesh.triangles.push_back({triangle[0] + first_vertex, triangle[1] + first_vertex, triangle[2] + first_vertex});
+      }
+    }
+    return pages;
   }
 
   // A .glb, or a .gltf JSON text.
@@ -817,9 +892,12 @@ class GlbDecoder {
 
   // The image of the primitive's material's base colour texture, when it has one: from a buffer
   // view, or a data: URI.
-  Status ReadBaseColorImage(const JsonValue& primitive, TexturedGlb* textured) const {
+  // The image of the primitive's material's base colour texture, and its index; empty when it has none.
+  Status ReadBaseColorImage(const JsonValue& primitive, const std::string& where, int64_t* image_index_out,
+                            std::string* image_bytes) const {
+    image_bytes->clear();
     int64_t material_index = -1, texture_index = -1, image_index = -1;
-    RECONAR_RETURN_IF_ERROR(GetIndex(primitive, "material", "meshes[0].primitives[0]", &material_index, -1));
+    RECONAR_RETURN_IF_ERROR(GetIndex(primitive, "material", where, &material_index, -1));
     if (material_index < 0) return Status::Ok();
     const JsonValue* material = nullptr;
     const std::string material_where = "materials[" + std::to_string(material_index) + "]";
@@ -839,6 +917,7 @@ class GlbDecoder {
         GetIndex(*texture, "source", "textures[" + std::to_string(texture_index) + "]", &image_index));
     const JsonValue* image_object = nullptr;
     RECONAR_RETURN_IF_ERROR(GetRootObject("images", image_index, &image_object));
+    *image_index_out = image_index;
     const JsonValue& image = *image_object;
     const std::string image_where = "images[" + std::to_string(image_index) + "]";
     if (const JsonValue* uri = image.Find("uri")) {
@@ -848,7 +927,7 @@ class GlbDecoder {
       std::string_view data;
       RECONAR_RETURN_IF_ERROR(LoadUriBuffer(kImageUriKey + static_cast<size_t>(image_index), *uri,
                                             image_where + ".uri", &data));
-      textured->base_color_image = std::string(data);
+      *image_bytes = std::string(data);
       return Status::Ok();
     }
     int64_t view_index = 0, buffer_index = 0, view_offset = 0, view_length = 0;
@@ -866,7 +945,7 @@ class GlbDecoder {
         static_cast<uint64_t>(view_length) > buffer.size() - static_cast<uint64_t>(view_offset)) {
       return Corrupt(view_where + " lies outside buffers[" + std::to_string(buffer_index) + "]");
     }
-    textured->base_color_image = std::string(buffer.substr(static_cast<size_t>(view_offset), static_cast<size_t>(view_length)));
+    *image_bytes = std::string(buffer.substr(static_cast<size_t>(view_offset), static_cast<size_t>(view_length)));
     return Status::Ok();
   }
 

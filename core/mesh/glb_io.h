@@ -13,9 +13,11 @@
 //   generator "reconar". Each buffer view starts on a 4-byte boundary, the JSON chunk is padded with
 //   spaces and the BIN chunk with zeros to 4 bytes. Written atomically.
 //
-// WriteTexturedGlb writes the same with TEXCOORD_0 (float VEC2) and one material: the given PNG as
-// its base colour texture (embedded in the BIN chunk; sampler linear, mipmapped, clamped to the
-// edge), metallic 0, roughness 1. COLOR_0, when the mesh has it, multiplies the texture (glTF's rule).
+// WriteTexturedGlb writes the same with TEXCOORD_0 (float VEC2) and one material per texture page:
+// the page's PNG as its base colour texture (embedded in the BIN chunk; sampler linear, mipmapped,
+// clamped to the edge), metallic 0, roughness 1. One page is the mesh as one primitive; several
+// pages are one primitive each (the page's triangles and the vertices they use), in page order,
+// of the one mesh. COLOR_0, when the mesh has it, multiplies the texture (glTF's rule).
 //
 // ReadGlb reads the first primitive of the first mesh: POSITION, NORMAL and COLOR_0 (float, or
 // normalized unsigned byte/short; VEC3 colours get alpha 255) and the indices (unsigned
@@ -51,19 +53,27 @@ Result<Mesh> ReadGlb(const std::string& path);
 // Whether `bytes` start with the PNG signature.
 bool IsPngSignature(std::string_view bytes);
 
-// kInvalidArgument as EncodeGlb, and for a mesh without texcoords or bytes that are not a PNG.
-Result<std::string> EncodeTexturedGlb(const Mesh& mesh, std::string_view base_color_png);
-Status WriteTexturedGlb(const std::string& path, const Mesh& mesh, std::string_view base_color_png);
+// A texture page as a file holds it (core/mesh/mesh.h's TexturePage, encoded).
+struct EncodedTexturePage {
+  size_t first_triangle = 0;
+  std::string image;  // PNG or JPEG bytes
+};
+
+// kInvalidArgument as EncodeGlb, and for a mesh without texcoords, pages out of order
+// (ValidateTexturePages) or an image that is not a PNG.
+Result<std::string> EncodeTexturedGlb(const Mesh& mesh, const std::vector<EncodedTexturePage>& pages);
+Status WriteTexturedGlb(const std::string& path, const Mesh& mesh, const std::vector<EncodedTexturePage>& pages);
 
 // A mesh with its texture as a .glb holds it.
 struct TexturedGlb {
-  Mesh mesh;                     // with texcoords when base_color_image is not empty
-  std::string base_color_image;  // the encoded image (PNG or JPEG), empty without one
+  Mesh mesh;                               // with texcoords when there are pages
+  std::vector<EncodedTexturePage> pages;   // empty without a texture
 };
-// ReadGlb, plus TEXCOORD_0 (float, or normalized unsigned byte/short) and the image of the first
-// primitive's material's base colour texture (from a buffer view or a data: URI; an external image
-// file is kUnsupported, as is a texture on another TEXCOORD set). Without a base colour image the
-// mesh comes back without texcoords.
+// ReadGlb, plus TEXCOORD_0 (float, or normalized unsigned byte/short) and the base colour images
+// of the first mesh's primitives' materials (from a buffer view or a data: URI; an external image
+// file is kUnsupported, as is a texture on another TEXCOORD set): when every TRIANGLES primitive of
+// the first mesh has one, they are read as one mesh, a page per run of primitives with one image.
+// Otherwise the first primitive alone, with its image when it has one, without texcoords when not.
 Result<TexturedGlb> DecodeTexturedGlb(std::string_view bytes, const std::string& name_for_errors);
 Result<TexturedGlb> ReadTexturedGlb(const std::string& path);
 

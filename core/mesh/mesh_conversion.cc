@@ -1,5 +1,6 @@
 #include "core/mesh/mesh_conversion.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 
@@ -26,12 +27,14 @@ Result<MeshConversionReport> ConvertMeshFile(const std::string& input, const std
   MeshConversionReport report;
   const auto start = std::chrono::steady_clock::now();
   Mesh mesh;
-  std::string texture_png;
+  std::vector<EncodedTexturePage> texture_pngs;
   if (input_format == MeshFileFormat::kGlb) {
     RECONAR_ASSIGN_OR_RETURN(TexturedGlb textured, ReadTexturedGlb(input));
     mesh = std::move(textured.mesh);
-    if (IsPngSignature(textured.base_color_image)) {
-      texture_png = std::move(textured.base_color_image);
+    if (!textured.pages.empty() && std::all_of(textured.pages.begin(), textured.pages.end(), [](const auto& page) {
+          return IsPngSignature(page.image);
+        })) {
+      texture_pngs = std::move(textured.pages);
     } else {
       mesh.texcoords.clear();  // a JPEG texture (another tool's) is not carried over
     }
@@ -42,7 +45,7 @@ Result<MeshConversionReport> ConvertMeshFile(const std::string& input, const std
   report.seconds_read = SecondsBetween(start, read);
   report.vertices_read = mesh.positions.size();
   report.triangles_read = mesh.triangles.size();
-  report.textured = !texture_png.empty();
+  report.textured = !texture_pngs.empty();
   if (report.textured && options.max_faces > 0 && mesh.triangles.size() > options.max_faces) {
     return FileError(StatusCode::kInvalidArgument, input,
                      "a textured model is not simplified (its texture charts would tear): export it without "
@@ -55,14 +58,18 @@ Result<MeshConversionReport> ConvertMeshFile(const std::string& input, const std
   const std::string parent = std::filesystem::path(output).parent_path().string();
   if (!parent.empty()) RECONAR_RETURN_IF_ERROR(CreateDirectories(parent));
   if (report.textured && output_format == MeshFileFormat::kGlb) {
-    RECONAR_RETURN_IF_ERROR(WriteTexturedGlb(output, mesh, texture_png));
+    RECONAR_RETURN_IF_ERROR(WriteTexturedGlb(output, mesh, texture_pngs));
   } else if (report.textured && output_format == MeshFileFormat::kObj) {
-    // The texture beside the OBJ, named after it, as its material library names it.
+    // The texture's pages beside the OBJ, named after it, as its material library names them.
     const std::filesystem::path obj(output);
-    const std::string texture_name = obj.stem().string() + ".png";
-    report.texture_path = (obj.parent_path() / texture_name).string();
-    RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.texture_path, texture_png));
-    RECONAR_RETURN_IF_ERROR(WriteTexturedObj(output, mesh, texture_name));
+    std::vector<ObjTextureFile> page_files;
+    for (size_t k = 0; k < texture_pngs.size(); ++k) {
+      const std::string name = obj.stem().string() + (k == 0 ? "" : "_" + std::to_string(k)) + ".png";
+      report.texture_paths.push_back((obj.parent_path() / name).string());
+      RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.texture_paths.back(), texture_pngs[k].image));
+      page_files.push_back({texture_pngs[k].first_triangle, name});
+    }
+    RECONAR_RETURN_IF_ERROR(WriteTexturedObj(output, mesh, page_files));
   } else {
     report.texture_dropped = report.textured;
     mesh.texcoords.clear();

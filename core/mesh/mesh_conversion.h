@@ -2,7 +2,8 @@
 // `reconar export`: a mesh or point cloud file read, simplified to a face budget when it has more
 // triangles, and written in the format its output name asks for (core/mesh/mesh_file.h). A
 // textured .glb (its base colour texture a PNG, as `reconar texture` writes it) keeps its texture
-// into .glb, and into .obj with the texture beside it (OUTPUT's stem + .png, named by the .mtl);
+// into .glb, and into .obj with the texture beside it (OUTPUT's stem + .png, and stem_1.png, ... for
+// further pages, named by the .mtl);
 // .ply and .wrl carry no texture (the report says it was dropped); a textured model over the face
 // budget is refused rather than simplified (its charts would tear).
 #include <cstddef>
@@ -26,7 +27,7 @@ struct MeshConversionReport {
   bool normals = false, colors = false;
   bool textured = false;         // the input had a texture
   bool texture_dropped = false;  // ... which the output's format cannot hold
-  std::string texture_path;      // the .obj's texture, written beside it
+  std::vector<std::string> texture_paths;  // the .obj's texture pages, written beside it
   SimplifyReport simplify;
   uintmax_t bytes = 0;  // of the output file
   double seconds_read = 0.0, seconds_write = 0.0;

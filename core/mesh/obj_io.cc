@@ -26,11 +26,13 @@ void AppendIndex(std::string* out, uint64_t one_based) {
   out->append(buffer, result.ptr);
 }
 
-// `material_library`: when not empty, the mesh's texcoords are written ("vt u 1-v") and its faces
-// use the library's material kTextureMaterial.
-constexpr const char* kTextureMaterial = "texture";
+// The material of texture page k in the library WriteTexturedObj writes.
+std::string TextureMaterial(size_t page) { return page == 0 ? "texture" : "texture_" + std::to_string(page); }
 
-std::string ObjText(const Mesh& mesh, const std::string& material_library = "") {
+// `material_library`: when not empty, the mesh's texcoords are written ("vt u 1-v") and the faces
+// of page k use the library's material TextureMaterial(k).
+std::string ObjText(const Mesh& mesh, const std::string& material_library = "",
+                    const std::vector<ObjTextureFile>& pages = {}) {
   std::string out = "# reconar\n# " + std::to_string(mesh.positions.size()) + " vertices, " +
                     std::to_string(mesh.triangles.size()) + " triangles\n";
   const bool with_texcoords = !material_library.empty();
@@ -63,9 +65,13 @@ std::string ObjText(const Mesh& mesh, const std::string& material_library = "") 
       AppendShortest(&out, 1.0f - uv.y());  // OBJ's v runs up the image
       out.push_back('\n');
     }
-    out += std::string("usemtl ") + kTextureMaterial + "\n";
   }
-  for (const std::array<uint32_t, 3>& triangle : mesh.triangles) {
+  size_t page = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    while (with_texcoords && page < pages.size() && pages[page].first_triangle == t) {
+      out += "usemtl " + TextureMaterial(page++) + "\n";
+    }
+    const std::array<uint32_t, 3>& triangle = mesh.triangles[t];
     out.push_back('f');
     for (const uint32_t index : triangle) {
       out.push_back(' ');
@@ -314,19 +320,24 @@ Status WriteObj(const std::string& path, const Mesh& mesh) {
   return WriteFileAtomically(path, ObjText(mesh));
 }
 
-Status WriteTexturedObj(const std::string& obj_path, const Mesh& mesh, const std::string& texture_file_name) {
+Status WriteTexturedObj(const std::string& obj_path, const Mesh& mesh, const std::vector<ObjTextureFile>& pages) {
   const Status valid = ValidateMesh(mesh);
   if (!valid.ok()) return valid.WithContext(obj_path);
   RECONAR_RETURN_IF_ERROR(mesh_internal::CheckFiniteVertices(obj_path, mesh));
   if (mesh.texcoords.empty()) return FileError(StatusCode::kInvalidArgument, obj_path, "the mesh has no texcoords");
+  const Status ordered = ValidateTexturePages(pages, mesh.triangles.size());
+  if (!ordered.ok()) return ordered.WithContext(obj_path);
   const std::filesystem::path obj(obj_path);
   const std::string library = obj.stem().string() + ".mtl";
   const std::string library_path = (obj.parent_path() / library).string();
   // Ka, Kd white: the texture's colours unchanged; illum 1: no specular highlight.
-  const std::string material = std::string("# reconar\nnewmtl ") + kTextureMaterial +
-                               "\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " + texture_file_name + "\n";
-  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(library_path, material));
-  return WriteFileAtomically(obj_path, ObjText(mesh, library));
+  std::string materials = "# reconar\n";
+  for (size_t k = 0; k < pages.size(); ++k) {
+    materials += "newmtl " + TextureMaterial(k) + "\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " +
+                 pages[k].file_name + "\n";
+  }
+  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(library_path, materials));
+  return WriteFileAtomically(obj_path, ObjText(mesh, library, pages));
 }
 
 Result<Mesh> ReadObj(const std::string& path) {

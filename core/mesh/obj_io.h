@@ -35,11 +35,18 @@
 namespace reconar {
 
 Status WriteObj(const std::string& path, const Mesh& mesh);
+// A texture page's image file, for the triangles from first_triangle on (core/mesh/mesh.h's
+// TexturePage).
+struct ObjTextureFile {
+  size_t first_triangle = 0;
+  std::string file_name;  // relative to the OBJ
+};
 // WriteObj with the mesh's texcoords ("vt u v", v flipped to OBJ's upward axis; corners "v/vt" or
 // "v/vt/vn") and a material library beside it (OBJ's stem + ".mtl", written first, atomically)
-// whose one material maps `texture_file_name` (relative to the OBJ, written by the caller) as
-// the diffuse colour. kInvalidArgument, nothing written, for a mesh without texcoords.
-Status WriteTexturedObj(const std::string& obj_path, const Mesh& mesh, const std::string& texture_file_name);
+// with a material per page ("texture", "texture_1", ...; "usemtl" before the page's first face)
+// mapping the page's file (written by the caller) as the diffuse colour. kInvalidArgument,
+// nothing written, for a mesh without texcoords or pages out of order.
+Status WriteTexturedObj(const std::string& obj_path, const Mesh& mesh, const std::vector<ObjTextureFile>& pages);
 Result<Mesh> ReadObj(const std::string& path);
 Result<std::vector<NamedMesh>> ReadObjGroups(const std::string& path);
 

@@ -452,7 +452,7 @@ Result<ReconstructReport> RunReconstruct(const std::vector<std::string>& image_p
       return Status::Ok();
     };
     RECONAR_RETURN_IF_ERROR(runner.Run("texture", TextureStageSettings(texture),
-                                       Exists(project.MeshDir() + "/texture_report.json"), runner.redone(),
+                                       Exists(TexturedModelFilesOf(project).report), runner.redone(),
                                        run_texture));
   }
 

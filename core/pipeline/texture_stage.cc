@@ -53,6 +53,7 @@ std::string TextureStageSettings(const TextureStageOptions& options) {
   return StageRecord::Settings({{"version", 1},
                                 {"max_faces", static_cast<double>(options.max_faces)},
                                 {"atlas_size", options.texture.atlas_size},
+                                {"max_pages", options.texture.max_pages},
                                 {"exclude", static_cast<double>(hash.value() >> 24)}});
 }
 
@@ -128,26 +129,55 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
   RECONAR_ASSIGN_OR_RETURN(const TexturedMesh textured, TextureMesh(mesh, photos, load, texture, &report.texture));
 
   RECONAR_RETURN_IF_ERROR(CreateDirectories(project.MeshDir()));
-  const std::string png_path = project.MeshDir() + "/textured.png";
-  RECONAR_ASSIGN_OR_RETURN(const std::string png, EncodePng(textured.atlas.view(), 3, kPngFastCompression));
-  RECONAR_RETURN_IF_ERROR(WriteFileAtomically(png_path, png));
-  const std::string obj_path = project.MeshDir() + "/textured.obj";
-  RECONAR_RETURN_IF_ERROR(WriteTexturedObj(obj_path, textured.mesh, "textured.png"));
-  const std::string glb_path = TexturedModelPath(project);
-  RECONAR_RETURN_IF_ERROR(WriteTexturedGlb(glb_path, textured.mesh, png));
-  report.paths = {glb_path, obj_path, project.MeshDir() + "/textured.mtl", png_path};
+  std::vector<EncodedTexturePage> pngs;
+  std::vector<ObjTextureFile> page_files;
+  std::vector<std::string> png_paths;
+  for (size_t k = 0; k < textured.pages.size(); ++k) {
+    const TexturePage& page = textured.pages[k];
+    RECONAR_ASSIGN_OR_RETURN(std::string png, EncodePng(page.image.view(), 3, kPngFastCompression));
+    png_paths.push_back(project.MeshDir() + "/" + TexturePageFileName(k));
+    RECONAR_RETURN_IF_ERROR(WriteFileAtomically(png_paths.back(), png));
+    pngs.push_back({page.first_triangle, std::move(png)});
+    page_files.push_back({page.first_triangle, TexturePageFileName(k)});
+  }
+  RECONAR_RETURN_IF_ERROR(RemoveTexturePagesFrom(project, textured.pages.size()));
+  const TexturedModelFiles files = TexturedModelFilesOf(project);
+  RECONAR_RETURN_IF_ERROR(WriteTexturedObj(files.obj, textured.mesh, page_files));
+  RECONAR_RETURN_IF_ERROR(WriteTexturedGlb(files.glb, textured.mesh, pngs));
+  report.paths = {files.glb, files.obj, files.mtl};
+  report.paths.insert(report.paths.end(), png_paths.begin(), png_paths.end());
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report.peak_rss_bytes = PeakResidentBytes();
-  report.report_path = project.MeshDir() + "/texture_report.json";
+  report.report_path = files.report;
   RECONAR_RETURN_IF_ERROR(WriteFileAtomically(report.report_path, TextureReportJson(report)));
   return report;
 }
 
-Status RemoveTexturedModel(const Project& project) {
-  for (const char* name : {"texture_report.json", "textured.glb", "textured.obj", "textured.mtl", "textured.png"}) {
-    RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(project.MeshDir() + "/" + name));
+TexturedModelFiles TexturedModelFilesOf(const Project& project) {
+  const std::string dir = project.MeshDir() + "/";
+  return {dir + "textured.glb", dir + "textured.obj", dir + "textured.mtl", dir + "texture_report.json"};
+}
+
+std::string TexturePageFileName(size_t page) {
+  return page == 0 ? "textured.png" : "textured_" + std::to_string(page) + ".png";
+}
+
+Status RemoveTexturePagesFrom(const Project& project, size_t first_page) {
+  // The pages are written in order, so those left behind are a run from first_page on.
+  for (size_t page = first_page;; ++page) {
+    const std::string path = project.MeshDir() + "/" + TexturePageFileName(page);
+    std::error_code error;
+    if (!std::filesystem::exists(path, error) && page > 0) return Status::Ok();
+    RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(path));
   }
-  return Status::Ok();
+}
+
+Status RemoveTexturedModel(const Project& project) {
+  const TexturedModelFiles files = TexturedModelFilesOf(project);
+  for (const std::string* path : {&files.report, &files.glb, &files.obj, &files.mtl}) {
+    RECONAR_RETURN_IF_ERROR(RemoveFileIfPresent(*path));
+  }
+  return RemoveTexturePagesFrom(project, 0);
 }
 
 std::string TextureReportJson(const TextureStageReport& report) {
@@ -178,6 +208,7 @@ std::string TextureReportJson(const TextureStageReport& report) {
   json.Key("seam_edges").Int(static_cast<long long>(t.seam_edges));
   json.Key("seam_step_before").Double(t.seam_step_before);
   json.Key("seam_step_after").Double(t.seam_step_after);
+  json.Key("atlas_pages").Int(static_cast<long long>(t.atlas_pages));
   json.Key("atlas_width").Int(t.atlas_width).Key("atlas_height").Int(t.atlas_height);
   json.Key("texels_per_pixel").Double(t.texels_per_pixel);
   json.Key("atlas_fill").Double(t.atlas_fill);

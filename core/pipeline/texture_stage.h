@@ -1,8 +1,8 @@
 #pragma once
 // Texture stage: PROJECT/mesh/mesh.{ply,glb,obj} and the registered photos -> the mesh simplified
 // to a face budget and textured from the photos (core/texture/texture_mesh.h) ->
-// PROJECT/mesh/textured.{png,obj,mtl,glb} and mesh/texture_report.json, each atomically, the
-// report last.
+// PROJECT/mesh/textured.{png,obj,mtl,glb} (textured_1.png, ... for the texture's further pages) and
+// mesh/texture_report.json, each atomically, the report last.
 //
 // Face budget: the texture carries the surface's detail, so the geometry needs only its shape:
 // kTexturedMaxFaces (a third of the handheld budget the untextured mesh keeps) leaves the GPU the
@@ -56,8 +56,22 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
 
 std::string TextureReportJson(const TextureStageReport& report);
 
-// PROJECT/mesh/textured.glb, the stage's main output.
-inline std::string TexturedModelPath(const Project& project) { return project.MeshDir() + "/textured.glb"; }
+// The stage's files in PROJECT/mesh, but for the texture's pages (TexturePageFileName).
+struct TexturedModelFiles {
+  std::string glb;     // textured.glb, the stage's main output
+  std::string obj;     // textured.obj
+  std::string mtl;     // textured.mtl, the OBJ's materials (WriteTexturedObj names it after the OBJ)
+  std::string report;  // texture_report.json
+};
+TexturedModelFiles TexturedModelFilesOf(const Project& project);
+
+inline std::string TexturedModelPath(const Project& project) { return TexturedModelFilesOf(project).glb; }
+
+// The file of texture page k in the mesh directory: textured.png, textured_1.png, ...
+std::string TexturePageFileName(size_t page);
+
+// Removes the page files from page `first_page` on (those a texture of fewer pages left behind).
+Status RemoveTexturePagesFrom(const Project& project, size_t first_page);
 
 // Removes the stage's outputs and report: the mesh stage does when it replaces the mesh they were
 // made from, so that no view or render shows a textured model of a mesh that is gone.

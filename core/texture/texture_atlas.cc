@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 #include "core/base/image_sampling.h"
@@ -38,34 +39,51 @@ void SizeCharts(double scale, int padding, std::vector<TextureChart>* charts) {
   }
 }
 
-// Skyline packing (bottom-left): each chart, in `order`, goes where the skyline lets it sit
-// lowest (its top the smallest), leftmost among equals; the skyline is the top edge of what is
-// placed, as segments left to right. The height used, or -1 when a chart is wider than `width`.
-int PackSkyline(int width, const std::vector<size_t>& order, std::vector<TextureChart>* charts) {
+// Skyline packing (bottom-left) into pages `width` wide and at most `max_height` high: each chart,
+// in `order`, goes where a page's skyline lets it sit lowest (its top the smallest), leftmost
+// among equals, on the first page where it fits; a new page when none holds it. The skyline is
+// the top edge of what is placed, as segments left to right. The height used on each page, or
+// nothing when a chart is wider than `width` or higher than `max_height`.
+std::optional<std::vector<int>> PackSkyline(int width, int max_height, const std::vector<size_t>& order,
+                             std::vector<TextureChart>* charts) {
   struct Segment {
     int x, y, width;
   };
-  std::vector<Segment> skyline = {{0, 0, width}};
-  int used = 0;
+  std::vector<std::vector<Segment>> skylines;
+  std::vector<int> used;
   for (const size_t index : order) {
     TextureChart& chart = (*charts)[index];
-    if (chart.width > width) return -1;
+    if (chart.width > width || chart.height > max_height) return std::nullopt;
     int best_top = INT32_MAX, best_segment = -1, best_y = 0;
-    for (size_t i = 0; i < skyline.size(); ++i) {
-      if (skyline[i].x + chart.width > width) break;
-      int y = 0;
-      for (size_t j = i; j < skyline.size() && skyline[j].x < skyline[i].x + chart.width; ++j) {
-        y = std::max(y, skyline[j].y);
+    size_t page = 0;
+    for (; page < skylines.size(); ++page) {
+      const std::vector<Segment>& skyline = skylines[page];
+      for (size_t i = 0; i < skyline.size(); ++i) {
+        if (skyline[i].x + chart.width > width) break;
+        int y = 0;
+        for (size_t j = i; j < skyline.size() && skyline[j].x < skyline[i].x + chart.width; ++j) {
+          y = std::max(y, skyline[j].y);
+        }
+        if (y + chart.height < best_top && y + chart.height <= max_height) {
+          best_top = y + chart.height;
+          best_segment = static_cast<int>(i);
+          best_y = y;
+        }
       }
-      if (y + chart.height < best_top) {
-        best_top = y + chart.height;
-        best_segment = static_cast<int>(i);
-        best_y = y;
-      }
+      if (best_segment >= 0) break;
     }
+    if (page == skylines.size()) {
+      skylines.push_back({{0, 0, width}});
+      used.push_back(0);
+      best_top = chart.height;
+      best_segment = 0;
+      best_y = 0;
+    }
+    std::vector<Segment>& skyline = skylines[page];
+    chart.page = static_cast<int>(page);
     chart.x = skyline[static_cast<size_t>(best_segment)].x;
     chart.y = best_y;
-    used = std::max(used, best_top);
+    used[page] = std::max(used[page], best_top);
     // The new segment replaces what it covers; a segment partly covered keeps its right part.
     const int right = chart.x + chart.width;
     size_t j = static_cast<size_t>(best_segment);
@@ -286,46 +304,51 @@ std::vector<TextureChart> MakeCharts(const Mesh& mesh, const TexturePatches& pat
   return charts;
 }
 
-Result<AtlasLayout> PackCharts(std::vector<TextureChart> charts, int atlas_size, int padding) {
+Result<AtlasLayout> PackCharts(std::vector<TextureChart> charts, int atlas_size, int padding, int max_pages) {
   AtlasLayout layout;
   layout.padding = padding;
-  auto try_scale = [&](double scale, int width) {
+  auto try_scale = [&](double scale, int width, int max_height) {
     SizeCharts(scale, padding, &charts);
-    return PackSkyline(width, PackingOrder(charts), &charts);
+    return PackSkyline(width, max_height, PackingOrder(charts), &charts);
   };
-  // At full resolution, the narrowest power-of-two square-ish atlas that holds the charts.
+  // At full resolution, the narrowest power-of-two square-ish page that holds the charts.
   SizeCharts(1.0, padding, &charts);
   double area = 0.0;
   for (const TextureChart& chart : charts) area += static_cast<double>(chart.width) * chart.height;
   int width = std::min(atlas_size, NextPowerOfTwo(std::max(kMinAtlasSide, static_cast<int>(std::sqrt(area)))));
   double scale = 1.0;
-  int height = -1;
+  std::optional<std::vector<int>> heights;
   for (; width <= atlas_size; width *= 2) {
-    height = try_scale(1.0, width);
-    if (height >= 0 && height <= width) break;
+    heights = try_scale(1.0, width, width);
+    if (heights && heights->size() == 1) break;
   }
   if (width > atlas_size) {
+    // Full pages at full resolution, as many as max_pages; the largest scale that fits them else.
     width = atlas_size;
-    double low = 0.0, high = 1.0;
-    for (int step = 0; step < kBisectionSteps; ++step) {
-      const double middle = 0.5 * (low + high);
-      const int used = try_scale(middle, width);
-      if (used >= 0 && used <= atlas_size) {
-        low = middle;
-      } else {
-        high = middle;
+    heights = try_scale(1.0, width, atlas_size);
+    if (!heights || heights->size() > static_cast<size_t>(max_pages)) {
+      double low = 0.0, high = 1.0;
+      for (int step = 0; step < kBisectionSteps; ++step) {
+        const double middle = 0.5 * (low + high);
+        const auto used = try_scale(middle, width, atlas_size);
+        if (used && used->size() <= static_cast<size_t>(max_pages)) {
+          low = middle;
+        } else {
+          high = middle;
+        }
       }
+      if (!(low > 0.0)) {
+        return Status(StatusCode::kResourceExhausted,
+                      "texture: " + std::to_string(charts.size()) + " charts do not fit in " +
+                          std::to_string(max_pages) + " page(s) of " + std::to_string(atlas_size) + " x " +
+                          std::to_string(atlas_size) + " texels with their padding");
+      }
+      scale = low;
+      heights = try_scale(scale, width, atlas_size);
     }
-    if (!(low > 0.0)) {
-      return Status(StatusCode::kResourceExhausted,
-                    "texture: " + std::to_string(charts.size()) + " charts do not fit in " +
-                        std::to_string(atlas_size) + " x " + std::to_string(atlas_size) + " texels with their padding");
-    }
-    scale = low;
-    height = try_scale(scale, width);
   }
-  layout.width = width;
-  layout.height = std::max(kMinAtlasSide, NextPowerOfTwo(height));
+  for (const int height : *heights) layout.pages.push_back({width, std::max(kMinAtlasSide, NextPowerOfTwo(height))});
+  if (layout.pages.empty()) layout.pages.push_back({kMinAtlasSide, kMinAtlasSide});
   layout.scale = scale;
   layout.charts = std::move(charts);
   return layout;
@@ -335,8 +358,11 @@ Result<AtlasFill> FillAtlas(const Mesh& mesh, const AtlasLayout& layout, const s
                             const std::vector<Eigen::Vector3f>& gains, const PatchColourCorrection& correction,
                             const PhotoAccess& access, int num_threads) {
   AtlasFill fill;
-  fill.atlas = Image<uint8_t>(layout.width, layout.height, 3);
-  std::vector<uint8_t> covered(static_cast<size_t>(layout.width) * layout.height, 0);
+  std::vector<std::vector<uint8_t>> covered;
+  for (const AtlasPage& page : layout.pages) {
+    fill.pages.emplace_back(page.width, page.height, 3);
+    covered.emplace_back(static_cast<size_t>(page.width) * page.height, 0);
+  }
   std::vector<std::vector<size_t>> charts_of_photo(projectors.size());
   for (size_t k = 0; k < layout.charts.size(); ++k) {
     const TextureChart& chart = layout.charts[k];
@@ -344,10 +370,12 @@ Result<AtlasFill> FillAtlas(const Mesh& mesh, const AtlasLayout& layout, const s
       charts_of_photo[static_cast<size_t>(chart.photo)].push_back(k);
       continue;
     }
+    Image<uint8_t>& atlas = fill.pages[static_cast<size_t>(chart.page)];
+    std::vector<uint8_t>& page_covered = covered[static_cast<size_t>(chart.page)];
     for (int y = chart.y; y < chart.y + chart.height; ++y) {
-      std::fill(fill.atlas.row(y) + 3 * chart.x, fill.atlas.row(y) + 3 * (chart.x + chart.width), uint8_t{255});
-      std::fill(covered.begin() + static_cast<ptrdiff_t>(y) * layout.width + chart.x,
-                covered.begin() + static_cast<ptrdiff_t>(y) * layout.width + chart.x + chart.width, uint8_t{1});
+      std::fill(atlas.row(y) + 3 * chart.x, atlas.row(y) + 3 * (chart.x + chart.width), uint8_t{255});
+      std::fill(page_covered.begin() + static_cast<ptrdiff_t>(y) * atlas.width() + chart.x,
+                page_covered.begin() + static_cast<ptrdiff_t>(y) * atlas.width() + chart.x + chart.width, uint8_t{1});
     }
   }
   std::vector<Status> errors(projectors.size());
@@ -361,22 +389,29 @@ Result<AtlasFill> FillAtlas(const Mesh& mesh, const AtlasLayout& layout, const s
     for (const size_t k : charts_of_photo[photo]) {
       const TextureChart& chart = layout.charts[k];
       for (const auto& triangle : chart.triangles) {
-        FillTriangle(mesh, layout, chart, triangle, projectors[photo], *pixels, gains[photo], correction, &fill.atlas,
-                     &covered);
+        FillTriangle(mesh, layout, chart, triangle, projectors[photo], *pixels, gains[photo], correction,
+                     &fill.pages[static_cast<size_t>(chart.page)], &covered[static_cast<size_t>(chart.page)]);
       }
     }
   });
   for (const Status& status : errors) RECONAR_RETURN_IF_ERROR(status);
-  size_t covered_texels = 0;
-  for (const uint8_t c : covered) covered_texels += c != 0;
-  fill.covered_fraction = static_cast<double>(covered_texels) / static_cast<double>(covered.size());
+  size_t covered_texels = 0, texels = 0;
+  for (const std::vector<uint8_t>& page_covered : covered) {
+    for (const uint8_t c : page_covered) covered_texels += c != 0;
+    texels += page_covered.size();
+  }
+  fill.covered_fraction = static_cast<double>(covered_texels) / static_cast<double>(texels);
   pool.ParallelFor(0, layout.charts.size(), [&](size_t k, int) {
-    if (layout.charts[k].photo >= 0) DilateChart(layout.charts[k], layout.padding + 1, &fill.atlas, &covered);
+    const TextureChart& chart = layout.charts[k];
+    if (chart.photo >= 0) {
+      const size_t page = static_cast<size_t>(chart.page);
+      DilateChart(chart, layout.padding + 1, &fill.pages[page], &covered[page]);
+    }
   });
   return fill;
 }
 
-SeamSteps MeasureSeamSteps(const Mesh& mesh, const AtlasLayout& layout, const Image<uint8_t>& atlas,
+SeamSteps MeasureSeamSteps(const Mesh& mesh, const AtlasLayout& layout, const std::vector<Image<uint8_t>>& pages,
                            const std::vector<Eigen::Vector3f>& gains, const PatchColourCorrection& correction,
                            const std::vector<SeamEdge>& edges) {
   std::vector<std::pair<int, int>> place_of_face(mesh.triangles.size(), {-1, -1});  // chart, triangle
@@ -399,7 +434,7 @@ SeamSteps MeasureSeamSteps(const Mesh& mesh, const AtlasLayout& layout, const Im
       offset += static_cast<float>(weights[static_cast<int>(i)]) * correction.At(chart.patch, chart.vertices[local]);
     }
     float rgb[3];
-    if (!SampleBilinear(atlas, texel.x() - 0.5, texel.y() - 0.5, rgb)) return false;
+    if (!SampleBilinear(pages[static_cast<size_t>(chart.page)], texel.x() - 0.5, texel.y() - 0.5, rgb)) return false;
     *corrected = Eigen::Vector3f(rgb[0], rgb[1], rgb[2]);
     *uncorrected = (*corrected - offset).cwiseQuotient(gains[static_cast<size_t>(chart.photo)]);
     return true;
@@ -431,27 +466,32 @@ SeamSteps MeasureSeamSteps(const Mesh& mesh, const AtlasLayout& layout, const Im
   return steps;
 }
 
-Mesh TexturedChartsMesh(const Mesh& mesh, const AtlasLayout& layout) {
+Mesh TexturedChartsMesh(const Mesh& mesh, const AtlasLayout& layout, std::vector<size_t>* page_first_triangle) {
   Mesh out;
   const bool untextured =
       std::any_of(layout.charts.begin(), layout.charts.end(), [](const TextureChart& c) { return c.patch < 0; });
-  const Eigen::Vector2d size(layout.width, layout.height);
-  for (const TextureChart& chart : layout.charts) {
-    const uint32_t first = static_cast<uint32_t>(out.positions.size());
-    for (size_t k = 0; k < chart.vertices.size(); ++k) {
-      const uint32_t vertex = chart.vertices[k];
-      out.positions.push_back(mesh.positions[vertex]);
-      if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[vertex]);
-      out.texcoords.push_back(layout.Texel(chart, k).cwiseQuotient(size).cast<float>());
-      if (untextured) {
-        if (chart.patch >= 0) {
-          out.colors.push_back({255, 255, 255, 255});
-        } else {
-          out.colors.push_back(mesh.colors.empty() ? kNoPhotoColour : mesh.colors[vertex]);
+  page_first_triangle->clear();
+  for (size_t page = 0; page < layout.pages.size(); ++page) {
+    page_first_triangle->push_back(out.triangles.size());
+    const Eigen::Vector2d size(layout.pages[page].width, layout.pages[page].height);
+    for (const TextureChart& chart : layout.charts) {
+      if (chart.page != static_cast<int>(page)) continue;
+      const uint32_t first = static_cast<uint32_t>(out.positions.size());
+      for (size_t k = 0; k < chart.vertices.size(); ++k) {
+        const uint32_t vertex = chart.vertices[k];
+        out.positions.push_back(mesh.positions[vertex]);
+        if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[vertex]);
+        out.texcoords.push_back(layout.Texel(chart, k).cwiseQuotient(size).cast<float>());
+        if (untextured) {
+          if (chart.patch >= 0) {
+            out.colors.push_back({255, 255, 255, 255});
+          } else {
+            out.colors.push_back(mesh.colors.empty() ? kNoPhotoColour : mesh.colors[vertex]);
+          }
         }
       }
+      for (const auto& t : chart.triangles) out.triangles.push_back({first + t[0], first + t[1], first + t[2]});
     }
-    for (const auto& t : chart.triangles) out.triangles.push_back({first + t[0], first + t[1], first + t[2]});
   }
   return out;
 }

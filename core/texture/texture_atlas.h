@@ -6,12 +6,14 @@
 // by one factor for the whole atlas (at most 1: never finer than the photos), offset to the
 // chart's rectangle, with `padding` texels around. The rectangles are packed, tallest first, each
 // where it sits lowest on the skyline of those before it (bottom-left skyline packing), into the
-// narrowest power-of-two width whose height fits it; when even
-// atlas_size does not hold them at full resolution, the largest scale that fits is found by
-// bisection. A texel whose centre lies in a face takes the photo's colour of the face's point
-// there (through the camera model, so the lens distortion is followed inside the face) times the
-// photo's gain plus the seam correction; then each chart's covered texels are grown into its padding, so that bilinear
-// filtering and mipmaps down to log2(padding) levels read the chart's own colours.
+// narrowest power-of-two square page that holds them all; when atlas_size does not, into pages of
+// atlas_size x atlas_size (a chart goes on the first page it fits on), as many as `max_pages`, and
+// when even those do not hold them at full resolution, the largest scale that fits is found by
+// bisection. Each page's height is cropped to the power of two its charts reach.
+// A texel whose centre lies in a face takes the photo's colour of the face's point there (through
+// the camera model, so the lens distortion is followed inside the face) times the photo's gain
+// plus the seam correction; then each chart's covered texels are grown into its padding, so that
+// bilinear filtering and mipmaps down to log2(padding) levels read the chart's own colours.
 // Faces no photo sees share a small white chart and keep their vertex colour.
 #include <array>
 #include <cstdint>
@@ -37,16 +39,21 @@ struct TextureChart {
   std::vector<std::array<uint32_t, 3>> triangles;    // local indices, one per face
   std::vector<Eigen::Vector2d> pixels;               // per local vertex: full-resolution photo pixel
   Eigen::Vector2d pixel_min = Eigen::Vector2d::Zero(), pixel_max = Eigen::Vector2d::Zero();
-  int x = 0, y = 0, width = 0, height = 0;           // rectangle in the atlas, padding included
+  int page = 0;                                      // of the atlas
+  int x = 0, y = 0, width = 0, height = 0;           // rectangle in its page, padding included
+};
+
+struct AtlasPage {
+  int width = 0, height = 0;  // texels, powers of two
 };
 
 struct AtlasLayout {
-  int width = 0, height = 0;
+  std::vector<AtlasPage> pages;
   double scale = 1.0;  // texels per photo pixel
   int padding = 0;
   std::vector<TextureChart> charts;
 
-  // Texel coordinates (continuous: texel i spans [i, i + 1)) of a chart's local vertex.
+  // Texel coordinates in its page (continuous: texel i spans [i, i + 1)) of a chart's local vertex.
   Eigen::Vector2d Texel(const TextureChart& chart, size_t local_vertex) const;
 };
 
@@ -54,17 +61,18 @@ struct AtlasLayout {
 std::vector<TextureChart> MakeCharts(const Mesh& mesh, const TexturePatches& patches,
                                      const std::vector<PhotoProjector>& projectors);
 
-// Places the charts. kResourceExhausted when even a tiny scale does not fit (more charts than
-// the atlas holds with their padding).
-Result<AtlasLayout> PackCharts(std::vector<TextureChart> charts, int atlas_size, int padding);
+// Places the charts on pages of at most atlas_size x atlas_size texels, at most `max_pages` of them.
+// kResourceExhausted when even a tiny scale does not fit (more charts than the pages hold with
+// their padding).
+Result<AtlasLayout> PackCharts(std::vector<TextureChart> charts, int atlas_size, int padding, int max_pages);
 
 // A photo's full-resolution pixels for the filling: *photo points to them (kept elsewhere, or
 // loaded into `storage`).
 using PhotoAccess = std::function<Status(size_t photo, Image<uint8_t>* storage, const Image<uint8_t>** photo_pixels)>;
 
 struct AtlasFill {
-  Image<uint8_t> atlas;  // RGB
-  double covered_fraction = 0.0;
+  std::vector<Image<uint8_t>> pages;  // RGB, as the layout's pages
+  double covered_fraction = 0.0;      // of all the pages' texels
 };
 
 // `gains`: per photo, multiplying its colours (view_labelling.h).
@@ -80,11 +88,13 @@ struct SeamSteps {
   double before = 0.0, after = 0.0;
   size_t edges = 0;  // measured
 };
-SeamSteps MeasureSeamSteps(const Mesh& mesh, const AtlasLayout& layout, const Image<uint8_t>& atlas,
+SeamSteps MeasureSeamSteps(const Mesh& mesh, const AtlasLayout& layout, const std::vector<Image<uint8_t>>& pages,
                            const std::vector<Eigen::Vector3f>& gains, const PatchColourCorrection& correction,
                            const std::vector<SeamEdge>& edges);
 
-// The output mesh: one vertex per chart vertex, texcoords over the atlas (u right, v down).
-Mesh TexturedChartsMesh(const Mesh& mesh, const AtlasLayout& layout);
+// The output mesh: one vertex per chart vertex, texcoords over its chart's page (u right, v
+// down), the pages' charts one after the other: page k's triangles begin at
+// (*page_first_triangle)[k].
+Mesh TexturedChartsMesh(const Mesh& mesh, const AtlasLayout& layout, std::vector<size_t>* page_first_triangle);
 
 }  // namespace reconar

@@ -41,6 +41,7 @@ Status TextureOptions::Check() const {
     return InvalidArgument("texture: the atlas size must be a power of two of at least 64, got " +
                            std::to_string(atlas_size));
   }
+  if (max_pages < 1) return InvalidArgument("texture: at least one atlas page, got " + std::to_string(max_pages));
   if (padding_texels < 1 || padding_texels > 64) return InvalidArgument("texture: padding must be 1..64 texels");
   if (raster_long_side < 16) return InvalidArgument("texture: raster_long_side must be at least 16");
   if (!(min_view_cosine >= 0.0 && min_view_cosine < 1.0)) return InvalidArgument("texture: min_view_cosine in [0, 1)");
@@ -68,11 +69,18 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
     }
     projectors.emplace_back(photo);
   }
-  // Decoded photos are kept for the atlas while the process stays under the budget less the atlas's
-  // own share (RGB texels, coverage, the PNG), measured as each photo is done: the resident set then
-  // holds every photo being worked on, so photos decided at once cannot together overshoot.
-  const size_t atlas_texels = static_cast<size_t>(options.atlas_size) * static_cast<size_t>(options.atlas_size);
-  const size_t atlas_bytes = atlas_texels * (3 + 1 + 3);
+  // The atlas pages may take half the budget (RGB texels, coverage, the PNG). Decoded photos are
+  // kept for the atlas while the process stays under the budget less the pages' share, measured
+  // as each photo is done: the resident set then holds every photo being worked on, so photos
+  // decided at once cannot together overshoot.
+  const size_t page_bytes =
+      static_cast<size_t>(options.atlas_size) * static_cast<size_t>(options.atlas_size) * (3 + 1 + 3);
+  int max_pages = options.max_pages;
+  if (options.memory_budget_bytes > 0) {
+    max_pages = static_cast<int>(std::clamp<size_t>(options.memory_budget_bytes / 2 / page_bytes, 1,
+                                                    static_cast<size_t>(max_pages)));
+  }
+  const size_t atlas_bytes = page_bytes * static_cast<size_t>(max_pages);
   auto may_keep = [&]() {
     return options.memory_budget_bytes == 0 ||
            CurrentMemoryUsage().resident_bytes + atlas_bytes <= options.memory_budget_bytes;
@@ -154,7 +162,7 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
   // 4. Atlas.
   phase = std::chrono::steady_clock::now();
   RECONAR_ASSIGN_OR_RETURN(const AtlasLayout layout,
-                           PackCharts(MakeCharts(mesh, patches, projectors), options.atlas_size, options.padding_texels));
+                           PackCharts(MakeCharts(mesh, patches, projectors), options.atlas_size, options.padding_texels, max_pages));
   const PhotoAccess access = [&](size_t photo, Image<uint8_t>* storage, const Image<uint8_t>** pixels) -> Status {
     if (!kept[photo].empty()) {
       *pixels = &kept[photo];
@@ -166,15 +174,19 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
   };
   RECONAR_ASSIGN_OR_RETURN(AtlasFill fill, FillAtlas(mesh, layout, projectors, gains, correction, access, num_threads));
   kept.clear();
-  const SeamSteps steps = MeasureSeamSteps(mesh, layout, fill.atlas, gains, correction, seam_edges);
+  const SeamSteps steps = MeasureSeamSteps(mesh, layout, fill.pages, gains, correction, seam_edges);
   report->seam_edges = seam_edges.size();
   report->seam_step_before = steps.before;
   report->seam_step_after = steps.after;
   TexturedMesh textured;
-  textured.mesh = TexturedChartsMesh(mesh, layout);
-  textured.atlas = std::move(fill.atlas);
-  report->atlas_width = layout.width;
-  report->atlas_height = layout.height;
+  std::vector<size_t> page_first_triangle;
+  textured.mesh = TexturedChartsMesh(mesh, layout, &page_first_triangle);
+  for (size_t page = 0; page < fill.pages.size(); ++page) {
+    textured.pages.push_back({page_first_triangle[page], std::move(fill.pages[page])});
+  }
+  report->atlas_width = layout.pages[0].width;
+  report->atlas_height = layout.pages[0].height;
+  report->atlas_pages = layout.pages.size();
   report->texels_per_pixel = layout.scale;
   report->atlas_fill = fill.covered_fraction;
   report->seconds_atlas = SecondsSince(phase);

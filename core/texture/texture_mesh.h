@@ -42,7 +42,10 @@ struct TexturePhoto {
 using PhotoLoader = std::function<Result<Image<uint8_t>>(size_t photo_index)>;
 
 struct TextureOptions {
-  int atlas_size = 4096;    // largest side of the texture, texels (a power of two)
+  int atlas_size = 4096;    // largest side of a texture page, texels (a power of two)
+  // More pages when one does not hold the charts at the photos' resolution, up to this many, and
+  // fewer when the memory budget is set: the pages may take half of it.
+  int max_pages = 4;
   int padding_texels = 4;   // around each chart: clean down to mip level log2(padding)
   // The depth buffers and the candidates' colours are computed on the photo reduced by a power of
   // two to at most this long side.
@@ -86,20 +89,21 @@ struct TextureReport {
   // (exposure gains, patch offsets and local moves; texture_atlas.h).
   double seam_step_before = 0.0, seam_step_after = 0.0;
   size_t seam_edges = 0;
-  int atlas_width = 0, atlas_height = 0;
+  int atlas_width = 0, atlas_height = 0;  // the first page's
+  size_t atlas_pages = 0;
   double texels_per_pixel = 0.0;  // the charts' scale against the photos' full resolution
-  double atlas_fill = 0.0;        // fraction of the texels that some face covers
+  double atlas_fill = 0.0;        // fraction of the pages' texels that some face covers
   size_t photos_kept_decoded = 0;  // from the views to the atlas (memory_budget_bytes)
   double seconds_candidates = 0.0, seconds_labelling = 0.0, seconds_seams = 0.0, seconds_atlas = 0.0;
   double seconds = 0.0;
 };
 
 struct TexturedMesh {
-  // Positions, normals (when the input has them) and texcoords (u right, v down, over the atlas);
-  // colours only when some face is untextured (white on textured vertices). A vertex is repeated
-  // in every chart it borders.
+  // Positions, normals (when the input has them) and texcoords (u right, v down, over their
+  // page); colours only when some face is untextured (white on textured vertices). A vertex is
+  // repeated in every chart it borders.
   Mesh mesh;
-  Image<uint8_t> atlas;  // RGB
+  std::vector<TexturePage> pages;  // RGB, the first at triangle 0
 };
 
 // The mesh textured from `photos`. The mesh must pass ValidateMesh and have triangles.

@@ -139,11 +139,14 @@ Result<ArModel> LoadArModel(const std::string& path, size_t max_faces) {
   ArModel model;
   if (const auto format = MeshFileFormatOf(path); format.ok() && *format == MeshFileFormat::kGlb) {
     RECONAR_ASSIGN_OR_RETURN(TexturedGlb textured, ReadTexturedGlb(path));
-    if (!textured.base_color_image.empty()) {
-      auto decoded = ReadImageFromMemory(textured.base_color_image, path + ": base colour texture");
-      if (!decoded.ok()) return decoded.status();
+    if (!textured.pages.empty()) {
+      for (size_t k = 0; k < textured.pages.size(); ++k) {
+        auto decoded = ReadImageFromMemory(textured.pages[k].image, path + ": base colour texture" +
+                                                                        (k > 0 ? " page " + std::to_string(k) : ""));
+        if (!decoded.ok()) return decoded.status();
+        model.texture.push_back({textured.pages[k].first_triangle, std::move(decoded->rgb)});
+      }
       model.mesh = std::move(textured.mesh);
-      model.base_color = std::move(decoded->rgb);
       return model;
     }
   }

@@ -60,13 +60,13 @@ Result<CameraIntrinsics> PhotoCameraForFrame(const std::vector<CameraIntrinsics>
 
 struct ArModel {
   Mesh mesh;
-  Image<uint8_t> base_color;  // RGB: the texture of a textured model (mesh.texcoords set); else empty
+  std::vector<TexturePage> texture;  // RGB pages of a textured model (mesh.texcoords set); else empty
   std::optional<SimplifyReport> simplified;  // set when the mesh was over the face budget
 };
 
 // The model file (core/mesh/mesh_file.h formats; a glTF scene of several nodes whole, each node
 // in its place), simplified to at most max_faces triangles (0: as it is). A .glb whose first
-// primitive has a base colour texture (mesh/textured.glb) comes with its texture and is not
+// primitive has a base colour texture (mesh/textured.glb) comes with its texture's pages and is not
 // simplified (texturing already sized it; simplifying would tear its charts).
 Result<ArModel> LoadArModel(const std::string& path, size_t max_faces);
 

@@ -121,7 +121,7 @@ Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const
   render_options.samples = options.samples;
   RECONAR_ASSIGN_OR_RETURN(std::unique_ptr<OverlayRenderer> renderer, OverlayRenderer::Create(render_options));
   RECONAR_ASSIGN_OR_RETURN(MeshDrawable drawable,
-                           MeshDrawable::Upload(model.mesh, model.base_color.empty() ? nullptr : &model.base_color));
+                           MeshDrawable::Upload(model.mesh, model.texture.empty() ? nullptr : &model.texture));
   std::optional<MeshDrawable> design_drawable, deviation_drawable;
   if (design != nullptr) {
     RECONAR_ASSIGN_OR_RETURN(design_drawable, MeshDrawable::Upload(design->design));

@@ -76,7 +76,7 @@ Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const
   report.model_path = options.model_path;
   if (report.model_path.empty()) report.model_path = ProjectModelPath(project_dir);
   RECONAR_ASSIGN_OR_RETURN(const ArModel ar_model, LoadArModel(report.model_path, 0));
-  report.textured = !ar_model.base_color.empty();
+  report.textured = !ar_model.texture.empty();
   report.faces = ar_model.mesh.triangles.size();
   RECONAR_RETURN_IF_ERROR(CreateDirectories(options.out_dir));
 
@@ -84,7 +84,7 @@ Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const
   context_options.kind = EglContextKind::kSurfaceless;
   RECONAR_ASSIGN_OR_RETURN(auto context, EglContext::Create(context_options));
   RECONAR_ASSIGN_OR_RETURN(const MeshDrawable drawable,
-                           MeshDrawable::Upload(ar_model.mesh, report.textured ? &ar_model.base_color : nullptr));
+                           MeshDrawable::Upload(ar_model.mesh, report.textured ? &ar_model.texture : nullptr));
   MeshStyle style;
   style.shading = false;
   for (const std::string& name : options.image_names) {
@@ -126,7 +126,7 @@ Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const
 
 Status WriteModelPreview(const std::string& model_path, const Eigen::Vector3d& up, const std::string& png_path) {
   RECONAR_ASSIGN_OR_RETURN(const ArModel model, LoadArModel(model_path, 0));
-  Status written = WritePreview(model.mesh, model.base_color.empty() ? nullptr : &model.base_color, up, png_path);
+  Status written = WritePreview(model.mesh, model.texture.empty() ? nullptr : &model.texture, up, png_path);
   return written.ok() ? written : written.WithContext(model_path);
 }
 

@@ -315,6 +315,45 @@ TEST_F(OverlayRendererTest, NearSurfacesHideFarOnes) {
   }
 }
 
+// A texture in pages: each square takes its colour from its own page (white vertex colours
+// times the texture, as glTF has it), whichever page comes first.
+TEST_F(OverlayRendererTest, EachTexturePageTexturesItsOwnTriangles) {
+  const CameraIntrinsics intrinsics = OffCentreCamera();
+  auto renderer = MakeRenderer(640, 480);
+  ASSERT_NE(renderer, nullptr);
+  Mesh squares;
+  AddSquare(Eigen::Vector3f(-0.3f, 0.0f, 2.0f), 0.2f, {255, 255, 255, 255}, &squares);
+  AddSquare(Eigen::Vector3f(0.3f, 0.0f, 2.0f), 0.2f, {255, 255, 255, 255}, &squares);
+  for (size_t i = 0; i < squares.positions.size(); ++i) squares.texcoords.emplace_back(0.5f, 0.5f);
+  auto plain = [](int width, int height, Rgb colour) {
+    Image<uint8_t> image(width, height, 3);
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) std::copy(colour.begin(), colour.end(), image.row(y) + 3 * x);
+    }
+    return image;
+  };
+  std::vector<TexturePage> pages;
+  pages.push_back({0, plain(64, 64, {200, 30, 30})});
+  pages.push_back({2, plain(32, 16, {30, 30, 200})});
+  auto drawable = MeshDrawable::Upload(squares, &pages);
+  ASSERT_TRUE(drawable.ok()) << drawable.status().ToString();
+  EXPECT_TRUE(drawable->has_texture());
+  MeshStyle unlit;
+  unlit.shading = false;
+  ASSERT_TRUE(renderer->BeginFrame().ok());
+  ASSERT_TRUE(renderer->DrawMesh(*drawable, intrinsics, Eigen::Matrix4d::Identity(), unlit).ok());
+  Image<uint8_t> rendered;
+  ASSERT_TRUE(renderer->ReadRgb(&rendered).ok());
+  const Eigen::Vector2d left = intrinsics.Project(Eigen::Vector3d(-0.3, 0.0, 2.0));
+  const Eigen::Vector2d right = intrinsics.Project(Eigen::Vector3d(0.3, 0.0, 2.0));
+  EXPECT_EQ(PixelAt(rendered, int(std::lround(left.x())), int(std::lround(left.y()))), (Rgb{200, 30, 30}));
+  EXPECT_EQ(PixelAt(rendered, int(std::lround(right.x())), int(std::lround(right.y()))), (Rgb{30, 30, 200}));
+
+  std::vector<TexturePage> out_of_order;
+  out_of_order.push_back({1, plain(8, 8, {0, 0, 0})});
+  EXPECT_EQ(MeshDrawable::Upload(squares, &out_of_order).status().code(), StatusCode::kInvalidArgument);
+}
+
 // A semi-transparent mesh (a design over the as-built) blends over what is drawn, is hidden by what
 // stands in front of it, and hides nothing drawn after it.
 TEST_F(OverlayRendererTest, SemiTransparentMeshesBlendAndHideNothing) {

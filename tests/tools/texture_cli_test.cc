@@ -52,7 +52,7 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   }
   const Result<TexturedGlb> textured = ReadTexturedGlb(project + "/mesh/textured.glb");
   ASSERT_TRUE(textured.ok()) << textured.status().ToString();
-  EXPECT_FALSE(textured->base_color_image.empty());
+  ASSERT_FALSE(textured->pages.empty());
   EXPECT_EQ(textured->mesh.texcoords.size(), textured->mesh.positions.size());
   const Result<JsonValue> report = ReadJsonFile(project + "/mesh/texture_report.json");
   ASSERT_TRUE(report.ok());
@@ -106,10 +106,30 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   ASSERT_EQ(to_glb.exit_code, 0) << to_glb.output;
   const Result<TexturedGlb> reexported = ReadTexturedGlb(exported + "/model.glb");
   ASSERT_TRUE(reexported.ok());
-  EXPECT_EQ(reexported->base_color_image, textured->base_color_image);
+  ASSERT_EQ(reexported->pages.size(), textured->pages.size());
+  for (size_t k = 0; k < textured->pages.size(); ++k) EXPECT_EQ(reexported->pages[k].image, textured->pages[k].image);
   const CommandRun to_ply = RunReconar("export " + project + "/mesh/textured.glb " + exported + "/model.ply");
   ASSERT_EQ(to_ply.exit_code, 0) << to_ply.output;
   EXPECT_NE(to_ply.output.find("texture was left out"), std::string::npos) << to_ply.output;
+
+  // Small pages: the charts go on several, each its own file, primitive and material, and export
+  // keeps them all.
+  const CommandRun paged = RunReconar("texture " + project + " --atlas-size 256 --max-pages 16 --json");
+  ASSERT_EQ(paged.exit_code, 0) << paged.output;
+  const Result<JsonValue> paged_report = ParseJson(paged.output.substr(paged.output.find('{')), "report");
+  ASSERT_TRUE(paged_report.ok()) << paged.output;
+  const double pages = ReportNumber(*paged_report, "atlas_pages");
+  EXPECT_GE(pages, 2.0);
+  EXPECT_TRUE(fs::exists(project + "/mesh/textured_1.png"));
+  const Result<TexturedGlb> paged_glb = ReadTexturedGlb(project + "/mesh/textured.glb");
+  ASSERT_TRUE(paged_glb.ok()) << paged_glb.status().ToString();
+  EXPECT_EQ(static_cast<double>(paged_glb->pages.size()), pages);
+  const CommandRun paged_obj = RunReconar("export " + project + "/mesh/textured.glb " + exported + "/paged.obj");
+  ASSERT_EQ(paged_obj.exit_code, 0) << paged_obj.output;
+  EXPECT_TRUE(fs::exists(exported + "/paged_1.png"));
+  const Result<std::string> paged_mtl = ReadFileToString(exported + "/paged.mtl");
+  ASSERT_TRUE(paged_mtl.ok());
+  EXPECT_NE(paged_mtl->find("map_Kd paged_1.png"), std::string::npos) << *paged_mtl;
 
   // Again without two photos: they are named in the report and texture nothing.
   const CommandRun excluded = RunReconar("texture " + project + " --exclude templeSR0004.png,templeSR0009.png --json");
@@ -118,6 +138,7 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   ASSERT_TRUE(excluded_report.ok()) << excluded.output;
   EXPECT_EQ(excluded_report->Find("excluded")->size(), 2u);
   EXPECT_EQ(ReportNumber(*excluded_report, "photos"), ReportNumber(*report, "photos") - 2);
+  EXPECT_FALSE(fs::exists(project + "/mesh/textured_1.png")) << "a page of the earlier texture left behind";
 
   // The textured model drawn from a held-out photo's pose covers the temple there. (How close it
   // is to the photo is measured on fountain, Herz-Jesu and the room in docs/texture.md; on this

@@ -132,7 +132,7 @@ TEST_F(GlbDataTest, KhronosValidatorAcceptsOurFiles) {
   const Result<std::string> png = EncodePng(checker.view(), 3);
   ASSERT_TRUE(png.ok());
   const std::string textured_path = (dir_ / "bunny_textured.glb").string();
-  ASSERT_TRUE(WriteTexturedGlb(textured_path, textured, *png).ok());
+  ASSERT_TRUE(WriteTexturedGlb(textured_path, textured, {{0, *png}}).ok());
   files += " " + textured_path;
   meshes.emplace_back("bunny_textured.glb", Mesh());
   const testing::CommandRun run = testing::RunCommand("node " + std::string(RECONAR_SOURCE_DIR) +

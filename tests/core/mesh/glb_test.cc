@@ -92,7 +92,7 @@ TEST(GlbTest, TexturedRoundTripKeepsTexcoordsAndTheImage) {
   Mesh mesh = testing::RandomMesh(301, 700, true, true, 5);
   for (size_t i = 0; i < mesh.positions.size(); ++i) mesh.texcoords.emplace_back(i / 301.0f, 1.0f - i / 602.0f);
   const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + "image bytes";
-  const Result<std::string> glb = EncodeTexturedGlb(mesh, png);
+  const Result<std::string> glb = EncodeTexturedGlb(mesh, {{0, png}});
   ASSERT_TRUE(glb.ok()) << glb.status().ToString();
   const GlbParts parts = Split(*glb);
   const JsonValue* material = parts.json.Find("materials");
@@ -102,7 +102,9 @@ TEST(GlbTest, TexturedRoundTripKeepsTexcoordsAndTheImage) {
 
   const Result<TexturedGlb> read = DecodeTexturedGlb(*glb, "textured.glb");
   ASSERT_TRUE(read.ok()) << read.status().ToString();
-  EXPECT_EQ(read->base_color_image, png);
+  ASSERT_EQ(read->pages.size(), 1u);
+  EXPECT_EQ(read->pages[0].first_triangle, 0u);
+  EXPECT_EQ(read->pages[0].image, png);
   ASSERT_EQ(read->mesh.texcoords.size(), mesh.texcoords.size());
   for (size_t i = 0; i < mesh.texcoords.size(); ++i) EXPECT_EQ(read->mesh.texcoords[i], mesh.texcoords[i]);
   Mesh without_texcoords = read->mesh;
@@ -117,20 +119,68 @@ TEST(GlbTest, TexturedRoundTripKeepsTexcoordsAndTheImage) {
   // An untextured file reads as a TexturedGlb without image or texcoords.
   const Result<TexturedGlb> untextured = DecodeTexturedGlb(*EncodeGlb(expected), "plain.glb");
   ASSERT_TRUE(untextured.ok());
-  EXPECT_TRUE(untextured->base_color_image.empty());
+  EXPECT_TRUE(untextured->pages.empty());
   EXPECT_TRUE(untextured->mesh.texcoords.empty());
 }
 
 TEST(GlbTest, TexturedWritingRefusesWhatCannotBeATexturedModel) {
   Mesh mesh = testing::RandomMesh(10, 5, false, false, 5);
   const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + "x";
-  EXPECT_EQ(EncodeTexturedGlb(mesh, png).status().code(), StatusCode::kInvalidArgument);  // no texcoords
+  EXPECT_EQ(EncodeTexturedGlb(mesh, {{0, png}}).status().code(), StatusCode::kInvalidArgument);  // no texcoords
   mesh.texcoords.assign(10, Eigen::Vector2f(0.5f, 0.5f));
-  EXPECT_EQ(EncodeTexturedGlb(mesh, "GIF89a").status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(EncodeTexturedGlb(mesh, {{0, "GIF89a"}}).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(EncodeTexturedGlb(mesh, {}).status().code(), StatusCode::kInvalidArgument);             // no page
+  EXPECT_EQ(EncodeTexturedGlb(mesh, {{1, png}}).status().code(), StatusCode::kInvalidArgument);     // not at 0
+  EXPECT_EQ(EncodeTexturedGlb(mesh, {{0, png}, {9, png}}).status().code(), StatusCode::kInvalidArgument);  // past
   mesh.texcoords[3].x() = NAN;
-  EXPECT_EQ(EncodeTexturedGlb(mesh, png).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(EncodeTexturedGlb(mesh, {{0, png}}).status().code(), StatusCode::kInvalidArgument);
   mesh.texcoords.resize(4);
-  EXPECT_EQ(EncodeTexturedGlb(mesh, png).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(EncodeTexturedGlb(mesh, {{0, png}}).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(GlbTest, TexturePagesAreOnePrimitiveAndMaterialEach) {
+  // Three pages as texturing writes them: each page's vertices its own.
+  std::vector<NamedMesh> parts;
+  for (int k = 0; k < 3; ++k) {
+    Mesh part = testing::RandomMesh(50 + 10 * k, 80 + k, true, false, 7 + k);
+    for (size_t i = 0; i < part.positions.size(); ++i) part.texcoords.emplace_back(i / 100.0f, 0.25f * k);
+    parts.push_back({"", part});
+  }
+  const Mesh mesh = JoinMeshes(parts);
+  std::vector<EncodedTexturePage> pages;
+  size_t first = 0;
+  for (int k = 0; k < 3; ++k) {
+    pages.push_back({first, std::string("\x89PNG\r\n\x1a\n", 8) + "page " + std::to_string(k)});
+    first += parts[static_cast<size_t>(k)].mesh.triangles.size();
+  }
+  const Result<std::string> glb = EncodeTexturedGlb(mesh, pages);
+  ASSERT_TRUE(glb.ok()) << glb.status().ToString();
+  const GlbParts split = Split(*glb);
+  const JsonValue& primitives = *(*split.json.Find("meshes"))[0].Find("primitives");
+  ASSERT_EQ(primitives.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) EXPECT_EQ(primitives[k].Find("material")->AsInteger(), static_cast<int64_t>(k));
+  EXPECT_EQ(split.json.Find("materials")->size(), 3u);
+  EXPECT_EQ(split.json.Find("images")->size(), 3u);
+  EXPECT_EQ(split.json.Find("nodes")->size(), 1u);
+
+  const Result<TexturedGlb> read = DecodeTexturedGlb(*glb, "pages.glb");
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  ASSERT_EQ(read->pages.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(read->pages[k].first_triangle, pages[k].first_triangle);
+    EXPECT_EQ(read->pages[k].image, pages[k].image);
+  }
+  // Every corner of every triangle where it was, with its normal and texcoord (a page's vertices
+  // may come back in another order).
+  ASSERT_EQ(read->mesh.triangles.size(), mesh.triangles.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (size_t c = 0; c < 3; ++c) {
+      const uint32_t a = read->mesh.triangles[t][c], b = mesh.triangles[t][c];
+      EXPECT_EQ(read->mesh.positions[a], mesh.positions[b]);
+      EXPECT_EQ(read->mesh.normals[a], mesh.normals[b]);
+      EXPECT_EQ(read->mesh.texcoords[a], mesh.texcoords[b]);
+    }
+  }
 }
 
 TEST(GlbTest, IndexTypeFollowsTheVertexCount) {

@@ -81,7 +81,7 @@ TEST_F(ObjTest, TexturedWritesTexcoordsAndItsMaterialLibrary) {
   mesh.texcoords = {{0, 0}, {1, 0.25f}, {0.5f, 1}};
   mesh.triangles = {{0, 1, 2}};
   const std::string path = dir_ + "/textured.obj";
-  ASSERT_TRUE(WriteTexturedObj(path, mesh, "textured.png").ok());
+  ASSERT_TRUE(WriteTexturedObj(path, mesh, {{0, "textured.png"}}).ok());
   const Result<std::string> text = ReadFileToString(path);
   ASSERT_TRUE(text.ok());
   EXPECT_EQ(*text,
@@ -100,9 +100,23 @@ TEST_F(ObjTest, TexturedWritesTexcoordsAndItsMaterialLibrary) {
   EXPECT_EQ(read->positions, mesh.positions);
   EXPECT_EQ(read->triangles, mesh.triangles);
 
+  // A second page: its faces after their material.
+  mesh.triangles.push_back({2, 1, 0});
+  ASSERT_TRUE(WriteTexturedObj(path, mesh, {{0, "textured.png"}, {1, "textured_1.png"}}).ok());
+  const Result<std::string> paged = ReadFileToString(path);
+  ASSERT_TRUE(paged.ok());
+  EXPECT_NE(paged->find("usemtl texture\nf 1/1/1 2/2/2 3/3/3\nusemtl texture_1\nf 3/3/3 2/2/2 1/1/1\n"),
+            std::string::npos);
+  const Result<std::string> paged_library = ReadFileToString(dir_ + "/textured.mtl");
+  ASSERT_TRUE(paged_library.ok());
+  EXPECT_NE(paged_library->find("newmtl texture_1\n"), std::string::npos);
+  EXPECT_NE(paged_library->find("map_Kd textured_1.png\n"), std::string::npos);
+  EXPECT_EQ(WriteTexturedObj(dir_ + "/late.obj", mesh, {{1, "textured.png"}}).code(), StatusCode::kInvalidArgument);
+
   mesh.texcoords.clear();
-  EXPECT_EQ(WriteTexturedObj(dir_ + "/none.obj", mesh, "none.png").code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(WriteTexturedObj(dir_ + "/none.obj", mesh, {{0, "none.png"}}).code(), StatusCode::kInvalidArgument);
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/none.obj"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/late.obj"));
 }
 
 // The corner forms of the OBJ specification (Wavefront, Appendix B1): v, v/vt, v//vn, v/vt/vn,

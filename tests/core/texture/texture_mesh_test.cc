@@ -161,7 +161,11 @@ void TextureError(const TexturedMesh& textured, double* mean, double* worst) {
   double sum = 0.0;
   *worst = 0.0;
   size_t count = 0;
-  for (const auto& t : textured.mesh.triangles) {
+  size_t page = 0;
+  for (size_t triangle = 0; triangle < textured.mesh.triangles.size(); ++triangle) {
+    while (triangle >= PageTrianglesEnd(textured.pages, page, textured.mesh.triangles.size())) ++page;
+    const Image<uint8_t>& atlas = textured.pages[page].image;
+    const auto& t = textured.mesh.triangles[triangle];
     if (!textured.mesh.colors.empty() && textured.mesh.colors[t[0]][0] != 255) continue;  // untextured
     for (int s = 0; s < 4; ++s) {
       double a = unit(random), b = unit(random);
@@ -177,8 +181,7 @@ void TextureError(const TexturedMesh& textured, double* mean, double* worst) {
         uv += weights[k] * textured.mesh.texcoords[t[k]].cast<double>();
       }
       float rgb[3];
-      ASSERT_TRUE(SampleBilinear(textured.atlas, uv.x() * textured.atlas.width() - 0.5,
-                                 uv.y() * textured.atlas.height() - 0.5, rgb));
+      ASSERT_TRUE(SampleBilinear(atlas, uv.x() * atlas.width() - 0.5, uv.y() * atlas.height() - 0.5, rgb));
       const double error = (Eigen::Vector3f(rgb[0], rgb[1], rgb[2]) - TrueColour(point)).cwiseAbs().mean();
       sum += error;
       *worst = std::max(*worst, error);
@@ -207,6 +210,30 @@ TEST(TextureMeshTest, GivesBackTheSurfaceColour) {
   EXPECT_LT(mean, 6.0);
   EXPECT_LT(worst, 60.0);
   EXPECT_EQ(report.texels_per_pixel, 1.0);
+  EXPECT_EQ(report.atlas_pages, 1u);
+  ASSERT_EQ(textured->pages.size(), 1u);
+}
+
+TEST(TextureMeshTest, ChartsThatOnePageCannotHoldGoOnMorePages) {
+  const Scene scene = MakeScene(1.0f, 0.0);
+  TextureOptions options;
+  options.atlas_size = 256;
+  options.max_pages = 16;
+  TextureReport report;
+  const auto textured = TextureMesh(scene.mesh, scene.photos, LoaderOf(scene), options, &report);
+  ASSERT_TRUE(textured.ok()) << textured.status().ToString();
+  EXPECT_GT(textured->pages.size(), 1u);
+  EXPECT_EQ(report.atlas_pages, textured->pages.size());
+  EXPECT_EQ(report.texels_per_pixel, 1.0);  // the photos' resolution kept
+  ASSERT_TRUE(ValidateTexturePages(textured->pages, textured->mesh.triangles.size()).ok());
+  for (const TexturePage& page : textured->pages) {
+    EXPECT_LE(page.image.width(), 256);
+    EXPECT_LE(page.image.height(), 256);
+  }
+  double mean = 0.0, worst = 0.0;
+  TextureError(*textured, &mean, &worst);  // each triangle read from its own page
+  EXPECT_LT(mean, 6.0);
+  EXPECT_LT(worst, 60.0);
 }
 
 TEST(TextureMeshTest, LevelsABrighterPhotoAndIgnoresAPasserBy) {
@@ -243,12 +270,14 @@ TEST(TextureMeshTest, SmallAtlasLowersTheScale) {
   const Scene scene = MakeScene(1.0f, 0.0);
   TextureOptions options;
   options.atlas_size = 128;
+  options.max_pages = 1;
   TextureReport report;
   const auto textured = TextureMesh(scene.mesh, scene.photos, LoaderOf(scene), options, &report);
   ASSERT_TRUE(textured.ok()) << textured.status().ToString();
   EXPECT_LT(report.texels_per_pixel, 1.0);
-  EXPECT_LE(textured->atlas.width(), 128);
-  EXPECT_LE(textured->atlas.height(), 128);
+  ASSERT_EQ(textured->pages.size(), 1u);
+  EXPECT_LE(textured->pages[0].image.width(), 128);
+  EXPECT_LE(textured->pages[0].image.height(), 128);
 }
 
 TEST(TextureMeshTest, NoPhotoSeeingTheMeshIsAFailedPrecondition) {
