@@ -19,6 +19,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/json_reader.h"
 #include "core/mesh/mesh_file.h"
+#include "tests/support/json_number.h"
 #include "tests/support/run_command.h"
 
 namespace reconar {
@@ -27,11 +28,6 @@ namespace {
 namespace fs = std::filesystem;
 using testing::CommandRun;
 using testing::RunReconar;
-
-double Number(const JsonValue& object, const char* key) {
-  const JsonValue* value = object.Find(key);
-  return value != nullptr && value->is_number() ? value->number() : std::nan("");
-}
 
 // Every file of a finished project except the reports (which hold timings and reuse flags).
 std::map<std::string, std::string> ProjectFiles(const std::string& project) {
@@ -66,8 +62,8 @@ TEST(ReconstructCli, KilledRunsResumeToTheSameFiles) {
   auto mesh_report = ReadJsonFile(dir + "/reference/mesh/report.json");
   ASSERT_TRUE(mesh_report.ok()) << mesh_report.status().ToString();
   EXPECT_TRUE(mesh_report->Find("simplified")->bool_value());
-  EXPECT_LE(Number(*mesh_report, "triangles"), 10000);
-  EXPECT_GT(Number(*mesh_report, "poisson_triangles"), 10000);
+  EXPECT_LE(testing::JsonNumber(*mesh_report, "triangles"), 10000);
+  EXPECT_GT(testing::JsonNumber(*mesh_report, "poisson_triangles"), 10000);
 
   // One project killed three times, each time in the run that resumed it: at about a fifth, half and
   // four fifths of the work (features or matching, then the later stages), then finished by a

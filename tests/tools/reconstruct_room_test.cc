@@ -19,6 +19,7 @@
 #include "core/sfm/model_io.h"
 #include "core/sfm/tag_observations.h"
 #include "tests/support/ground_truth.h"
+#include "tests/support/json_number.h"
 #include "tests/support/run_command.h"
 
 namespace reconar {
@@ -30,11 +31,6 @@ using testing::RunReconar;
 
 constexpr double kSwatTagSize = 0.127;
 constexpr double kSwatCalibratedFx = 765.00;  // calibration/calib.txt (SOURCE.txt)
-
-double Number(const JsonValue& object, const char* key) {
-  const JsonValue* value = object.Find(key);
-  return value != nullptr && value->is_number() ? value->number() : std::nan("");
-}
 
 // Each tag measured at the scale set by the other tags (tags.json "held_out_*"): the plain mean
 // over all tags is the tag size by construction.
@@ -50,9 +46,9 @@ TagFigures ReadTagFigures(const std::string& project) {
   if (!tags.ok()) return figures;
   const JsonValue* list = tags->Find("tags");
   figures.tags = list != nullptr ? static_cast<int>(list->size()) : 0;
-  figures.edge_mean = Number(*tags, "held_out_edge_mean_m");
-  figures.edge_std = Number(*tags, "held_out_edge_std_m");
-  figures.edge_max_error = Number(*tags, "held_out_edge_max_abs_error_m");
+  figures.edge_mean = testing::JsonNumber(*tags, "held_out_edge_mean_m");
+  figures.edge_std = testing::JsonNumber(*tags, "held_out_edge_std_m");
+  figures.edge_max_error = testing::JsonNumber(*tags, "held_out_edge_max_abs_error_m");
   return figures;
 }
 
@@ -66,10 +62,10 @@ TEST(ReconstructCli, SwatboticsRoomIsRegisteredInMetresByItsTags) {
   auto report = ReadJsonFile(project + "/report.json");
   ASSERT_TRUE(report.ok()) << report.status().ToString();
   const JsonValue& table1 = *report->Find("table1");
-  const double registered = Number(table1, "registered");
-  EXPECT_EQ(Number(table1, "images"), 72);
+  const double registered = testing::JsonNumber(table1, "registered");
+  EXPECT_EQ(testing::JsonNumber(table1, "images"), 72);
   EXPECT_GE(registered, 0.8 * 72) << "most photos registered";
-  const double focal = Number(table1, "mean_focal_ratio") * 816;
+  const double focal = testing::JsonNumber(table1, "mean_focal_ratio") * 816;
   EXPECT_LT(std::abs(focal - kSwatCalibratedFx) / kSwatCalibratedFx, 0.01) << focal;
   EXPECT_TRUE(report->Find("metric")->bool_value());
 

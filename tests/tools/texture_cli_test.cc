@@ -25,6 +25,7 @@
 #include "core/mesh/glb_io.h"
 #include "core/mesh/mesh_file.h"
 #include "core/sfm/model_io.h"
+#include "tests/support/json_number.h"
 #include "tests/support/run_command.h"
 
 namespace reconar {
@@ -35,11 +36,6 @@ using testing::CommandRun;
 using testing::RunReconar;
 
 // A number of the texture report (NaN when absent, failing every comparison).
-double ReportNumber(const JsonValue& report, const char* key) {
-  const JsonValue* value = report.Find(key);
-  return value != nullptr && value->is_number() ? value->number() : std::nan("");
-}
-
 TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   const std::string data = std::string(RECONAR_SOURCE_DIR) + "/data/templeSparseRing";
   const fs::path root = testing::MakeTestDirectory("reconar_texture_cli");
@@ -56,8 +52,8 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   EXPECT_EQ(textured->mesh.texcoords.size(), textured->mesh.positions.size());
   const Result<JsonValue> report = ReadJsonFile(project + "/mesh/texture_report.json");
   ASSERT_TRUE(report.ok());
-  EXPECT_GT(ReportNumber(*report, "textured_faces"), 0.9 * ReportNumber(*report, "faces"));
-  EXPECT_LT(ReportNumber(*report, "seam_step_after"), ReportNumber(*report, "seam_step_before"));
+  EXPECT_GT(testing::JsonNumber(*report, "textured_faces"), 0.9 * testing::JsonNumber(*report, "faces"));
+  EXPECT_LT(testing::JsonNumber(*report, "seam_step_after"), testing::JsonNumber(*report, "seam_step_before"));
 
   // A reconstruct killed in its texture stage (the stage's record gone, as a kill before it is
   // written leaves it) does the texture again when run again, reusing the rest, to the same files.
@@ -118,7 +114,7 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   ASSERT_EQ(paged.exit_code, 0) << paged.output;
   const Result<JsonValue> paged_report = ParseJson(paged.output.substr(paged.output.find('{')), "report");
   ASSERT_TRUE(paged_report.ok()) << paged.output;
-  const double pages = ReportNumber(*paged_report, "atlas_pages");
+  const double pages = testing::JsonNumber(*paged_report, "atlas_pages");
   EXPECT_GE(pages, 2.0);
   EXPECT_TRUE(fs::exists(project + "/mesh/textured_1.png"));
   const Result<TexturedGlb> paged_glb = ReadTexturedGlb(project + "/mesh/textured.glb");
@@ -137,7 +133,7 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   const Result<JsonValue> excluded_report = ParseJson(excluded.output.substr(excluded.output.find('{')), "report");
   ASSERT_TRUE(excluded_report.ok()) << excluded.output;
   EXPECT_EQ(excluded_report->Find("excluded")->size(), 2u);
-  EXPECT_EQ(ReportNumber(*excluded_report, "photos"), ReportNumber(*report, "photos") - 2);
+  EXPECT_EQ(testing::JsonNumber(*excluded_report, "photos"), testing::JsonNumber(*report, "photos") - 2);
   EXPECT_FALSE(fs::exists(project + "/mesh/textured_1.png")) << "a page of the earlier texture left behind";
 
   // The textured model drawn from a held-out photo's pose covers the temple there. (How close it
