@@ -44,6 +44,7 @@ constexpr const char* kFragmentShader = R"(#version 300 es
 precision highp float;
 uniform int u_shading_mode;
 uniform float u_opacity;
+uniform vec3 u_gain;
 uniform bool u_textured;
 uniform sampler2D u_base_color;
 in vec3 v_cam_position;
@@ -61,7 +62,7 @@ void main() {
     vec3 to_eye = normalize(-v_cam_position);
     shade = length_n > 0.0 ? 0.2 + 0.8 * abs(dot(normal / length_n, to_eye)) : 1.0;
   }
-  o_color = vec4(color * shade, u_opacity);
+  o_color = vec4(color * u_gain * shade, u_opacity);
 }
 )";
 
@@ -186,6 +187,7 @@ Result<MeshPipeline> MeshPipeline::Create() {
   pipeline.point_size_ = pipeline.program_.Uniform("u_point_size");
   pipeline.shading_mode_ = pipeline.program_.Uniform("u_shading_mode");
   pipeline.opacity_ = pipeline.program_.Uniform("u_opacity");
+  pipeline.gain_ = pipeline.program_.Uniform("u_gain");
   pipeline.textured_ = pipeline.program_.Uniform("u_textured");
   pipeline.base_color_ = pipeline.program_.Uniform("u_base_color");
   return pipeline;
@@ -226,6 +228,7 @@ Status MeshPipeline::Draw(const MeshDrawable& mesh, const Eigen::Matrix4d& clip_
   glUniform1f(point_size_, style.point_size_px);
   glUniform1i(shading_mode_, mode);
   glUniform1f(opacity_, std::clamp(style.opacity, 0.0f, 1.0f));
+  glUniform3f(gain_, style.gain[0], style.gain[1], style.gain[2]);
   glUniform1i(textured_, mesh.has_texture() ? 1 : 0);
   glUniform1i(base_color_, 0);
   glActiveTexture(GL_TEXTURE0);

@@ -61,6 +61,9 @@ struct MeshStyle {
   // Below 1: blended over what is drawn (a design over the as-built), without hiding what is drawn
   // after it (the depth buffer is not written).
   float opacity = 1.0f;
+  // Multiplies the colour drawn, per channel: e.g. a texture brought to the video's exposure
+  // (render/ar/exposure_match.h).
+  std::array<float, 3> gain = {1.0f, 1.0f, 1.0f};
 };
 
 class MeshPipeline {
@@ -81,6 +84,7 @@ class MeshPipeline {
   GLint point_size_ = -1;
   GLint shading_mode_ = -1;
   GLint opacity_ = -1;
+  GLint gain_ = -1;
   GLint textured_ = -1;
   GLint base_color_ = -1;
 };

@@ -51,6 +51,8 @@ constexpr char kHelp[] =
     "  --model-offset X,Y,Z  move the model in the tag frame (metres)\n"
     "Display:\n"
     "  --no-axes             do not draw the tag's axes and outline\n"
+    "  --no-exposure-match   draw a textured model as its texture holds it (default: brought to each\n"
+    "                        frame's exposure, from the model drawn small against the frame)\n"
     "  --point-size PX       point size for point clouds (default 3)\n"
     "  --samples N           multisample anti-aliasing (default 0: off)\n"
     "  --max-faces N         draw a mesh of more triangles simplified to N (default 500000; 0: all)\n"
@@ -113,7 +115,7 @@ int RunView(int argc, char** argv, int first) {
   valued.insert({"model", "project", "camera", "frames", "out", "tag-id", "model-height", "model-scale", "model-up",
                  "model-rotate", "model-offset", "point-size", "samples", "window", "max-frames", "max-faces", "measure",
                  "design", "layer"});
-  Args args(valued, {"no-axes", "smooth", "no-map", "json"});
+  Args args(valued, {"no-axes", "no-exposure-match", "smooth", "no-map", "json"});
   // A model or a project, and a camera or frames: one of each.
   const CommandUsage usage = {0, 0, {}, [](const Args& a) {
                                 return a.Has("model") != a.Has("project") && a.Has("camera") != a.Has("frames");
@@ -145,6 +147,7 @@ int RunView(int argc, char** argv, int first) {
   if (!point_size.ok()) return Fail(point_size.status());
   options.style.point_size_px = static_cast<float>(*point_size);
   options.draw_axes = !args.Has("no-axes");
+  options.match_exposure = !args.Has("no-exposure-match");
   if (Status measure = ReadMeasureArgs(args, &options); !measure.ok()) return Fail(measure);
   options.out_dir = args.Get("out");
   const bool to_files = args.Has("out");
@@ -213,6 +216,10 @@ int RunView(int argc, char** argv, int first) {
                stderr_is_terminal ? "\r" : "", report->session.frames, report->frames_with_model,
                report->session.median_track_ms, report->median_render_ms, report->median_frame_ms,
                to_files ? " (render includes the readback)" : "");
+  if ((*view)->exposure_gain() != std::array<float, 3>{1.0f, 1.0f, 1.0f}) {
+    std::fprintf(stderr, "reconar view: the texture brought to the video's exposure, last gain %.2f %.2f %.2f\n",
+                 report->exposure_gain[0], report->exposure_gain[1], report->exposure_gain[2]);
+  }
   if (session.map) {
     std::fprintf(stderr, "reconar view: %s%s\n", PoseSourceSummary(report->session.frames_by_source).c_str(),
                  session.map->metric ? "" : "; poses in model units");

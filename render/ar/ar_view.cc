@@ -14,6 +14,9 @@
 namespace reconar {
 namespace {
 
+// The small drawing's clear colour: pixels the model does not cover (exposure_match.h).
+constexpr std::array<uint8_t, 3> kExposureKey = {255, 0, 255};
+
 // The PNG for a frame: its file name with .png, or frameNNNNNN.png for a device or a recording.
 std::string OutputName(const Frame& frame) {
   std::string name(frame.name);
@@ -127,9 +130,46 @@ Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const
     RECONAR_ASSIGN_OR_RETURN(design_drawable, MeshDrawable::Upload(design->design));
     RECONAR_ASSIGN_OR_RETURN(deviation_drawable, MeshDrawable::Upload(design->deviation));
   }
-  return std::unique_ptr<ArView>(new ArView(options, std::move(session), std::move(*context), std::move(renderer),
-                                            std::move(drawable), std::move(design_drawable),
-                                            std::move(deviation_drawable)));
+  std::unique_ptr<OverlayRenderer> exposure_renderer;
+  std::optional<MeshDrawable> exposure_proxy;
+  if (options.match_exposure && drawable.has_texture()) {
+    RECONAR_ASSIGN_OR_RETURN(const Mesh proxy, ExposureProxy(model.mesh, model.texture, options.exposure.proxy_max_faces));
+    RECONAR_ASSIGN_OR_RETURN(exposure_proxy, MeshDrawable::Upload(proxy));
+    OverlayRendererOptions small;
+    small.width = std::max(8, options.exposure.sample_width);
+    small.height = std::max(8, static_cast<int>(std::lround(static_cast<double>(small.width) * session->height() /
+                                                            session->width())));
+    small.clear_color = {1.0f, 0.0f, 1.0f};  // kExposureKey: where the model is not
+    RECONAR_ASSIGN_OR_RETURN(exposure_renderer, OverlayRenderer::Create(small));
+  }
+  auto view = std::unique_ptr<ArView>(new ArView(options, std::move(session), std::move(*context), std::move(renderer),
+                                                 std::move(drawable), std::move(design_drawable),
+                                                 std::move(deviation_drawable)));
+  if (exposure_renderer) {
+    view->exposure_.emplace(options.exposure);
+    view->exposure_model_ = Image<uint8_t>(exposure_renderer->width(), exposure_renderer->height(), 3);
+    view->exposure_frame_ = Image<uint8_t>(exposure_renderer->width(), exposure_renderer->height(), 3);
+    view->exposure_renderer_ = std::move(exposure_renderer);
+    view->exposure_proxy_ = std::move(exposure_proxy);
+  }
+  return view;
+}
+
+std::array<float, 3> ArView::exposure_gain() const {
+  return exposure_ ? exposure_->gain() : std::array<float, 3>{1.0f, 1.0f, 1.0f};
+}
+
+Status ArView::MatchExposure(const CameraIntrinsics& intrinsics, const Eigen::Matrix4d& cam_from_model) {
+  if (!exposure_) return Status::Ok();
+  MeshStyle plain = options_.style;
+  plain.shading = false;
+  plain.gain = {1.0f, 1.0f, 1.0f};
+  RECONAR_RETURN_IF_ERROR(exposure_renderer_->BeginFrame());
+  RECONAR_RETURN_IF_ERROR(exposure_renderer_->DrawMesh(*exposure_proxy_, intrinsics, cam_from_model, plain));
+  RECONAR_RETURN_IF_ERROR(exposure_renderer_->ReadRgb(&exposure_model_));
+  BoxReduce(session_->frame().rgb, session_->width(), session_->height(), &exposure_frame_);
+  exposure_->Update(exposure_->Estimate(exposure_model_, exposure_frame_, kExposureKey));
+  return Status::Ok();
 }
 
 ArView::ArView(const ArViewOptions& options, std::unique_ptr<ArSession> session, std::unique_ptr<EglContext> context,
@@ -153,6 +193,12 @@ std::string ArView::Describe(const std::string& model_name) const {
 
 Status ArView::Draw(bool* drawn_model) {
   *drawn_model = false;
+  const WorldPose& found = session_->pose();
+  if (found.found && exposure_ && options_.layer == ArLayer::kAsBuilt) {
+    RECONAR_RETURN_IF_ERROR(MatchExposure(session_->intrinsics(), options_.placement
+                                                                      ? CamFromModel(found.cam_from_world, *options_.placement)
+                                                                      : found.cam_from_world.Matrix()));
+  }
   RECONAR_RETURN_IF_ERROR(renderer_->BeginFrame());
   RECONAR_RETURN_IF_ERROR(renderer_->DrawBackground(session_->frame().rgb, 3));
   const WorldPose& pose = session_->pose();
@@ -173,7 +219,10 @@ Status ArView::Draw(bool* drawn_model) {
       options_.placement ? CamFromModel(pose.cam_from_world, *options_.placement) : pose.cam_from_world.Matrix();
   const bool deviation_layer = options_.layer == ArLayer::kDeviation && deviation_;
   MeshStyle model_style = options_.style;
-  if (!deviation_layer && model_.has_texture()) model_style.shading = false;
+  if (!deviation_layer && model_.has_texture()) {
+    model_style.shading = false;
+    model_style.gain = exposure_gain();
+  }
   RECONAR_RETURN_IF_ERROR(
       renderer_->DrawMesh(deviation_layer ? *deviation_ : model_, intrinsics, cam_from_model, model_style));
   if (options_.layer != ArLayer::kAsBuilt && design_) {
@@ -259,6 +308,7 @@ Result<ArViewReport> ArView::Run(const std::function<void(const ArSession& sessi
   RECONAR_ASSIGN_OR_RETURN(report.session, session_->Run(draw_frame));
   report.median_render_ms = Median(std::move(render_ms));
   report.median_frame_ms = Median(std::move(frame_ms));
+  report.exposure_gain = exposure_gain();
   return report;
 }
 

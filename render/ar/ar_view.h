@@ -17,6 +17,7 @@
 #include "platform/egl/egl_context.h"
 #include "render/ar/ar_project.h"
 #include "render/ar/ar_session.h"
+#include "render/ar/exposure_match.h"
 #include "render/mesh_drawable.h"
 #include "render/model_placement.h"
 #include "render/overlay_renderer.h"
@@ -48,6 +49,10 @@ struct ArViewOptions {
   ArLayer layer = ArLayer::kAsBuilt;  // the first layer shown (kDesign, kDeviation need a design)
   float design_opacity = 0.45f;
   std::array<float, 3> design_colour = {0.1f, 0.85f, 0.95f};
+  // A textured model brought to each frame's exposure (exposure_match.h); false: drawn as the
+  // texture holds it.
+  bool match_exposure = true;
+  ExposureMatchOptions exposure;
 };
 
 // The frame's measure (ArViewOptions::measure_pixels).
@@ -65,6 +70,7 @@ struct ArViewReport {
   // tracking and drawing together.
   double median_render_ms = 0.0;
   double median_frame_ms = 0.0;
+  std::array<float, 3> exposure_gain = {1.0f, 1.0f, 1.0f};  // the last frame's (match_exposure)
 };
 
 class ArView {
@@ -87,6 +93,8 @@ class ArView {
 
   // The last frame's measure, when ArViewOptions::measure_pixels is set.
   const ViewMeasurement& measurement() const { return measurement_; }
+  // The gain the textured model is drawn with (ArViewOptions::match_exposure); 1 otherwise.
+  std::array<float, 3> exposure_gain() const;
 
  private:
   ArView(const ArViewOptions& options, std::unique_ptr<ArSession> session, std::unique_ptr<EglContext> context,
@@ -95,6 +103,8 @@ class ArView {
   // The frame, the model and the tags' axes at this frame's pose; true in *drawn_model when the
   // model was drawn.
   Status Draw(bool* drawn_model);
+  // The model drawn small and compared with the frame (exposure_match.h).
+  Status MatchExposure(const CameraIntrinsics& intrinsics, const Eigen::Matrix4d& cam_from_model);
 
   ArViewOptions options_;
   std::unique_ptr<ArSession> session_;
@@ -110,6 +120,11 @@ class ArView {
 
   ViewMeasurement measurement_;
   std::optional<Eigen::Vector2d> first_tap_;
+  // With match_exposure and a textured model: the small drawing and its comparison.
+  std::unique_ptr<OverlayRenderer> exposure_renderer_;
+  std::optional<MeshDrawable> exposure_proxy_;
+  std::optional<ExposureMatcher> exposure_;
+  Image<uint8_t> exposure_model_, exposure_frame_;
 };
 
 }  // namespace reconar

@@ -151,6 +151,18 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   }
   EXPECT_GT(covered, static_cast<size_t>(0.05 * mask->rgb.width() * mask->rgb.height()));
 
+  // The AR view draws the textured model brought to each frame's exposure; a flag turns it off.
+  const std::string overlays = (root / "overlays").string();
+  const CommandRun view = RunReconar("view --project " + project + " --frames " + data + " --out " + overlays +
+                                     " --max-frames 3");
+  ASSERT_EQ(view.exit_code, 0) << view.output;
+  EXPECT_NE(view.output.find("brought to the video's exposure"), std::string::npos) << view.output;
+  EXPECT_TRUE(fs::exists(overlays + "/templeSR0001.png")) << view.output;
+  const CommandRun plain_view = RunReconar("view --project " + project + " --frames " + data + " --out " + overlays +
+                                           " --max-frames 1 --no-exposure-match");
+  ASSERT_EQ(plain_view.exit_code, 0) << plain_view.output;
+  EXPECT_EQ(plain_view.output.find("brought to the video's exposure"), std::string::npos) << plain_view.output;
+
   // Names that are no registered photo: usage errors naming them.
   const CommandRun unknown_exclude = RunReconar("texture " + project + " --exclude nothere.png");
   EXPECT_EQ(unknown_exclude.exit_code, 2);
