@@ -141,9 +141,9 @@ Result<MeshDrawable> MeshDrawable::Upload(const Mesh& mesh, const std::vector<Te
     for (size_t k = 0; k < texture->size(); ++k) {
       const Image<uint8_t>& image = (*texture)[k].image;
       // Row 0 first: texcoord v = 0 is the image's top row, as glTF has it.
-      drawable.pages_.push_back(
-          {MakeGlTexture(), static_cast<int64_t>((*texture)[k].first_triangle) * 3,
-           static_cast<int64_t>(PageTrianglesEnd(*texture, k, mesh.triangles.size()) - (*texture)[k].first_triangle) * 3});
+      const size_t first = (*texture)[k].first_triangle;
+      const size_t end = PageTrianglesEnd(*texture, k, mesh.triangles.size());
+      drawable.pages_.push_back({MakeGlTexture(), static_cast<int64_t>(first) * 3, static_cast<int64_t>(end - first) * 3});
       glBindTexture(GL_TEXTURE_2D, drawable.pages_.back().texture.get());
       glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, image.width(), image.height(), 0, GL_RGB, GL_UNSIGNED_BYTE, image.data());

@@ -2,10 +2,11 @@
 // MeshDrawable: a Mesh uploaded once to GL buffers (positions, optional normals and RGBA colours,
 // triangle indices, 16-bit when the mesh has at most 65536 vertices), and with a base colour
 // texture its texcoords and the texture's pages (each mipmapped once at upload, and drawn with its
-// triangles; the colour is the vertex colour, or white, times the texture, as glTF has it). MeshPipeline: the program that draws it with a
-// headlight Lambert shade (light at the camera, two-sided): vertex normals when the mesh has them, otherwise the flat
-// normal of each triangle from screen-space derivatives of the camera-frame position. A mesh without triangles is drawn
-// as GL_POINTS of MeshStyle::point_size_px (unlit without normals).
+// triangles; the colour is the vertex colour, or white, times the texture, as glTF has it).
+// MeshPipeline: the program that draws it with a headlight Lambert shade (light at the camera,
+// two-sided): vertex normals when the mesh has them, otherwise the flat normal of each triangle
+// from screen-space derivatives of the camera-frame position. A mesh without triangles is drawn as
+// GL_POINTS of MeshStyle::point_size_px (unlit without normals).
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>

@@ -484,7 +484,9 @@ class GlbDecoder {
       if (image.empty()) return textured;
       RECONAR_ASSIGN_OR_RETURN(const Mesh part, ReadPrimitive(primitives[p], where));
       if (part.triangles.empty()) continue;
-      if (part.texcoords.size() != part.positions.size()) return Unsupported(where + " has no TEXCOORD_0 for its texture");
+      if (part.texcoords.size() != part.positions.size()) {
+        return Unsupported(where + " has no TEXCOORD_0 for its texture");
+      }
       if (part.positions.size() > kMaxSceneVertices - pages.mesh.positions.size()) {
         return FileError(StatusCode::kResourceExhausted, name_,
                          "more than " + std::to_string(kMaxSceneVertices) + " vertices in the mesh");

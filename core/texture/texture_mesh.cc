@@ -161,8 +161,9 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
 
   // 4. Atlas.
   phase = std::chrono::steady_clock::now();
-  RECONAR_ASSIGN_OR_RETURN(const AtlasLayout layout,
-                           PackCharts(MakeCharts(mesh, patches, projectors), options.atlas_size, options.padding_texels, max_pages));
+  RECONAR_ASSIGN_OR_RETURN(
+      const AtlasLayout layout,
+      PackCharts(MakeCharts(mesh, patches, projectors), options.atlas_size, options.padding_texels, max_pages));
   const PhotoAccess access = [&](size_t photo, Image<uint8_t>* storage, const Image<uint8_t>** pixels) -> Status {
     if (!kept[photo].empty()) {
       *pixels = &kept[photo];

@@ -133,7 +133,8 @@ Result<std::unique_ptr<ArView>> ArView::Open(const ArViewOptions& options, const
   std::unique_ptr<OverlayRenderer> exposure_renderer;
   std::optional<MeshDrawable> exposure_proxy;
   if (options.match_exposure && drawable.has_texture()) {
-    RECONAR_ASSIGN_OR_RETURN(const Mesh proxy, ExposureProxy(model.mesh, model.texture, options.exposure.proxy_max_faces));
+    RECONAR_ASSIGN_OR_RETURN(const Mesh proxy,
+                             ExposureProxy(model.mesh, model.texture, options.exposure.proxy_max_faces));
     RECONAR_ASSIGN_OR_RETURN(exposure_proxy, MeshDrawable::Upload(proxy));
     OverlayRendererOptions small;
     small.width = std::max(8, options.exposure.sample_width);
@@ -195,9 +196,9 @@ Status ArView::Draw(bool* drawn_model) {
   *drawn_model = false;
   const WorldPose& found = session_->pose();
   if (found.found && exposure_ && options_.layer == ArLayer::kAsBuilt) {
-    RECONAR_RETURN_IF_ERROR(MatchExposure(session_->intrinsics(), options_.placement
-                                                                      ? CamFromModel(found.cam_from_world, *options_.placement)
-                                                                      : found.cam_from_world.Matrix()));
+    const Eigen::Matrix4d cam_from_model = options_.placement ? CamFromModel(found.cam_from_world, *options_.placement)
+                                                              : found.cam_from_world.Matrix();
+    RECONAR_RETURN_IF_ERROR(MatchExposure(session_->intrinsics(), cam_from_model));
   }
   RECONAR_RETURN_IF_ERROR(renderer_->BeginFrame());
   RECONAR_RETURN_IF_ERROR(renderer_->DrawBackground(session_->frame().rgb, 3));

@@ -28,8 +28,8 @@ void MakePair(const std::array<float, 3>& gain, double occluded, Image<uint8_t>*
       const bool hidden = unit(random) < occluded;
       for (int c = 0; c < 3; ++c) {
         m[c] = background ? kKey[static_cast<size_t>(c)] : static_cast<uint8_t>(colour(random));
-        f[c] = background || hidden ? static_cast<uint8_t>(any(random))
-                                    : static_cast<uint8_t>(std::lround(std::min(255.0f, m[c] * gain[static_cast<size_t>(c)])));
+        const float seen = std::min(255.0f, m[c] * gain[static_cast<size_t>(c)]);
+        f[c] = background || hidden ? static_cast<uint8_t>(any(random)) : static_cast<uint8_t>(std::lround(seen));
       }
     }
   }
