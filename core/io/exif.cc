@@ -16,6 +16,9 @@ constexpr uint16_t kTagMake = 0x010F;
 constexpr uint16_t kTagModel = 0x0110;
 constexpr uint16_t kTagOrientation = 0x0112;
 constexpr uint16_t kTagExifIfdPointer = 0x8769;
+constexpr uint16_t kTagExposureTime = 0x829A;
+constexpr uint16_t kTagFNumber = 0x829D;
+constexpr uint16_t kTagIsoSpeedRatings = 0x8827;
 constexpr uint16_t kTagFocalLength = 0x920A;
 constexpr uint16_t kTagPixelXDimension = 0xA002;
 constexpr uint16_t kTagPixelYDimension = 0xA003;
@@ -275,6 +278,27 @@ void ApplyEntry(const TiffReader& reader, const IfdEntry& entry, ExifInfo* info,
         bad(entry.tag == kTagFocalPlaneXResolution ? "FocalPlaneXResolution" : "FocalPlaneYResolution");
       } else {
         (entry.tag == kTagFocalPlaneXResolution ? info->focal_plane_x_resolution : info->focal_plane_y_resolution) = d;
+      }
+      break;
+    case kTagExposureTime:
+      if (!GetRational(reader, entry, &d) || !std::isfinite(d) || d < 0 || d > 3600) {
+        bad("ExposureTime");
+      } else {
+        info->exposure_time_s = d;
+      }
+      break;
+    case kTagFNumber:
+      if (!GetRational(reader, entry, &d) || !std::isfinite(d) || d < 0 || d > 1000) {
+        bad("FNumber");
+      } else {
+        info->f_number = d;
+      }
+      break;
+    case kTagIsoSpeedRatings:
+      if (!GetUInt(reader, entry, &u) || u > 10'000'000) {
+        bad("ISOSpeedRatings");
+      } else {
+        info->iso = static_cast<int>(u);
       }
       break;
     case kTagFocalPlaneResolutionUnit:

@@ -1,6 +1,6 @@
 #pragma once
 // A minimal EXIF reader and writer: only the tags photogrammetry needs (camera identity, focal length,
-// orientation, sensor geometry). Every read is bounds-checked against the block it came from;
+// orientation, sensor geometry, and for the reader the exposure settings). Every read is bounds-checked against the block it came from;
 // a malformed block never fails a caller, it yields present=false (or the fields read before
 // the damage) plus a human-readable `warning`.
 #include <string>
@@ -21,6 +21,10 @@ struct ExifInfo {
   int focal_plane_resolution_unit = 2;  // 2 = inch (EXIF default), 3 = centimetre
   int pixel_x_dimension = 0;            // PixelXDimension (0xA002); may disagree with the pixels
   int pixel_y_dimension = 0;            // PixelYDimension (0xA003)
+  // The exposure settings (read, not written): 0 when absent.
+  double exposure_time_s = 0;  // ExposureTime (0x829A), seconds
+  double f_number = 0;         // FNumber (0x829D)
+  int iso = 0;                 // ISOSpeedRatings (0x8827), the first value
   std::string warning;                  // why (part of) the block was ignored; empty if clean
 };
 

@@ -9,6 +9,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/base/fnv_hash.h"
+#include "core/base/json_reader.h"
 #include "core/base/json_writer.h"
 #include "core/base/memory_usage.h"
 #include "core/io/image_io.h"
@@ -81,15 +82,19 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
 
   std::vector<TexturePhoto> photos;
   std::vector<std::string> paths;
+  std::vector<std::optional<double>> log_exposures;
   std::string first_reason;
   for (const SfmImage& image : model.images) {
     if (!image.registered || excluded.count(image.name) != 0) continue;
     const auto it = path_of.find(image.name);
     std::string reason;
+    std::optional<double> log_exposure;
     if (it == path_of.end()) {
       reason = "not in " + project.ImageListPath();
     } else if (const auto header = ReadImageHeader(it->second); !header.ok()) {
       reason = header.status().ToString();
+    } else {
+      log_exposure = LogExposure(header->exif);
     }
     if (!reason.empty()) {
       if (first_reason.empty()) first_reason = reason;
@@ -103,6 +108,7 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
     photo.cam_from_world = image.cam_from_world;
     photos.push_back(photo);
     paths.push_back(it->second);
+    log_exposures.push_back(log_exposure);
   }
   if (photos.empty()) {
     std::string why = "texture: no registered photo to texture from";
@@ -127,6 +133,10 @@ Result<TextureStageReport> RunTextureStage(const Project& project, const Texture
     return std::move(decoded.rgb);
   };
   RECONAR_ASSIGN_OR_RETURN(const TexturedMesh textured, TextureMesh(mesh, photos, load, texture, &report.texture));
+  for (size_t i = 0; i < photos.size(); ++i) {
+    report.photo_exposures.push_back({photos[i].name, report.texture.photo_gains[i], log_exposures[i]});
+  }
+  report.exposure_fit = FitExposureGains(log_exposures, report.texture.photo_gains);
 
   RECONAR_RETURN_IF_ERROR(CreateDirectories(project.MeshDir()));
   std::vector<EncodedTexturePage> pngs;
@@ -180,6 +190,57 @@ Status RemoveTexturedModel(const Project& project) {
   return RemoveTexturePagesFrom(project, 0);
 }
 
+namespace {
+
+// Three numbers of an array member, or nothing.
+std::optional<Eigen::Vector3d> Vector3Member(const JsonValue& object, const char* key) {
+  const JsonValue* array = object.Find(key);
+  if (array == nullptr || !array->is_array() || array->size() != 3) return std::nullopt;
+  Eigen::Vector3d v;
+  for (size_t c = 0; c < 3; ++c) {
+    if (!(*array)[c].is_number()) return std::nullopt;
+    v[static_cast<int>(c)] = (*array)[c].number();
+  }
+  return v;
+}
+
+}  // namespace
+
+Result<TextureExposure> ReadTextureExposure(const Project& project) {
+  const std::string path = TexturedModelFilesOf(project).report;
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) return FailedPrecondition(path + ": no texture report (reconar texture)");
+  RECONAR_ASSIGN_OR_RETURN(const JsonValue report, ReadJsonFile(path));
+  TextureExposure exposure;
+  const JsonValue* photos = report.Find("photo_exposures");
+  if (photos == nullptr) return exposure;  // a report of an older version: no exposures
+  if (!photos->is_array()) return FileError(StatusCode::kCorruptData, path, "photo_exposures is not an array");
+  for (size_t i = 0; i < photos->size(); ++i) {
+    const JsonValue& photo = (*photos)[i];
+    const JsonValue* name = photo.Find("name");
+    const std::optional<Eigen::Vector3d> gain = Vector3Member(photo, "gain");
+    if (name == nullptr || !name->is_string() || !gain) {
+      return FileError(StatusCode::kCorruptData, path, "photo_exposures[" + std::to_string(i) + "] is not a name and a gain");
+    }
+    PhotoExposure entry;
+    entry.name = name->string();
+    entry.gain = gain->cast<float>();
+    if (const JsonValue* log_exposure = photo.Find("log_exposure"); log_exposure && log_exposure->is_number()) {
+      entry.log_exposure = log_exposure->number();
+    }
+    exposure.photos.push_back(std::move(entry));
+  }
+  if (const JsonValue* fit = report.Find("exposure_fit")) {
+    const std::optional<Eigen::Vector3d> intercept = Vector3Member(*fit, "intercept"), slope = Vector3Member(*fit, "slope");
+    if (!intercept || !slope) return FileError(StatusCode::kCorruptData, path, "exposure_fit has no intercept and slope");
+    ExposureFit parsed;
+    parsed.intercept = *intercept;
+    parsed.slope = *slope;
+    exposure.fit = parsed;
+  }
+  return exposure;
+}
+
 std::string TextureReportJson(const TextureStageReport& report) {
   const TextureReport& t = report.texture;
   JsonWriter json(2);
@@ -208,6 +269,23 @@ std::string TextureReportJson(const TextureStageReport& report) {
   json.Key("seam_edges").Int(static_cast<long long>(t.seam_edges));
   json.Key("seam_step_before").Double(t.seam_step_before);
   json.Key("seam_step_after").Double(t.seam_step_after);
+  json.Key("photo_exposures").BeginArray();
+  for (const PhotoExposure& photo : report.photo_exposures) {
+    json.BeginObject().Key("name").String(photo.name);
+    json.Key("gain").BeginArray().Double(photo.gain.x()).Double(photo.gain.y()).Double(photo.gain.z()).EndArray();
+    if (photo.log_exposure) json.Key("log_exposure").Double(*photo.log_exposure);
+    json.EndObject();
+  }
+  json.EndArray();
+  if (report.exposure_fit) {
+    const ExposureFit& fit = *report.exposure_fit;
+    json.Key("exposure_fit").BeginObject();
+    json.Key("intercept").BeginArray().Double(fit.intercept.x()).Double(fit.intercept.y()).Double(fit.intercept.z());
+    json.EndArray();
+    json.Key("slope").BeginArray().Double(fit.slope.x()).Double(fit.slope.y()).Double(fit.slope.z()).EndArray();
+    json.Key("photos").Int(static_cast<long long>(fit.photos)).Key("correlation").Double(fit.correlation);
+    json.EndObject();
+  }
   json.Key("atlas_pages").Int(static_cast<long long>(t.atlas_pages));
   json.Key("atlas_width").Int(t.atlas_width).Key("atlas_height").Int(t.atlas_height);
   json.Key("texels_per_pixel").Double(t.texels_per_pixel);

@@ -12,11 +12,13 @@
 // texture the model. When texturing cannot be done (no photo sees the mesh, a photo that fails to
 // decode) the stage fails with the reason and the untextured mesh stays as it was.
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/base/status.h"
 #include "core/pipeline/project.h"
+#include "core/texture/exposure_fit.h"
 #include "core/texture/texture_mesh.h"
 
 namespace reconar {
@@ -34,6 +36,14 @@ struct TextureStageOptions {
   Status Check() const;
 };
 
+// A textured photo's exposure: its gain (what brings its colours to the texture's exposure) and
+// log H from its EXIF (core/texture/exposure_fit.h) when it has the settings.
+struct PhotoExposure {
+  std::string name;
+  Eigen::Vector3f gain = Eigen::Vector3f::Ones();
+  std::optional<double> log_exposure;
+};
+
 struct TextureStageReport {
   std::string mesh_path;  // read
   size_t faces_in = 0;    // of the mesh read
@@ -41,6 +51,8 @@ struct TextureStageReport {
   TextureReport texture;
   std::vector<std::string> excluded;  // as asked
   std::vector<std::string> unreadable;  // photos left out because they do not read
+  std::vector<PhotoExposure> photo_exposures;  // the photos textured from
+  std::optional<ExposureFit> exposure_fit;     // gains against EXIF exposure, when it says something
   double seconds = 0.0;
   size_t peak_rss_bytes = 0;
   std::vector<std::string> paths;  // written
@@ -55,6 +67,15 @@ std::string TextureStageSettings(const TextureStageOptions& options);
 Result<TextureStageReport> RunTextureStage(const Project& project, const TextureStageOptions& options);
 
 std::string TextureReportJson(const TextureStageReport& report);
+
+// What `reconar render` needs of the texture's exposure: mesh/texture_report.json's
+// photo_exposures and exposure_fit. FailedPrecondition without a report; kCorruptData naming the
+// file for one that does not parse.
+struct TextureExposure {
+  std::vector<PhotoExposure> photos;
+  std::optional<ExposureFit> fit;
+};
+Result<TextureExposure> ReadTextureExposure(const Project& project);
 
 // The stage's files in PROJECT/mesh, but for the texture's pages (TexturePageFileName).
 struct TexturedModelFiles {

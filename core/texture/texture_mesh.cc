@@ -138,6 +138,7 @@ Result<TexturedMesh> TextureMesh(const Mesh& mesh, const std::vector<TexturePhot
   report->patches = patches.photo.size();
   std::set<int> used(patches.photo.begin(), patches.photo.end());
   report->photos_used = used.size();
+  report->photo_gains = gains;
   for (const Eigen::Vector3f& gain : gains) {
     report->min_gain = std::min(report->min_gain, static_cast<double>(gain.minCoeff()));
     report->max_gain = std::max(report->max_gain, static_cast<double>(gain.maxCoeff()));

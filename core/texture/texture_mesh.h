@@ -94,6 +94,7 @@ struct TextureReport {
   double texels_per_pixel = 0.0;  // the charts' scale against the photos' full resolution
   double atlas_fill = 0.0;        // fraction of the pages' texels that some face covers
   size_t photos_kept_decoded = 0;  // from the views to the atlas (memory_budget_bytes)
+  std::vector<Eigen::Vector3f> photo_gains;  // per photo, in order: its exposure gain (1 unlevelled)
   double seconds_candidates = 0.0, seconds_labelling = 0.0, seconds_seams = 0.0, seconds_atlas = 0.0;
   double seconds = 0.0;
 };

@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
+#include <optional>
 
 #include "core/base/atomic_file.h"
 #include "core/io/image_io.h"
 #include "core/io/image_write.h"
 #include "core/mvs/undistort.h"
 #include "core/pipeline/project.h"
+#include "core/pipeline/texture_stage.h"
 #include "core/sfm/model_io.h"
 #include "platform/egl/egl_context.h"
 #include "render/ar/ar_project.h"
@@ -56,6 +59,15 @@ Image<uint8_t> CoverageMask(const Image<uint8_t>& on_black, const Image<uint8_t>
 
 }  // namespace
 
+const char* RenderExposureName(RenderExposure exposure) {
+  switch (exposure) {
+    case RenderExposure::kPhotoGain: return "photo's gain";
+    case RenderExposure::kExif: return "EXIF";
+    case RenderExposure::kTexture: break;
+  }
+  return "texture";
+}
+
 Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const PhotoRenderOptions& options) {
   if (options.image_names.empty()) return InvalidArgument("render: no photo named");
   if (options.out_dir.empty()) return InvalidArgument("render: no output directory (--out)");
@@ -79,6 +91,18 @@ Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const
   report.textured = !ar_model.texture.empty();
   report.faces = ar_model.mesh.triangles.size();
   RECONAR_RETURN_IF_ERROR(CreateDirectories(options.out_dir));
+  // The texture's exposure, when the model is the project's textured model.
+  std::optional<TextureExposure> exposure;
+  std::error_code error;
+  if (report.textured && options.match_photo_exposure &&
+      std::filesystem::equivalent(report.model_path, TexturedModelPath(project), error)) {
+    Result<TextureExposure> read = ReadTextureExposure(project);
+    if (read.ok()) {
+      exposure = std::move(*read);
+    } else {
+      report.warning = read.status().ToString() + "; the texture is drawn at its own exposure";
+    }
+  }
 
   EglContextOptions context_options;
   context_options.kind = EglContextKind::kSurfaceless;
@@ -90,6 +114,26 @@ Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const
   for (const std::string& name : options.image_names) {
     const SfmImage& image = *registered[name];
     const SfmCamera& camera = model.cameras[static_cast<size_t>(image.camera_id)];
+    RenderExposure exposed = RenderExposure::kTexture;
+    Eigen::Vector3f gain = Eigen::Vector3f::Ones();
+    if (exposure) {
+      const auto own = std::find_if(exposure->photos.begin(), exposure->photos.end(),
+                                    [&](const PhotoExposure& photo) { return photo.name == name; });
+      const auto path = path_of.find(name);
+      if (own != exposure->photos.end()) {
+        gain = own->gain;
+        exposed = RenderExposure::kPhotoGain;
+      } else if (exposure->fit && path != path_of.end()) {
+        const Result<ImageHeader> header = ReadImageHeader(path->second);
+        if (header.ok()) {
+          if (const std::optional<double> log_exposure = LogExposure(header->exif)) {
+            gain = exposure->fit->Predict(*log_exposure);
+            exposed = RenderExposure::kExif;
+          }
+        }
+      }
+    }
+    style.gain = {1.0f / gain.x(), 1.0f / gain.y(), 1.0f / gain.z()};
     CameraIntrinsics intrinsics = camera.Intrinsics();
     intrinsics.k1 = intrinsics.k2 = 0.0;
     Image<uint8_t> renders[2];
@@ -120,6 +164,8 @@ Result<PhotoRenderReport> RenderFromPhotos(const std::string& project_dir, const
     }
     report.written.push_back(base + ".png");
     report.coverage.push_back(coverage);
+    report.exposure.push_back(exposed);
+    report.gain.push_back(gain);
   }
   return report;
 }

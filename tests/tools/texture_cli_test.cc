@@ -141,8 +141,13 @@ TEST(TextureCli, TexturesRendersAndRefusesClearly) {
   // temple, 16 small photos of white plaster, the geometry limits the texture and the vertex
   // colours alike, both about 16 dB.)
   const std::string out = (root / "render").string();
-  const CommandRun render = RunReconar("render " + project + " templeSR0004.png --out " + out);
+  const CommandRun render = RunReconar("render " + project + " templeSR0004.png templeSR0005.png --out " + out);
   ASSERT_EQ(render.exit_code, 0) << render.output;
+  // The held-out photo at the texture's exposure (its PNG has no EXIF to predict its own); a photo
+  // texturing used at its own gain.
+  EXPECT_NE(render.output.find("templeSR0004.png.png (model covers"), std::string::npos) << render.output;
+  EXPECT_NE(render.output.find("exposure: texture"), std::string::npos) << render.output;
+  EXPECT_NE(render.output.find("exposure: photo's gain"), std::string::npos) << render.output;
   const auto mask = ReadImage(out + "/templeSR0004.png.mask.png");
   ASSERT_TRUE(mask.ok() && fs::exists(out + "/templeSR0004.png.png") && fs::exists(out + "/templeSR0004.png.photo.png"));
   size_t covered = 0;

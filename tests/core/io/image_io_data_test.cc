@@ -107,6 +107,10 @@ TEST(ImageIoDataTest, ReadsIphoneExif) {
   EXPECT_EQ(decoded->rgb.width(), 816);
   EXPECT_EQ(decoded->rgb.height(), 612);
   EXPECT_EQ(ReadExifFromJpeg(ReadAll(path)).model, "iPhone 4S");
+  // The exposure settings, as PIL reads them: 1/20 s, f/2.4, ISO 125.
+  EXPECT_DOUBLE_EQ(exif.exposure_time_s, 0.05);
+  EXPECT_NEAR(exif.f_number, 2.4, 1e-9);
+  EXPECT_EQ(exif.iso, 125);
 
   const FocalPrior prior = EstimateFocalPrior(exif, 816, 612);
   EXPECT_EQ(prior.source, FocalPrior::Source::kExif35mm);
@@ -125,6 +129,9 @@ TEST(ImageIoDataTest, ReadsLittleEndianCanonExif) {
   EXPECT_EQ(exif.focal_length_35mm, 0);
   EXPECT_NEAR(exif.focal_plane_x_resolution, 3106.8, 0.1);
   EXPECT_EQ(exif.focal_plane_resolution_unit, 2);
+  EXPECT_DOUBLE_EQ(exif.exposure_time_s, 0.05);  // 1/20 s at f/2.8, no ISO recorded (as PIL reads it)
+  EXPECT_NEAR(exif.f_number, 2.8, 1e-9);
+  EXPECT_EQ(exif.iso, 0);
   const FocalPrior prior = EstimateFocalPrior(exif, decoded->rgb.width(), decoded->rgb.height());
   EXPECT_EQ(prior.source, FocalPrior::Source::kExifSensorTable);
   EXPECT_NEAR(prior.focal_px, exif.focal_length_mm / 5.27 * 640, 1e-6);
