@@ -9,6 +9,7 @@
 #include "core/base/thread_pool.h"
 #include "core/texture/face_adjacency.h"
 #include "core/texture/face_views.h"
+#include "core/texture/photo_gains.h"
 #include "core/texture/seam_levelling.h"
 #include "core/texture/texture_atlas.h"
 #include "core/texture/view_labelling.h"

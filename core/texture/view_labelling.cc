@@ -44,53 +44,6 @@ FaceCandidateTable GroupByFace(size_t num_faces, const std::vector<std::vector<F
   return table;
 }
 
-std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table, size_t num_photos) {
-  std::vector<std::array<std::vector<float>, 3>> ratios(num_photos);
-  std::vector<float> channel;
-  for (size_t f = 0; f + 1 < table.begin.size(); ++f) {
-    const size_t begin = table.begin[f], end = table.begin[f + 1];
-    if (end - begin < 2) continue;
-    for (size_t c = 0; c < 3; ++c) {
-      channel.clear();
-      for (size_t k = begin; k < end; ++k) channel.push_back(table.candidates[k].colour[c]);
-      const float median = MedianInPlace(channel.data(), channel.size());
-      if (median < kMinGainColour) continue;
-      for (size_t k = begin; k < end; ++k) {
-        ratios[static_cast<size_t>(table.candidates[k].photo)][c].push_back(table.candidates[k].colour[c] / median);
-      }
-    }
-  }
-  std::vector<Eigen::Vector3f> gains(num_photos, Eigen::Vector3f::Ones());
-  for (size_t p = 0; p < num_photos; ++p) {
-    for (size_t c = 0; c < 3; ++c) {
-      if (ratios[p][c].empty()) continue;
-      const float ratio = MedianInPlace(ratios[p][c].data(), ratios[p][c].size());
-      if (ratio > 0.0f) gains[p][static_cast<int>(c)] = 1.0f / ratio;
-    }
-  }
-  // One common scale keeps the mean colour of all the candidates as the photos show it.
-  Eigen::Vector3d observed = Eigen::Vector3d::Zero(), levelled = Eigen::Vector3d::Zero();
-  for (const FaceCandidate& candidate : table.candidates) {
-    const Eigen::Vector3f& gain = gains[static_cast<size_t>(candidate.photo)];
-    for (int c = 0; c < 3; ++c) {
-      observed[c] += candidate.colour[static_cast<size_t>(c)];
-      levelled[c] += gain[c] * candidate.colour[static_cast<size_t>(c)];
-    }
-  }
-  for (int c = 0; c < 3; ++c) {
-    if (levelled[c] <= 0.0) continue;
-    const float scale = static_cast<float>(observed[c] / levelled[c]);
-    for (Eigen::Vector3f& gain : gains) gain[c] *= scale;
-  }
-  return gains;
-}
-
-void ApplyPhotoGains(const std::vector<Eigen::Vector3f>& gains, FaceCandidateTable* table) {
-  for (FaceCandidate& candidate : table->candidates) {
-    for (size_t c = 0; c < 3; ++c) candidate.colour[c] *= gains[static_cast<size_t>(candidate.photo)][static_cast<int>(c)];
-  }
-}
-
 void WeighCandidates(FaceCandidateTable* table) {
   std::vector<float> sharpness;
   for (size_t f = 0; f + 1 < table->begin.size(); ++f) {

@@ -46,16 +46,6 @@ struct FaceCandidateTable {
 // Groups the candidates (any order) of `num_faces` faces, each face's in photo order.
 FaceCandidateTable GroupByFace(size_t num_faces, const std::vector<std::vector<FaceCandidate>>& per_photo);
 
-// Exposure: photos of one scene differ in exposure and white balance (a camera on automatic),
-// which a texture made of several photos shows as patches of another brightness. Each photo gets
-// a gain per channel: the inverse of the median, over the faces it sees with others, of its
-// colour there over the median colour of the face's candidates (faces darker than
-// kMinGainColour left out), scaled so that the mean colour of all the candidates is kept. Candidate colours are multiplied by their photo's gain; so are the seam
-// samples and the texels.
-inline constexpr float kMinGainColour = 16.0f;
-std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table, size_t num_photos);
-void ApplyPhotoGains(const std::vector<Eigen::Vector3f>& gains, FaceCandidateTable* table);
-
 // Sets every candidate's quality from its area and sharpness (above).
 void WeighCandidates(FaceCandidateTable* table);
 
