@@ -29,10 +29,10 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
                                                 const PhotoGainOptions& options) {
   const size_t num_faces = table.begin.size() - 1;
   const size_t num_candidates = table.candidates.size();
-  // Per candidate: its log colour and weight; weight 0 for a candidate left out, or on a face with
-  // fewer than two usable candidates.
-  std::vector<Eigen::Vector3d> log_colour(num_candidates, Eigen::Vector3d::Zero());
-  std::vector<double> weight(num_candidates, 0.0);
+  // Per candidate (floats: a million candidates are common): its log colour and weight; weight 0 for
+  // a candidate left out, or on a face with fewer than two usable candidates.
+  std::vector<Eigen::Vector3f> log_colour(num_candidates, Eigen::Vector3f::Zero());
+  std::vector<float> weight(num_candidates, 0.0f);
   for (size_t f = 0; f < num_faces; ++f) {
     const size_t begin = table.begin[f], end = table.begin[f + 1];
     size_t usable = 0;
@@ -41,14 +41,15 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
     for (size_t k = begin; k < end; ++k) {
       const FaceCandidate& candidate = table.candidates[k];
       if (!Usable(candidate)) continue;
-      weight[k] = 1.0;
-      for (int c = 0; c < 3; ++c) log_colour[k][c] = std::log(static_cast<double>(candidate.colour[static_cast<size_t>(c)]));
+      weight[k] = 1.0f;
+      for (int c = 0; c < 3; ++c) log_colour[k][c] = std::log(candidate.colour[static_cast<size_t>(c)]);
     }
   }
 
   const Eigen::Index n = static_cast<Eigen::Index>(num_photos);
   Eigen::MatrixXd system(n, n);
   Eigen::MatrixX3d rhs(n, 3), log_gain = Eigen::MatrixX3d::Zero(n, 3);
+  std::vector<float> rms(num_candidates, 0.0f);  // per candidate, its last RMS log residual
   std::vector<float> residuals;
   residuals.reserve(num_candidates);
   auto photo_of = [&](size_t k) { return static_cast<Eigen::Index>(table.candidates[k].photo); };
@@ -56,7 +57,7 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double total = 0.0;
     for (size_t k = begin; k < end; ++k) {
-      sum += weight[k] * (log_colour[k] + log_gain.row(photo_of(k)).transpose());
+      sum += weight[k] * (log_colour[k].cast<double>() + log_gain.row(photo_of(k)).transpose());
       total += weight[k];
     }
     *total_weight = total;
@@ -66,7 +67,6 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
   for (int round = 0; round < std::max(1, options.max_rounds); ++round) {
     if (round > 0) {
       // Huber weights from the residuals of the last solution, against the faces' weighted means.
-      std::vector<double> rms(num_candidates, 0.0);
       residuals.clear();
       for (size_t f = 0; f < num_faces; ++f) {
         const size_t begin = table.begin[f], end = table.begin[f + 1];
@@ -75,9 +75,9 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
         if (total <= 0.0) continue;
         for (size_t k = begin; k < end; ++k) {
           if (weight[k] <= 0.0) continue;
-          const Eigen::Vector3d residual = log_colour[k] + log_gain.row(photo_of(k)).transpose() - mean;
-          rms[k] = std::sqrt(residual.squaredNorm() / 3.0);
-          residuals.push_back(static_cast<float>(rms[k]));
+          const Eigen::Vector3d residual = log_colour[k].cast<double>() + log_gain.row(photo_of(k)).transpose() - mean;
+          rms[k] = static_cast<float>(std::sqrt(residual.squaredNorm() / 3.0));
+          residuals.push_back(rms[k]);
         }
       }
       if (residuals.empty()) break;
@@ -85,7 +85,7 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
       if (!(scale > 0.0)) break;
       const double threshold = kHuberThreshold * scale;
       for (size_t k = 0; k < num_candidates; ++k) {
-        if (weight[k] > 0.0) weight[k] = rms[k] <= threshold ? 1.0 : threshold / rms[k];
+        if (weight[k] > 0.0f) weight[k] = rms[k] <= threshold ? 1.0f : static_cast<float>(threshold / rms[k]);
       }
     }
     // Normal equations: with r_f eliminated, each face adds w_p (a_p - mean_f(a)) = -w_p (x_p - mean_f(x)).
@@ -96,7 +96,7 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
       double total = 0.0;
       Eigen::Vector3d mean_colour = Eigen::Vector3d::Zero();
       for (size_t k = begin; k < end; ++k) {
-        mean_colour += weight[k] * log_colour[k];
+        mean_colour += weight[k] * log_colour[k].cast<double>();
         total += weight[k];
       }
       if (total <= 0.0) continue;
@@ -105,8 +105,8 @@ std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table,
         if (weight[k] <= 0.0) continue;
         const Eigen::Index p = photo_of(k);
         system(p, p) += weight[k];
-        rhs.row(p) -= weight[k] * (log_colour[k] - mean_colour).transpose();
-        const double scaled = weight[k] / total;
+        rhs.row(p) -= weight[k] * (log_colour[k].cast<double>() - mean_colour).transpose();
+        const double scaled = static_cast<double>(weight[k]) / total;
         for (size_t j = begin; j < end; ++j) system(p, photo_of(j)) -= scaled * weight[j];
       }
     }
