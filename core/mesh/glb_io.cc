@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -471,9 +472,20 @@ class GlbDecoder {
       return textured;
     }
     textured.pages.push_back({0, std::move(image)});
-    // The other TRIANGLES primitives, when every one has a base colour image.
+    // The other TRIANGLES primitives, when every one has a base colour image; else the first alone.
     const JsonValue& primitives = *(*RootArray("meshes"))[0].Find("primitives");
-    TexturedGlb pages = textured;
+    Mesh& mesh = textured.mesh;
+    const std::array<size_t, 5> first_sizes = {mesh.positions.size(), mesh.normals.size(), mesh.colors.size(),
+                                               mesh.texcoords.size(), mesh.triangles.size()};
+    auto first_primitive_alone = [&]() {
+      mesh.positions.resize(first_sizes[0]);
+      mesh.normals.resize(first_sizes[1]);
+      mesh.colors.resize(first_sizes[2]);
+      mesh.texcoords.resize(first_sizes[3]);
+      mesh.triangles.resize(first_sizes[4]);
+      textured.pages.resize(1);
+      return std::move(textured);
+    };
     for (size_t p = 1; p < primitives.size(); ++p) {
       const std::string where = "meshes[0].primitives[" + std::to_string(p) + "]";
       if (!primitives[p].is_object()) return Corrupt(where + " is not an object");
@@ -481,23 +493,22 @@ class GlbDecoder {
       RECONAR_RETURN_IF_ERROR(GetIndex(primitives[p], "mode", where, &mode, kModeTriangles));
       if (mode != kModeTriangles) continue;
       RECONAR_RETURN_IF_ERROR(ReadBaseColorImage(primitives[p], where, &index, &image));
-      if (image.empty()) return textured;
+      if (image.empty()) return first_primitive_alone();
       RECONAR_ASSIGN_OR_RETURN(const Mesh part, ReadPrimitive(primitives[p], where));
       if (part.triangles.empty()) continue;
       if (part.texcoords.size() != part.positions.size()) {
         return Unsupported(where + " has no TEXCOORD_0 for its texture");
       }
-      if (part.positions.size() > kMaxSceneVertices - pages.mesh.positions.size()) {
+      if (part.positions.size() > kMaxSceneVertices - mesh.positions.size()) {
         return FileError(StatusCode::kResourceExhausted, name_,
                          "more than " + std::to_string(kMaxSceneVertices) + " vertices in the mesh");
       }
-      if (pages.mesh.normals.empty() != part.normals.empty() || pages.mesh.colors.empty() != part.colors.empty()) {
+      if (mesh.normals.empty() != part.normals.empty() || mesh.colors.empty() != part.colors.empty()) {
         return Unsupported(where + " has other vertex attributes than meshes[0].primitives[0]");
       }
-      if (index != image_index) pages.pages.push_back({pages.mesh.triangles.size(), std::move(image)});
+      if (index != image_index) textured.pages.push_back({mesh.triangles.size(), std::move(image)});
       image_index = index;
-      const uint32_t first_vertex = static_cast<uint32_t>(pages.mesh.positions.size());
-      Mesh& mesh = pages.mesh;
+      const uint32_t first_vertex = static_cast<uint32_t>(mesh.positions.size());
       mesh.positions.insert(mesh.positions.end(), part.positions.begin(), part.positions.end());
       mesh.normals.insert(mesh.normals.end(), part.normals.begin(), part.normals.end());
       mesh.colors.insert(mesh.colors.end(), part.colors.begin(), part.colors.end());
@@ -506,7 +517,7 @@ class GlbDecoder {
         mesh.triangles.push_back({triangle[0] + first_vertex, triangle[1] + first_vertex, triangle[2] + first_vertex});
       }
     }
-    return pages;
+    return textured;
   }
 
   // A .glb, or a .gltf JSON text.

@@ -1,5 +1,5 @@
 #pragma once
-// The photos' exposure gains (view_labelling.h: per photo and channel, what brings its colours to
+// The photos' exposure gains (photo_gains.h: per photo and channel, what brings its colours to
 // the photos' common exposure) against their cameras' exposure settings, so that a photo texturing
 // did not use can be shown at its own exposure: per channel, log gain = intercept + slope * log H,
 // H = ExposureTime * ISO / FNumber^2 (the light the sensor integrates for one scene radiance),

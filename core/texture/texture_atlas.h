@@ -75,7 +75,7 @@ struct AtlasFill {
   double covered_fraction = 0.0;      // of all the pages' texels
 };
 
-// `gains`: per photo, multiplying its colours (view_labelling.h).
+// `gains`: per photo, multiplying its colours (photo_gains.h).
 Result<AtlasFill> FillAtlas(const Mesh& mesh, const AtlasLayout& layout, const std::vector<PhotoProjector>& projectors,
                             const std::vector<Eigen::Vector3f>& gains, const PatchColourCorrection& correction,
                             const PhotoAccess& access, int num_threads);

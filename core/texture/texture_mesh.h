@@ -5,8 +5,9 @@
 // 1. Candidates (face_views.h): in each photo, a depth buffer of the whole mesh decides which faces
 //    the photo sees; a seen face gets a quality (its projected area times the photo's local
 //    gradient magnitude: close, frontal and sharp views win) and its mean colour there.
-// 2. Labels (view_labelling.h): each photo's exposure is levelled to the others'; per face, candidates whose colour disagrees with the others'
-//    (a passer-by, a reflection) are dropped; then each face takes a photo so that its own quality
+// 2. Labels: each photo's exposure is levelled to all the others' at once (photo_gains.h); per face
+//    (view_labelling.h), candidates whose colour disagrees with the others' (a passer-by, a
+//    reflection) are dropped; then each face takes a photo so that its own quality
 //    and its neighbours' agreement are best together (a Potts labelling). Connected faces with the
 //    same photo form a patch.
 // 3. Seams (seam_levelling.h): one colour offset per patch, by least squares over the patches'
@@ -60,7 +61,7 @@ struct TextureOptions {
   double smoothness = 0.3;
   int max_labelling_sweeps = 30;
   bool check_photo_consistency = true;
-  bool level_exposure = true;  // a gain per photo and channel (view_labelling.h)
+  bool level_exposure = true;  // a gain per photo and channel (photo_gains.h)
   bool level_seams = true;
   int blend_rings = 6;  // how far into a patch the local seam correction fades
   // A photo stays decoded from the views to the atlas while the process, with it, stays under this

@@ -183,6 +183,40 @@ TEST(GlbTest, TexturePagesAreOnePrimitiveAndMaterialEach) {
   }
 }
 
+TEST(GlbTest, APageWithoutAnImageLeavesTheFirstPrimitiveAlone) {
+  // Two textured pages, then the second's material taken away: not a paged texture any more, so
+  // the first primitive is read alone, as a file that only it textures.
+  std::vector<NamedMesh> parts;
+  for (int k = 0; k < 2; ++k) {
+    Mesh part = testing::RandomMesh(40 + 10 * k, 60 + k, true, false, 3 + k);
+    for (size_t i = 0; i < part.positions.size(); ++i) part.texcoords.emplace_back(i / 100.0f, 0.5f * k);
+    parts.push_back({"", part});
+  }
+  const std::vector<EncodedTexturePage> pages = {{0, std::string("\x89PNG\r\n\x1a\n", 8) + "page 0"},
+                                                 {parts[0].mesh.triangles.size(), std::string("\x89PNG\r\n\x1a\n", 8) + "page 1"}};
+  const Result<std::string> glb = EncodeTexturedGlb(JoinMeshes(parts), pages);
+  ASSERT_TRUE(glb.ok()) << glb.status().ToString();
+  std::string json = glb->substr(20, Load32(*glb, 12));
+  const std::string member = ",\"material\":1";
+  const size_t material = json.find(member);
+  ASSERT_NE(material, std::string::npos) << json;
+  json.erase(material, member.size());
+  const Result<TexturedGlb> read = DecodeTexturedGlb(MakeGlb(json, Split(*glb).bin), "one_page.glb");
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  ASSERT_EQ(read->pages.size(), 1u);
+  EXPECT_EQ(read->pages[0].image, pages[0].image);
+  const Mesh& first = parts[0].mesh;
+  ASSERT_EQ(read->mesh.triangles.size(), first.triangles.size());
+  ASSERT_EQ(read->mesh.positions.size(), first.positions.size());
+  EXPECT_EQ(read->mesh.normals.size(), first.positions.size());
+  EXPECT_EQ(read->mesh.texcoords.size(), first.positions.size());
+  for (size_t t = 0; t < first.triangles.size(); ++t) {
+    for (size_t c = 0; c < 3; ++c) {
+      EXPECT_EQ(read->mesh.positions[read->mesh.triangles[t][c]], first.positions[first.triangles[t][c]]);
+    }
+  }
+}
+
 TEST(GlbTest, IndexTypeFollowsTheVertexCount) {
   // 65535 vertices: the largest index is 65534, below the reserved 65535, so uint16 suffices.
   for (const int num_vertices : {65535, 65536}) {
