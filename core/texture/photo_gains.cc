@@ -27,7 +27,8 @@ bool Usable(const FaceCandidate& candidate) {
 
 std::vector<Eigen::Vector3f> EstimatePhotoGains(const FaceCandidateTable& table, size_t num_photos,
                                                 const PhotoGainOptions& options) {
-  const size_t num_faces = table.begin.size() - 1;
+  if (num_photos == 0) return {};
+  const size_t num_faces = table.begin.empty() ? 0 : table.begin.size() - 1;
   const size_t num_candidates = table.candidates.size();
   // Per candidate (floats: a million candidates are common): its log colour and weight; weight 0 for
   // a candidate left out, or on a face with fewer than two usable candidates.

@@ -115,5 +115,12 @@ TEST(PhotoGainsTest, ClippedAndUnsharedCandidatesSayNothing) {
   }
 }
 
+TEST(PhotoGainsTest, NothingSharedLeavesEveryGainAtOne) {
+  EXPECT_TRUE(EstimatePhotoGains(FaceCandidateTable(), 0).empty());
+  const std::vector<Eigen::Vector3f> gains = EstimatePhotoGains(GroupByFace(0, {}), 2);
+  ASSERT_EQ(gains.size(), 2u);
+  for (const Eigen::Vector3f& gain : gains) EXPECT_EQ(gain, Eigen::Vector3f::Ones());
+}
+
 }  // namespace
 }  // namespace reconar
