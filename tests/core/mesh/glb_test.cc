@@ -138,21 +138,29 @@ TEST(GlbTest, TexturedWritingRefusesWhatCannotBeATexturedModel) {
   EXPECT_EQ(EncodeTexturedGlb(mesh, {{0, png}}).status().code(), StatusCode::kInvalidArgument);
 }
 
-TEST(GlbTest, TexturePagesAreOnePrimitiveAndMaterialEach) {
-  // Three pages as texturing writes them: each page's vertices its own.
+// Pages as texturing writes them, each page's vertices its own, with a fake PNG each.
+struct PagedMesh {
   std::vector<NamedMesh> parts;
-  for (int k = 0; k < 3; ++k) {
-    Mesh part = testing::RandomMesh(50 + 10 * k, 80 + k, true, false, 7 + k);
-    for (size_t i = 0; i < part.positions.size(); ++i) part.texcoords.emplace_back(i / 100.0f, 0.25f * k);
-    parts.push_back({"", part});
-  }
-  const Mesh mesh = JoinMeshes(parts);
   std::vector<EncodedTexturePage> pages;
+};
+
+PagedMesh MakePagedMesh(int num_pages) {
+  PagedMesh paged;
   size_t first = 0;
-  for (int k = 0; k < 3; ++k) {
-    pages.push_back({first, std::string("\x89PNG\r\n\x1a\n", 8) + "page " + std::to_string(k)});
-    first += parts[static_cast<size_t>(k)].mesh.triangles.size();
+  for (int k = 0; k < num_pages; ++k) {
+    Mesh part = testing::RandomMesh(50 + 10 * k, 80 + k, true, false, 7 + static_cast<unsigned>(k));
+    for (size_t i = 0; i < part.positions.size(); ++i) part.texcoords.emplace_back(i / 100.0f, 0.25f * k);
+    paged.pages.push_back({first, std::string("\x89PNG\r\n\x1a\n", 8) + "page " + std::to_string(k)});
+    first += part.triangles.size();
+    paged.parts.push_back({"", std::move(part)});
   }
+  return paged;
+}
+
+TEST(GlbTest, TexturePagesAreOnePrimitiveAndMaterialEach) {
+  const PagedMesh paged = MakePagedMesh(3);
+  const Mesh mesh = JoinMeshes(paged.parts);
+  const std::vector<EncodedTexturePage>& pages = paged.pages;
   const Result<std::string> glb = EncodeTexturedGlb(mesh, pages);
   ASSERT_TRUE(glb.ok()) << glb.status().ToString();
   const GlbParts split = Split(*glb);
@@ -186,15 +194,8 @@ TEST(GlbTest, TexturePagesAreOnePrimitiveAndMaterialEach) {
 TEST(GlbTest, APageWithoutAnImageLeavesTheFirstPrimitiveAlone) {
   // Two textured pages, then the second's material taken away: not a paged texture any more, so
   // the first primitive is read alone, as a file that only it textures.
-  std::vector<NamedMesh> parts;
-  for (int k = 0; k < 2; ++k) {
-    Mesh part = testing::RandomMesh(40 + 10 * k, 60 + k, true, false, 3 + k);
-    for (size_t i = 0; i < part.positions.size(); ++i) part.texcoords.emplace_back(i / 100.0f, 0.5f * k);
-    parts.push_back({"", part});
-  }
-  const std::vector<EncodedTexturePage> pages = {{0, std::string("\x89PNG\r\n\x1a\n", 8) + "page 0"},
-                                                 {parts[0].mesh.triangles.size(), std::string("\x89PNG\r\n\x1a\n", 8) + "page 1"}};
-  const Result<std::string> glb = EncodeTexturedGlb(JoinMeshes(parts), pages);
+  const PagedMesh paged = MakePagedMesh(2);
+  const Result<std::string> glb = EncodeTexturedGlb(JoinMeshes(paged.parts), paged.pages);
   ASSERT_TRUE(glb.ok()) << glb.status().ToString();
   std::string json = glb->substr(20, Load32(*glb, 12));
   const std::string member = ",\"material\":1";
@@ -204,8 +205,8 @@ TEST(GlbTest, APageWithoutAnImageLeavesTheFirstPrimitiveAlone) {
   const Result<TexturedGlb> read = DecodeTexturedGlb(MakeGlb(json, Split(*glb).bin), "one_page.glb");
   ASSERT_TRUE(read.ok()) << read.status().ToString();
   ASSERT_EQ(read->pages.size(), 1u);
-  EXPECT_EQ(read->pages[0].image, pages[0].image);
-  const Mesh& first = parts[0].mesh;
+  EXPECT_EQ(read->pages[0].image, paged.pages[0].image);
+  const Mesh& first = paged.parts[0].mesh;
   ASSERT_EQ(read->mesh.triangles.size(), first.triangles.size());
   ASSERT_EQ(read->mesh.positions.size(), first.positions.size());
   EXPECT_EQ(read->mesh.normals.size(), first.positions.size());
