@@ -80,14 +80,16 @@ ScreenColours ReadScreen(Display* display) {
   return colours;
 }
 
-// Shows the picture until the screen holds it (the server draws it asynchronously), at most ~2 s.
-ScreenColours ShowAndRead(CaptureWindow* window, const Image<uint8_t>& picture, Display* display, long expected) {
+// Shows the picture until the screen holds about `each` pixels of red and of blue (the server
+// draws asynchronously, so the screen may still show the picture before), at most ~2 s.
+ScreenColours ShowAndRead(CaptureWindow* window, const Image<uint8_t>& picture, Display* display, long each) {
+  auto near = [each](long count) { return count >= each * 9 / 10 && count <= each * 11 / 10; };
   ScreenColours colours;
   for (int attempt = 0; attempt < 40; ++attempt) {
     const Result<bool> shown = window->Show(picture);
     EXPECT_TRUE(shown.ok()) << shown.status().ToString();
     colours = ReadScreen(display);
-    if (colours.red >= expected && colours.blue >= expected) break;
+    if (near(colours.red) && near(colours.blue)) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   return colours;
@@ -120,14 +122,14 @@ TEST(CaptureWindow, ThePictureIsOnTheScreenUprightAndQStops) {
   EXPECT_NE((*window)->Describe().find("x11"), std::string::npos) << (*window)->Describe();
 
   // 320 x 240 fills the 400 x 300 window: 400 x 150 of each colour.
-  ScreenColours colours = ShowAndRead(window->get(), RedOverBlue(320, 240), display, 400 * 150 * 9 / 10);
+  ScreenColours colours = ShowAndRead(window->get(), RedOverBlue(320, 240), display, 400 * 150);
   EXPECT_GE(colours.red, 400 * 150 * 9 / 10);
   EXPECT_GE(colours.blue, 400 * 150 * 9 / 10);
   EXPECT_LT(colours.red_mean_y, colours.blue_mean_y) << "the picture's top (red) must be at the top";
 
   // A picture of another size (a camera that changed mode) is letterboxed into the same window:
   // 640 x 160 scaled to 400 x 100.
-  colours = ShowAndRead(window->get(), RedOverBlue(640, 160), display, 400 * 50 * 9 / 10);
+  colours = ShowAndRead(window->get(), RedOverBlue(640, 160), display, 400 * 50);
   EXPECT_GE(colours.red, 400 * 50 * 9 / 10);
   EXPECT_LE(colours.red, 400 * 50 * 11 / 10);
   EXPECT_LT(colours.red_mean_y, colours.blue_mean_y);
