@@ -27,84 +27,131 @@ int NextPowerOfTwo(int value) {
   return power;
 }
 
+// The rows [low, high] a triangle spans over the vertical slab [x0, x1]; false when it misses it.
+bool TriangleRowsOverSlab(const std::array<Eigen::Vector2d, 3>& corner, double x0, double x1, double* low, double* high) {
+  *low = INFINITY;
+  *high = -INFINITY;
+  for (size_t i = 0; i < 3; ++i) {
+    const Eigen::Vector2d& a = corner[i];
+    const Eigen::Vector2d& b = corner[(i + 1) % 3];
+    if (a.x() >= x0 && a.x() <= x1) {
+      *low = std::min(*low, a.y());
+      *high = std::max(*high, a.y());
+    }
+    for (const double x : {x0, x1}) {  // where the edge crosses the slab's sides
+      if ((a.x() - x) * (b.x() - x) < 0.0) {
+        const double y = a.y() + (b.y() - a.y()) * (x - a.x()) / (b.x() - a.x());
+        *low = std::min(*low, y);
+        *high = std::max(*high, y);
+      }
+    }
+  }
+  return *low <= *high;
+}
+
+// The rows each column of the chart's rectangle may take: a texel is filled when its centre lies
+// in a face, then the filled texels grow by padding + 1 rings (DilateChart); so per column, the
+// rows of its faces over the column widened by those rings, widened by them again.
+void ProfileChart(double scale, int padding, TextureChart* chart) {
+  const size_t columns = static_cast<size_t>((chart->width + kChartColumnWidth - 1) / kChartColumnWidth);
+  if (chart->patch < 0) {
+    chart->profile.assign(columns, {0, chart->height});
+    return;
+  }
+  chart->profile.assign(columns, {chart->height, 0});
+  const int grow = padding + 1;
+  std::array<Eigen::Vector2d, 3> corner;
+  for (const std::array<uint32_t, 3>& triangle : chart->triangles) {
+    double x_low = INFINITY, x_high = -INFINITY;
+    for (size_t i = 0; i < 3; ++i) {
+      corner[i] = (chart->pixels[triangle[i]].array() + 0.5 - chart->pixel_min.array()).matrix() * scale +
+                  Eigen::Vector2d::Constant(padding);
+      x_low = std::min(x_low, corner[i].x());
+      x_high = std::max(x_high, corner[i].x());
+    }
+    const int first_column = std::max(0, static_cast<int>(std::floor(x_low)) - grow) / kChartColumnWidth;
+    const int last_column = std::min(chart->width - 1, static_cast<int>(std::floor(x_high)) + grow) / kChartColumnWidth;
+    for (int column = first_column; column <= last_column; ++column) {
+      double low, high;
+      const double x0 = column * kChartColumnWidth - grow, x1 = (column + 1) * kChartColumnWidth + grow;
+      if (!TriangleRowsOverSlab(corner, x0, x1, &low, &high)) continue;
+      std::array<int, 2>& rows = chart->profile[static_cast<size_t>(column)];
+      rows[0] = std::min(rows[0], std::max(0, static_cast<int>(std::floor(low)) - grow));
+      rows[1] = std::max(rows[1], std::min(chart->height, static_cast<int>(std::floor(high)) + grow + 1));
+    }
+  }
+}
+
 void SizeCharts(double scale, int padding, std::vector<TextureChart>* charts) {
   for (TextureChart& chart : *charts) {
     if (chart.patch < 0) {
       chart.width = chart.height = 2 * padding + 2;
-      continue;
+    } else {
+      const Eigen::Vector2d extent = (chart.pixel_max - chart.pixel_min) * scale;
+      chart.width = static_cast<int>(std::ceil(extent.x())) + 2 * padding + 1;
+      chart.height = static_cast<int>(std::ceil(extent.y())) + 2 * padding + 1;
     }
-    const Eigen::Vector2d extent = (chart.pixel_max - chart.pixel_min) * scale;
-    chart.width = static_cast<int>(std::ceil(extent.x())) + 2 * padding + 1;
-    chart.height = static_cast<int>(std::ceil(extent.y())) + 2 * padding + 1;
+    ProfileChart(scale, padding, &chart);
   }
 }
 
-// Skyline packing (bottom-left) into pages `width` wide and at most `max_height` high: each chart,
-// in `order`, goes where a page's skyline lets it sit lowest (its top the smallest), leftmost
-// among equals, on the first page where it fits; a new page when none holds it. The skyline is
-// the top edge of what is placed, as segments left to right. The height used on each page, or
-// nothing when a chart is wider than `width` or higher than `max_height`.
+// Texels the charts' profiles take.
+double ProfileArea(const std::vector<TextureChart>& charts) {
+  double area = 0.0;
+  for (const TextureChart& chart : charts) {
+    for (const std::array<int, 2>& rows : chart.profile) area += kChartColumnWidth * std::max(0, rows[1] - rows[0]);
+  }
+  return area;
+}
+
+// Skyline packing by profile into pages `width` wide and at most `max_height` high: the skyline
+// is a height per column of kChartColumnWidth texels; each chart, in `order`, rests on it by its
+// lower profile where its upper profile's top is lowest (leftmost among equals), on the first page
+// where its rectangle fits; a new page when none holds it. Its upper profile becomes the skyline
+// under it. The height each page's rectangles reach, or nothing when a chart is wider than `width`
+// or higher than `max_height`.
 std::optional<std::vector<int>> PackSkyline(int width, int max_height, const std::vector<size_t>& order,
-                             std::vector<TextureChart>* charts) {
-  struct Segment {
-    int x, y, width;
-  };
-  std::vector<std::vector<Segment>> skylines;
+                                            std::vector<TextureChart>* charts) {
+  const size_t columns = static_cast<size_t>(width / kChartColumnWidth);
+  std::vector<std::vector<int>> skylines;
   std::vector<int> used;
   for (const size_t index : order) {
     TextureChart& chart = (*charts)[index];
     if (chart.width > width || chart.height > max_height) return std::nullopt;
-    int best_top = INT32_MAX, best_segment = -1, best_y = 0;
+    int profile_end = 0;  // the lowest row under the chart's profile, from its rectangle's top
+    for (const std::array<int, 2>& rows : chart.profile) profile_end = std::max(profile_end, rows[1]);
+    int best_top = INT32_MAX, best_column = -1, best_y = 0;
     size_t page = 0;
     for (; page < skylines.size(); ++page) {
-      const std::vector<Segment>& skyline = skylines[page];
-      for (size_t i = 0; i < skyline.size(); ++i) {
-        if (skyline[i].x + chart.width > width) break;
+      const std::vector<int>& skyline = skylines[page];
+      for (size_t x0 = 0; static_cast<int>(x0) * kChartColumnWidth + chart.width <= width; ++x0) {
         int y = 0;
-        for (size_t j = i; j < skyline.size() && skyline[j].x < skyline[i].x + chart.width; ++j) {
-          y = std::max(y, skyline[j].y);
+        for (size_t c = 0; c < chart.profile.size(); ++c) {
+          const std::array<int, 2>& rows = chart.profile[c];
+          if (rows[1] > rows[0]) y = std::max(y, skyline[x0 + c] - rows[0]);
         }
-        if (y + chart.height < best_top && y + chart.height <= max_height) {
-          best_top = y + chart.height;
-          best_segment = static_cast<int>(i);
+        if (y + profile_end < best_top && y + chart.height <= max_height) {
+          best_top = y + profile_end;
+          best_column = static_cast<int>(x0);
           best_y = y;
         }
       }
-      if (best_segment >= 0) break;
+      if (best_column >= 0) break;
     }
     if (page == skylines.size()) {
-      skylines.push_back({{0, 0, width}});
+      skylines.emplace_back(columns, 0);
       used.push_back(0);
-      best_top = chart.height;
-      best_segment = 0;
+      best_column = 0;
       best_y = 0;
     }
-    std::vector<Segment>& skyline = skylines[page];
+    std::vector<int>& skyline = skylines[page];
     chart.page = static_cast<int>(page);
-    chart.x = skyline[static_cast<size_t>(best_segment)].x;
+    chart.x = best_column * kChartColumnWidth;
     chart.y = best_y;
-    used[page] = std::max(used[page], best_top);
-    // The new segment replaces what it covers; a segment partly covered keeps its right part.
-    const int right = chart.x + chart.width;
-    size_t j = static_cast<size_t>(best_segment);
-    while (j < skyline.size() && skyline[j].x + skyline[j].width <= right) ++j;
-    std::vector<Segment> next(skyline.begin(), skyline.begin() + best_segment);
-    next.push_back({chart.x, best_top, chart.width});
-    if (j < skyline.size()) {
-      Segment rest = skyline[j];
-      rest.width -= right - rest.x;
-      rest.x = right;
-      if (rest.width > 0) next.push_back(rest);
-      next.insert(next.end(), skyline.begin() + static_cast<ptrdiff_t>(j) + 1, skyline.end());
-    }
-    // Neighbours at one height merge.
-    skyline.clear();
-    for (const Segment& segment : next) {
-      if (!skyline.empty() && skyline.back().y == segment.y) {
-        skyline.back().width += segment.width;
-      } else {
-        skyline.push_back(segment);
-      }
+    used[page] = std::max(used[page], best_y + chart.height);
+    for (size_t c = 0; c < chart.profile.size(); ++c) {
+      const std::array<int, 2>& rows = chart.profile[c];
+      if (rows[1] > rows[0]) skyline[static_cast<size_t>(best_column) + c] = best_y + rows[1];
     }
   }
   return used;
@@ -172,8 +219,9 @@ void FillTriangle(const Mesh& mesh, const AtlasLayout& layout, const TextureChar
   }
 }
 
-// Grows the chart's covered texels into the rest of its rectangle, `rings` texels far: each pass
-// gives an uncovered texel the mean of its covered 8-neighbours.
+// Grows the chart's covered texels into the rest of its profile, `rings` texels far: each pass
+// gives an uncovered texel the mean of its covered 8-neighbours. It reads and writes only texels
+// of its own profile, which no other chart's overlaps: charts are grown in parallel.
 void DilateChart(const TextureChart& chart, int rings, Image<uint8_t>* atlas, std::vector<uint8_t>* covered) {
   const int width = atlas->width();
   std::vector<std::pair<int, std::array<uint8_t, 3>>> grown;
@@ -181,13 +229,12 @@ void DilateChart(const TextureChart& chart, int rings, Image<uint8_t>* atlas, st
     grown.clear();
     for (int y = chart.y; y < chart.y + chart.height; ++y) {
       for (int x = chart.x; x < chart.x + chart.width; ++x) {
-        if ((*covered)[static_cast<size_t>(y) * width + x]) continue;
+        if (!chart.Owns(x, y) || (*covered)[static_cast<size_t>(y) * width + x]) continue;
         int sum[3] = {0, 0, 0}, count = 0;
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dx = -1; dx <= 1; ++dx) {
             const int nx = x + dx, ny = y + dy;
-            if (nx < chart.x || ny < chart.y || nx >= chart.x + chart.width || ny >= chart.y + chart.height) continue;
-            if (!(*covered)[static_cast<size_t>(ny) * width + nx]) continue;
+            if (!chart.Owns(nx, ny) || !(*covered)[static_cast<size_t>(ny) * width + nx]) continue;
             const uint8_t* in = atlas->row(ny) + 3 * nx;
             for (int c = 0; c < 3; ++c) sum[c] += in[c];
             ++count;
@@ -209,6 +256,13 @@ void DilateChart(const TextureChart& chart, int rings, Image<uint8_t>* atlas, st
 }
 
 }  // namespace
+
+bool TextureChart::Owns(int page_x, int page_y) const {
+  const int local_x = page_x - x, local_y = page_y - y;
+  if (local_x < 0 || local_x >= width) return false;
+  const std::array<int, 2>& rows = profile[static_cast<size_t>(local_x / kChartColumnWidth)];
+  return local_y >= rows[0] && local_y < rows[1];
+}
 
 Eigen::Vector2d AtlasLayout::Texel(const TextureChart& chart, size_t local_vertex) const {
   if (chart.patch < 0) return Eigen::Vector2d(chart.x + 0.5 * chart.width, chart.y + 0.5 * chart.height);
@@ -313,8 +367,7 @@ Result<AtlasLayout> PackCharts(std::vector<TextureChart> charts, int atlas_size,
   };
   // At full resolution, the narrowest power-of-two square-ish page that holds the charts.
   SizeCharts(1.0, padding, &charts);
-  double area = 0.0;
-  for (const TextureChart& chart : charts) area += static_cast<double>(chart.width) * chart.height;
+  const double area = ProfileArea(charts);
   int width = std::min(atlas_size, NextPowerOfTwo(std::max(kMinAtlasSide, static_cast<int>(std::sqrt(area)))));
   double scale = 1.0;
   std::optional<std::vector<int>> heights;

@@ -4,9 +4,15 @@
 // A chart is a patch's faces as its photo sees them (a patch that fills little of its bounding
 // box is cut into pieces that fill more): its vertices' full-resolution pixels, scaled
 // by one factor for the whole atlas (at most 1: never finer than the photos), offset to the
-// chart's rectangle, with `padding` texels around. The rectangles are packed, tallest first, each
-// where it sits lowest on the skyline of those before it (bottom-left skyline packing), into the
-// narrowest power-of-two square page that holds them all; when atlas_size does not, into pages of
+// chart's rectangle, with `padding` texels around. Charts are irregular (their faces fill about
+// half their rectangles on the fountain), so they are packed by their shape, not their
+// rectangle: per column of kChartColumnWidth texels, the rows its faces take there, widened by
+// the padding + 1 rings its texels are grown over, its profile. Tallest first, each chart goes
+// where its profile's top sits lowest on the skyline of those before it, the skyline a height per
+// column and the chart resting on it by the bottom of its profile, so that it nests into the gaps
+// its neighbours' shapes leave; the top of its profile becomes the skyline. Rectangles may
+// overlap, profiles never: a chart's texels and padding are written only within its profile. Into
+// the narrowest power-of-two square page that holds them all; when atlas_size does not, into pages of
 // atlas_size x atlas_size (a chart goes on the first page it fits on), as many as `max_pages`, and
 // when even those do not hold them at full resolution, the largest scale that fits is found by
 // bisection. Each page's height is cropped to the power of two its charts reach.
@@ -41,7 +47,15 @@ struct TextureChart {
   Eigen::Vector2d pixel_min = Eigen::Vector2d::Zero(), pixel_max = Eigen::Vector2d::Zero();
   int page = 0;                                      // of the atlas
   int x = 0, y = 0, width = 0, height = 0;           // rectangle in its page, padding included
+  // Per column of kChartColumnWidth texels of the rectangle, from the left: the rows [first, end)
+  // (from the rectangle's top) that its faces and padding may take; end <= first for none.
+  std::vector<std::array<int, 2>> profile;
+
+  // Whether the texel (page coordinates) lies within the chart's profile.
+  bool Owns(int page_x, int page_y) const;
 };
+
+inline constexpr int kChartColumnWidth = 2;
 
 struct AtlasPage {
   int width = 0, height = 0;  // texels, powers of two
